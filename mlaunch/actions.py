@@ -1,0 +1,817 @@
+"""Actions: the launch description, as the same classes and keywords as ROS 2 ``launch.actions``.
+
+An action is data plus ``execute(resolver)``, which reads the context, adds steps to the plan
+and may return entities to visit next. Nothing here starts a process or prints.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import shutil
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.origin import caller_origin
+from mlaunch.plan import (
+    OUTPUT_MODES,
+    AddHandler,
+    ArgumentInfo,
+    Deferred,
+    Log,
+    ProcessSpec,
+    RemoveHandler,
+    RequestShutdown,
+    RespawnPolicy,
+    StartTimer,
+)
+from mlaunch.plan import EmitEvent as EmitEventStep
+from mlaunch.substitutions import (
+    LaunchConfiguration,
+    SomeSubstitutionsType,
+    Substitution,
+    describe,
+    normalize,
+    perform,
+    perform_substitutions,
+    to_bool,
+)
+
+if TYPE_CHECKING:
+    from mlaunch.conditions import Condition
+    from mlaunch.context import LaunchContext
+    from mlaunch.resolve import Resolver
+
+
+class LaunchDescriptionEntity:
+    """Anything that can appear in a launch description."""
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        return None
+
+    def describe_short(self) -> str:
+        return type(self).__name__
+
+
+class Action(LaunchDescriptionEntity):
+    """Base of every action: an optional condition and where it was written."""
+
+    def __init__(self, *, condition: Condition | None = None) -> None:
+        self.condition = condition
+        self.origin = caller_origin()
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        if self.condition is not None and not self.condition.evaluate(resolver.context):
+            return None
+        return self.execute(resolver)
+
+    def execute(self, resolver: Resolver) -> list[Any] | None:
+        return None
+
+    def get_sub_entities(self) -> list[Any]:
+        return []
+
+
+class LaunchDescription(LaunchDescriptionEntity):
+    """An ordered list of entities; what generate_launch_description() returns."""
+
+    def __init__(
+        self, initial_entities: Iterable[Any] | None = None, *, deprecated_reason: str | None = None
+    ) -> None:
+        self.entities: list[Any] = list(initial_entities or [])
+        self.deprecated_reason = deprecated_reason
+        self.origin = caller_origin()
+
+    def add_action(self, action: Any) -> None:
+        self.entities.append(action)
+
+    def add_entity(self, entity: Any) -> None:
+        self.entities.append(entity)
+
+    def describe_sub_entities(self) -> list[Any]:
+        return list(self.entities)
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        if self.deprecated_reason:
+            resolver.warn(f"launch description is deprecated: {self.deprecated_reason}")
+        resolver.visit_all(self.entities)
+        return None
+
+    def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
+        """The DeclareLaunchArgument actions in this description, includes not followed."""
+        found: list[Any] = []
+
+        def walk(entities: Iterable[Any]) -> None:
+            for entity in entities:
+                if isinstance(entity, DeclareLaunchArgument):
+                    found.append(entity)
+                elif isinstance(entity, (LaunchDescription, GroupAction)):
+                    walk(
+                        entity.entities if isinstance(entity, LaunchDescription) else entity.actions
+                    )
+
+        walk(self.entities)
+        return found
+
+
+# --- arguments and configurations ------------------------------------------------------------
+
+
+class DeclareLaunchArgument(Action):
+    """A launch argument: the command line or an includer may set it, else its default applies."""
+
+    def __init__(
+        self,
+        name: str,
+        *,
+        default_value: SomeSubstitutionsType | None = None,
+        description: str | None = None,
+        choices: Iterable[str] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.name = name
+        self.default_value = None if default_value is None else normalize(default_value)
+        self.choices = None if choices is None else tuple(str(c) for c in choices)
+        if self.choices is not None and not self.choices:
+            raise LaunchArgumentError(
+                f"argument {name!r} declares an empty list of choices", where=self.origin
+            )
+        if description is None:
+            description = (
+                f"One of: {list(self.choices)}" if self.choices else "no description given"
+            )
+        elif self.choices:
+            sep = "" if description.endswith(".") else "."
+            description = f"{description}{sep} Valid choices are: {list(self.choices)}"
+        self.description = description
+
+    def argument_info(self, conditional: bool) -> ArgumentInfo:
+        default = None
+        if self.default_value is not None:
+            default = " + ".join(
+                s.text if hasattr(s, "text") else s.describe()  # type: ignore[attr-defined]
+                for s in self.default_value
+            )
+        return ArgumentInfo(
+            name=self.name,
+            default=default,
+            description=self.description,
+            choices=self.choices,
+            origin=self.origin,
+            conditional=conditional or self.condition is not None,
+        )
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        resolver.plan.arguments.setdefault(self.name, self.argument_info(conditional=False))
+        if self.name not in ctx.launch_configurations:
+            if self.default_value is None:
+                raise LaunchArgumentError(
+                    f"required launch argument {self.name!r} was not provided"
+                    f" (pass {self.name}:=<value>)"
+                    + (f"; valid choices: {', '.join(self.choices)}" if self.choices else ""),
+                    where=self.origin,
+                )
+            ctx.launch_configurations[self.name] = perform_substitutions(ctx, self.default_value)
+        value = ctx.launch_configurations[self.name]
+        if self.choices is not None and value not in self.choices:
+            raise LaunchArgumentError(
+                f"argument {self.name!r} got {value!r}, which is not one of its choices:"
+                f" {', '.join(self.choices)}",
+                where=self.origin,
+            )
+
+    def describe_short(self) -> str:
+        return f"DeclareLaunchArgument({self.name!r})"
+
+
+class SetLaunchConfiguration(Action):
+    def __init__(self, name: SomeSubstitutionsType, value: SomeSubstitutionsType, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+        self.value = normalize(value)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        name = perform_substitutions(ctx, self.name)
+        ctx.launch_configurations[name] = perform_substitutions(ctx, self.value)
+
+
+class UnsetLaunchConfiguration(Action):
+    def __init__(self, name: SomeSubstitutionsType, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        ctx.launch_configurations.pop(perform_substitutions(ctx, self.name), None)
+
+
+class PushLaunchConfigurations(Action):
+    def execute(self, resolver: Resolver) -> None:
+        resolver.context.push_scope()
+
+
+class PopLaunchConfigurations(Action):
+    def execute(self, resolver: Resolver) -> None:
+        resolver.context.pop_scope()
+
+
+PushEnvironment = PushLaunchConfigurations
+PopEnvironment = PopLaunchConfigurations
+
+
+class ResetLaunchConfigurations(Action):
+    """Forget every configuration, then set the given ones (performed before forgetting)."""
+
+    def __init__(self, launch_configurations: dict[Any, Any] | None = None, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.launch_configurations = launch_configurations or {}
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        keep = {perform(ctx, k): perform(ctx, v) for k, v in self.launch_configurations.items()}
+        ctx.launch_configurations = keep
+
+
+class ResetEnvironment(Action):
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        ctx.environment = dict(ctx.initial_environment)
+
+
+# --- environment -----------------------------------------------------------------------------
+
+
+class SetEnvironmentVariable(Action):
+    def __init__(self, name: SomeSubstitutionsType, value: SomeSubstitutionsType, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+        self.value = normalize(value)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        ctx.environment[perform_substitutions(ctx, self.name)] = perform_substitutions(
+            ctx, self.value
+        )
+
+
+class UnsetEnvironmentVariable(Action):
+    def __init__(self, name: SomeSubstitutionsType, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        ctx.environment.pop(perform_substitutions(ctx, self.name), None)
+
+
+class AppendEnvironmentVariable(Action):
+    def __init__(
+        self,
+        name: SomeSubstitutionsType,
+        value: SomeSubstitutionsType,
+        prepend: Any = False,
+        separator: SomeSubstitutionsType = os.pathsep,
+        **kwargs: Any,
+    ):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+        self.value = normalize(value)
+        self.prepend = prepend
+        self.separator = normalize(separator)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        name = perform_substitutions(ctx, self.name)
+        value = perform_substitutions(ctx, self.value)
+        prepend = (
+            self.prepend
+            if isinstance(self.prepend, bool)
+            else to_bool(perform(ctx, self.prepend), "prepend")
+        )
+        old = ctx.environment.get(name)
+        sep = perform_substitutions(ctx, self.separator)
+        if not old:
+            ctx.environment[name] = value
+        else:
+            ctx.environment[name] = f"{value}{sep}{old}" if prepend else f"{old}{sep}{value}"
+
+
+# --- structure -------------------------------------------------------------------------------
+
+
+class GroupAction(Action):
+    """Actions in a scope: by default configuration and environment changes stay inside."""
+
+    def __init__(
+        self,
+        actions: Iterable[Any],
+        *,
+        scoped: Any = True,
+        forwarding: Any = True,
+        launch_configurations: dict[Any, Any] | None = None,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.actions = list(actions)
+        self.scoped = scoped
+        self.forwarding = forwarding
+        self.launch_configurations = launch_configurations or {}
+
+    def get_sub_entities(self) -> list[Any]:
+        return list(self.actions)
+
+    def _flag(self, ctx: LaunchContext, value: Any, what: str) -> bool:
+        return value if isinstance(value, bool) else to_bool(perform(ctx, value), what)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        configs = {perform(ctx, k): perform(ctx, v) for k, v in self.launch_configurations.items()}
+        if not self._flag(ctx, self.scoped, "scoped"):
+            ctx.launch_configurations.update(configs)
+            resolver.visit_all(self.actions)
+            return
+        with ctx.scope(forwarding=self._flag(ctx, self.forwarding, "forwarding"), configs=configs):
+            resolver.visit_all(self.actions)
+
+
+class IncludeLaunchDescription(Action):
+    """Another launch file (any format), with arguments; not scoped, as in ROS 2.
+
+    ``scoped=True`` (an mlaunch extension, like rolling's ScopedIncludeLaunchDescription) keeps
+    the included file's configurations and environment changes from leaking out.
+    """
+
+    def __init__(
+        self,
+        launch_description_source: Any,
+        *,
+        launch_arguments: Iterable[tuple[Any, Any]] | dict[Any, Any] | None = None,
+        scoped: bool = False,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        from mlaunch.launch_description_sources import LaunchDescriptionSource, source_for
+
+        if not isinstance(launch_description_source, LaunchDescriptionSource):
+            launch_description_source = source_for(launch_description_source)
+        self.launch_description_source = launch_description_source
+        if isinstance(launch_arguments, dict):
+            launch_arguments = list(launch_arguments.items())
+        self.launch_arguments = list(launch_arguments or [])
+        self.scoped = scoped
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        source = self.launch_description_source
+        path = source.get_launch_file_location(ctx)
+        args = [(perform(ctx, k), perform(ctx, v)) for k, v in self.launch_arguments]
+        description = resolver.load_source(source, ctx, origin=self.origin)
+        if self.scoped:
+            ctx.push_scope()
+        try:
+            for name, value in args:
+                ctx.launch_configurations[name] = value
+            if path is None:
+                resolver.visit(description)
+            else:
+                with ctx.file_locals(path):
+                    resolver.visit(description)
+        finally:
+            if self.scoped:
+                ctx.pop_scope()
+
+    def describe_short(self) -> str:
+        return f"IncludeLaunchDescription({self.launch_description_source.describe()})"
+
+
+class OpaqueFunction(Action):
+    """Call ``function(context, *args, **kwargs)`` while resolving; visit what it returns."""
+
+    def __init__(
+        self,
+        *,
+        function: Callable[..., Any],
+        args: Iterable[Any] | None = None,
+        kwargs: dict[str, Any] | None = None,
+        **action_kwargs: Any,
+    ) -> None:
+        super().__init__(**action_kwargs)
+        self.function = function
+        self.args = list(args or [])
+        self.kwargs = dict(kwargs or {})
+
+    def execute(self, resolver: Resolver) -> list[Any] | None:
+        result = resolver.call_user(self.function, resolver.context, *self.args, **self.kwargs)
+        return list(result) if result else None
+
+    def describe_short(self) -> str:
+        return f"OpaqueFunction({getattr(self.function, '__qualname__', self.function)!r})"
+
+
+class OpaqueCoroutine(OpaqueFunction):
+    """Not supported: mlaunch does not run an asyncio loop for launch files."""
+
+    def __init__(self, *, coroutine: Callable[..., Any], **kwargs: Any) -> None:
+        raise LaunchFileError(
+            "OpaqueCoroutine is not supported by mlaunch (no asyncio loop runs launch code);"
+            " use an OpaqueFunction or a TimerAction",
+            where=caller_origin(),
+        )
+
+
+class TimerAction(Action):
+    """Resolve and run ``actions`` after ``period`` seconds (cancelled on shutdown by default)."""
+
+    def __init__(
+        self,
+        *,
+        period: float | SomeSubstitutionsType,
+        actions: Iterable[Any],
+        cancel_on_shutdown: Any = True,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.period = period
+        self.actions = list(actions)
+        self.cancel_on_shutdown = cancel_on_shutdown
+
+    def get_sub_entities(self) -> list[Any]:
+        return list(self.actions)
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        period = resolver.float_value(self.period, "TimerAction period", self.origin)
+        cancel = self.cancel_on_shutdown
+        if not isinstance(cancel, bool):
+            cancel = to_bool(perform(ctx, cancel), "cancel_on_shutdown")
+        resolver.add(
+            StartTimer(
+                origin=self.origin,
+                period=period,
+                body=resolver.defer(self.actions, self.origin),
+                cancel_on_shutdown=cancel,
+            )
+        )
+
+    def describe_short(self) -> str:
+        return f"TimerAction(period={self.period!r})"
+
+
+# --- events ----------------------------------------------------------------------------------
+
+
+class RegisterEventHandler(Action):
+    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event_handler = event_handler
+
+    def execute(self, resolver: Resolver) -> None:
+        handler = self.event_handler
+        kind = getattr(handler, "kind", "")
+        if not kind:
+            raise LaunchFileError(
+                f"event handler {type(handler).__name__} is not supported by mlaunch",
+                where=self.origin,
+            )
+        resolver.add(
+            AddHandler(
+                origin=self.origin,
+                kind=kind,
+                matcher=handler.process_matcher() if hasattr(handler, "process_matcher") else None,
+                body=resolver.defer(handler.entities, self.origin, callback=handler.callback),
+                io_callbacks=dict(getattr(handler, "io_callbacks", {})),
+                once=handler.handle_once,
+                handler=handler,
+            )
+        )
+
+
+class UnregisterEventHandler(Action):
+    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event_handler = event_handler
+
+    def execute(self, resolver: Resolver) -> None:
+        resolver.add(RemoveHandler(origin=self.origin, handler=self.event_handler))
+
+
+class EmitEvent(Action):
+    def __init__(self, *, event: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event = event
+
+    def execute(self, resolver: Resolver) -> None:
+        from mlaunch.events import Shutdown as ShutdownEvent
+
+        if isinstance(self.event, ShutdownEvent):
+            resolver.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
+        else:
+            resolver.add(EmitEventStep(origin=self.origin, event=self.event))
+
+
+class Shutdown(Action):
+    """Shut the launch down (what ``on_exit=Shutdown()`` uses to make a process required)."""
+
+    def __init__(self, *, reason: SomeSubstitutionsType = "reason not given", **kwargs: Any):
+        super().__init__(**kwargs)
+        self.reason = normalize(reason)
+
+    def execute(self, resolver: Resolver) -> None:
+        reason = perform_substitutions(resolver.context, self.reason)
+        resolver.add(RequestShutdown(origin=self.origin, reason=reason))
+
+
+class LogInfo(Action):
+    def __init__(self, *, msg: SomeSubstitutionsType, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.msg = normalize(msg)
+
+    def execute(self, resolver: Resolver) -> None:
+        resolver.add(
+            Log(origin=self.origin, message=perform_substitutions(resolver.context, self.msg))
+        )
+
+
+# --- processes -------------------------------------------------------------------------------
+
+
+def _number(resolver: Resolver, value: Any, what: str, origin: str) -> float:
+    return resolver.float_value(value, what, origin)
+
+
+class ExecuteProcess(Action):
+    """A process to start and supervise, with ROS 2's keywords (ExecuteProcess/ExecuteLocal).
+
+    mlaunch extensions: ``respawn`` also takes ``'always'``/``'on-failure'``; ``required=True``
+    is short for ``on_exit=Shutdown()``; ``respawn_backoff``/``respawn_max_delay`` slow a crash
+    loop down.
+    """
+
+    def __init__(
+        self,
+        *,
+        cmd: Iterable[SomeSubstitutionsType],
+        prefix: SomeSubstitutionsType | None = None,
+        name: SomeSubstitutionsType | None = None,
+        cwd: SomeSubstitutionsType | None = None,
+        env: dict[Any, Any] | None = None,
+        additional_env: dict[Any, Any] | None = None,
+        shell: bool = False,
+        sigterm_timeout: Any = LaunchConfiguration("sigterm_timeout", default=5),
+        sigkill_timeout: Any = LaunchConfiguration("sigkill_timeout", default=5),
+        emulate_tty: Any = False,
+        output: Any = "log",
+        output_format: str = "[{this.process_description.final_name}] {line}",
+        cached_output: bool = False,
+        log_cmd: bool = False,
+        on_exit: Any = None,
+        respawn: Any = False,
+        respawn_delay: Any = None,
+        respawn_max_retries: Any = -1,
+        respawn_backoff: Any = 1.0,
+        respawn_max_delay: Any = 30.0,
+        required: Any = False,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        if isinstance(cmd, (str, Substitution)):
+            cmd = [cmd]
+        self.cmd = [normalize(item) for item in cmd]
+        self.prefix = None if prefix is None else normalize(prefix)
+        self.name = None if name is None else normalize(name)
+        self.cwd = None if cwd is None else normalize(cwd)
+        self.env = env
+        self.additional_env = additional_env
+        self.shell = shell
+        self.sigterm_timeout = sigterm_timeout
+        self.sigkill_timeout = sigkill_timeout
+        self.emulate_tty = emulate_tty
+        self.output = output
+        self.log_cmd = log_cmd
+        self.on_exit = on_exit
+        self.respawn = respawn
+        self.respawn_delay = respawn_delay
+        self.respawn_max_retries = respawn_max_retries
+        self.respawn_backoff = respawn_backoff
+        self.respawn_max_delay = respawn_max_delay
+        self.required = required
+
+    # The ROS layer (Node) overrides these three to build a node's command line.
+    def command(self, resolver: Resolver) -> list[str]:
+        """The argv before any prefix: each cmd item performed to one element."""
+        return [perform_substitutions(resolver.context, item) for item in self.cmd]
+
+    def label_base(self, resolver: Resolver, argv: list[str]) -> str:
+        if self.name is not None:
+            return perform_substitutions(resolver.context, self.name)
+        return os.path.basename(argv[0]) if argv else "process"
+
+    def node_info(self, resolver: Resolver) -> Any:
+        return None
+
+    def execute(self, resolver: Resolver) -> None:
+        resolver.spawn(self.build_spec(resolver))
+
+    def build_spec(self, resolver: Resolver) -> ProcessSpec:
+        ctx = resolver.context
+        argv = self.command(resolver)
+        if not argv or not argv[0]:
+            raise SubstitutionFailure("the command is empty", where=self.origin)
+        argv, standin = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
+        prefix = self._prefix(ctx, argv)
+        label_argv = prefix + argv if prefix else argv
+        base = self.label_base(resolver, label_argv)
+        env = self._environment(ctx)
+        on_exit, required = self._exit_policy(resolver)
+        spec = ProcessSpec(
+            label=resolver.new_label(base),
+            argv=tuple(prefix + argv),
+            env=env,
+            env_changes=_env_changes(ctx.initial_environment, env),
+            cwd=None if self.cwd is None else perform_substitutions(ctx, self.cwd),
+            shell=self.shell,
+            output=self._output(ctx),
+            respawn=self._respawn(resolver),
+            sigterm_timeout=_number(resolver, self.sigterm_timeout, "sigterm_timeout", self.origin),
+            sigkill_timeout=_number(resolver, self.sigkill_timeout, "sigkill_timeout", self.origin),
+            required=required,
+            on_exit=on_exit,
+            origin=self.origin,
+            action=self,
+            node=self.node_info(resolver),
+            standin=standin,
+        )
+        if spec.cwd is not None and not os.path.isdir(spec.cwd):
+            raise MlaunchError(
+                f"working directory {spec.cwd!r} does not exist", where=self.origin, what=base
+            )
+        return spec
+
+    def _prefix(self, ctx: LaunchContext, argv: list[str]) -> list[str]:
+        if self.prefix is not None:
+            text = perform_substitutions(ctx, self.prefix)
+        else:
+            text = str(ctx.launch_configurations.get("launch-prefix", ""))
+            pattern = str(ctx.launch_configurations.get("launch-prefix-filter", ""))
+            if text and pattern:
+                import re
+
+                if not re.match(pattern, os.path.basename(argv[0])):
+                    text = ""
+        return shlex.split(text) if text.strip() else []
+
+    def _environment(self, ctx: LaunchContext) -> dict[str, str]:
+        if self.env is not None:
+            env = {perform(ctx, k): perform(ctx, v) for k, v in _items(self.env)}
+        else:
+            env = dict(ctx.environment)
+        if self.additional_env:
+            env.update({perform(ctx, k): perform(ctx, v) for k, v in _items(self.additional_env)})
+        # Timely output from pipes (ROS 2's L#188): children line-buffer unless told otherwise.
+        env.setdefault("PYTHONUNBUFFERED", "1")
+        env.setdefault("RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED", "1")
+        if _truthy(ctx, self.emulate_tty) or _truthy(
+            ctx, ctx.launch_configurations.get("emulate_tty", False)
+        ):
+            env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
+        return env
+
+    def _output(self, ctx: LaunchContext) -> str:
+        override = ctx.environment.get("OVERRIDE_LAUNCH_PROCESS_OUTPUT")
+        value = self.output
+        if isinstance(value, dict):
+            value = _output_from_dict(value)
+        text = override or perform(ctx, value)
+        if text not in OUTPUT_MODES:
+            raise MlaunchError(
+                f"output is {text!r}; valid: {', '.join(OUTPUT_MODES)}", where=self.origin
+            )
+        return text
+
+    def _respawn(self, resolver: Resolver) -> RespawnPolicy:
+        ctx = resolver.context
+        value = self.respawn
+        if isinstance(value, bool):
+            mode = "always" if value else "never"
+        else:
+            text = perform(ctx, value).strip().lower()
+            if text in ("always", "on-failure", "on_failure", "never"):
+                mode = text.replace("_", "-")
+            else:
+                try:
+                    mode = "always" if to_bool(text, "respawn") else "never"
+                except SubstitutionFailure:
+                    raise MlaunchError(
+                        f"respawn is {text!r}; valid: true, false, always, on-failure, never",
+                        where=self.origin,
+                    )
+        delay = 0.0
+        if self.respawn_delay is not None:
+            delay = resolver.float_value(self.respawn_delay, "respawn_delay", self.origin)
+        retries = int(
+            resolver.float_value(self.respawn_max_retries, "respawn_max_retries", self.origin)
+        )
+        backoff = resolver.float_value(self.respawn_backoff, "respawn_backoff", self.origin)
+        max_delay = resolver.float_value(self.respawn_max_delay, "respawn_max_delay", self.origin)
+        if delay < 0 or backoff < 1.0:
+            raise MlaunchError(
+                f"respawn_delay must be >= 0 and respawn_backoff >= 1 (got {delay}, {backoff})",
+                where=self.origin,
+            )
+        return RespawnPolicy(
+            mode=mode, delay=delay, max_retries=retries, backoff=backoff, max_delay=max_delay
+        )
+
+    def _exit_policy(self, resolver: Resolver) -> tuple[Deferred | None, bool]:
+        ctx = resolver.context
+        required = self.required
+        if not isinstance(required, bool):
+            required = to_bool(perform(ctx, required), "required")
+        on_exit = self.on_exit
+        if on_exit is None:
+            return None, required
+        if callable(on_exit) and not hasattr(on_exit, "visit"):
+            return resolver.defer([], self.origin, callback=on_exit), required
+        entities = list(on_exit) if isinstance(on_exit, (list, tuple)) else [on_exit]
+        if any(isinstance(e, Shutdown) for e in entities):
+            required = True
+        return resolver.defer(entities, self.origin), required
+
+    def describe_short(self) -> str:
+        return "ExecuteProcess(" + " ".join(describe(c) for c in self.cmd) + ")"
+
+
+def _items(mapping: Any) -> list[tuple[Any, Any]]:
+    if isinstance(mapping, dict):
+        return list(mapping.items())
+    return list(mapping)
+
+
+def _truthy(ctx: LaunchContext, value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    try:
+        return to_bool(perform(ctx, value), "emulate_tty")
+    except SubstitutionFailure:
+        return False
+
+
+def _output_from_dict(value: dict[str, Any]) -> str:
+    """ROS 2's dict form of ``output``, mapped to the nearest whole mode."""
+    targets = {k: ({v} if isinstance(v, str) else set(v)) for k, v in value.items()}
+    both = targets.get("both", set())
+    stdout = targets.get("stdout", set()) | both
+    stderr = targets.get("stderr", set()) | both
+    if "screen" in stdout and "screen" in stderr:
+        return "both" if ("log" in stdout or "log" in stderr) else "screen"
+    if "own_log" in stdout or "own_log" in stderr:
+        return "own_log"
+    return "log"
+
+
+def _env_changes(before: dict[str, str], after: dict[str, str]) -> dict[str, str | None]:
+    changes: dict[str, str | None] = {k: v for k, v in after.items() if before.get(k) != v}
+    changes.update({k: None for k in before if k not in after})
+    return changes
+
+
+ExecuteLocal = ExecuteProcess
+
+
+def which(name: str, env: dict[str, str]) -> str | None:
+    return shutil.which(name, path=env.get("PATH", os.defpath))
+
+
+__all__ = [
+    "Action",
+    "AppendEnvironmentVariable",
+    "DeclareLaunchArgument",
+    "EmitEvent",
+    "ExecuteLocal",
+    "ExecuteProcess",
+    "GroupAction",
+    "IncludeLaunchDescription",
+    "LaunchDescription",
+    "LaunchDescriptionEntity",
+    "LogInfo",
+    "OpaqueCoroutine",
+    "OpaqueFunction",
+    "PopEnvironment",
+    "PopLaunchConfigurations",
+    "PushEnvironment",
+    "PushLaunchConfigurations",
+    "RegisterEventHandler",
+    "ResetEnvironment",
+    "ResetLaunchConfigurations",
+    "SetEnvironmentVariable",
+    "SetLaunchConfiguration",
+    "Shutdown",
+    "TimerAction",
+    "UnregisterEventHandler",
+    "UnsetEnvironmentVariable",
+    "UnsetLaunchConfiguration",
+]

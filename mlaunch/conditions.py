@@ -1,0 +1,92 @@
+"""Conditions: whether an action is visited, decided while resolving."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.substitutions import (
+    SomeSubstitutionsType,
+    describe,
+    evaluate_condition_expression,
+    normalize,
+    perform_substitutions,
+)
+
+if TYPE_CHECKING:
+    from mlaunch.context import LaunchContext
+
+
+class Condition:
+    """A predicate over the launch context."""
+
+    def __init__(self, *, predicate: Callable[[Any], bool] | None = None) -> None:
+        self._predicate = predicate
+
+    def evaluate(self, context: LaunchContext) -> bool:
+        if self._predicate is None:
+            return True
+        return bool(self._predicate(context))
+
+    def describe(self) -> str:
+        return type(self).__name__
+
+
+class IfCondition(Condition):
+    """True when the expression performs to true or 1 (false/0 otherwise; anything else fails)."""
+
+    def __init__(self, predicate_expression: SomeSubstitutionsType) -> None:
+        super().__init__()
+        self.expression = normalize(predicate_expression)
+
+    def evaluate(self, context: LaunchContext) -> bool:
+        return evaluate_condition_expression(perform_substitutions(context, self.expression))
+
+    def describe(self) -> str:
+        return f"if {describe(self.expression)}"
+
+
+class UnlessCondition(IfCondition):
+    def evaluate(self, context: LaunchContext) -> bool:
+        return not super().evaluate(context)
+
+    def describe(self) -> str:
+        return f"unless {describe(self.expression)}"
+
+
+class LaunchConfigurationEquals(Condition):
+    """The configuration equals the expected text; ``expected_value=None`` means it is unset."""
+
+    def __init__(self, launch_configuration_name: str, expected_value: Any) -> None:
+        super().__init__()
+        self.name = launch_configuration_name
+        self.expected = None if expected_value is None else normalize(expected_value)
+
+    def _matches(self, context: LaunchContext) -> bool:
+        value = context.launch_configurations.get(self.name)
+        if self.expected is None:
+            return value is None
+        return value is not None and value == perform_substitutions(context, self.expected)
+
+    def evaluate(self, context: LaunchContext) -> bool:
+        return self._matches(context)
+
+    def describe(self) -> str:
+        return f"{self.name} == {describe(self.expected) if self.expected else 'unset'}"
+
+
+class LaunchConfigurationNotEquals(LaunchConfigurationEquals):
+    def evaluate(self, context: LaunchContext) -> bool:
+        return not self._matches(context)
+
+    def describe(self) -> str:
+        return f"{self.name} != {describe(self.expected) if self.expected else 'unset'}"
+
+
+__all__ = [
+    "Condition",
+    "IfCondition",
+    "LaunchConfigurationEquals",
+    "LaunchConfigurationNotEquals",
+    "UnlessCondition",
+]

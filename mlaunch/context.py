@@ -1,0 +1,133 @@
+"""The launch context: what substitutions and conditions are evaluated against while resolving.
+
+Unlike ROS 2, ``environment`` is a copy owned by the context, never the launcher's own
+``os.environ``: SetEnvironmentVariable changes what later children get, and a scoped group or a
+deferred action restores or captures it without touching the launcher process.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from typing import Any
+
+
+class Locals:
+    """Attribute access to the context locals (``context.locals.event``), as ROS 2 offers."""
+
+    def __init__(self, values: dict[str, Any]) -> None:
+        object.__setattr__(self, "_values", values)
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self._values[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._values
+
+    def get(self, name: str, default: Any = None) -> Any:
+        return self._values.get(name, default)
+
+
+class LaunchContext:
+    """Launch configurations, environment and locals, with scopes that can be pushed and popped."""
+
+    def __init__(
+        self,
+        *,
+        environment: Mapping[str, str],
+        argv: tuple[str, ...] = (),
+        log_dir: str = "",
+        warn: Callable[[str], None] | None = None,
+    ) -> None:
+        self.launch_configurations: dict[str, Any] = {}
+        self.environment: dict[str, str] = dict(environment)
+        self.initial_environment: dict[str, str] = dict(environment)
+        self.argv = argv
+        self.log_dir = log_dir
+        self._locals: dict[str, Any] = {}
+        self._scopes: list[tuple[dict[str, Any], dict[str, str]]] = []
+        self._warn = warn
+
+    # --- what ROS 2 launch files use -------------------------------------------------------
+
+    @property
+    def locals(self) -> Locals:
+        return Locals(self._locals)
+
+    def get_locals_as_dict(self) -> dict[str, Any]:
+        return dict(self._locals)
+
+    def extend_locals(self, values: Mapping[str, Any]) -> None:
+        self._locals.update(values)
+
+    def perform_substitution(self, substitution: Any) -> str:
+        from mlaunch.substitutions import perform
+
+        return perform(self, substitution)
+
+    @property
+    def current_launch_file_path(self) -> str | None:
+        return self._locals.get("current_launch_file_path")
+
+    def warn(self, message: str) -> None:
+        if self._warn is not None:
+            self._warn(message)
+
+    # --- scopes ------------------------------------------------------------------------------
+
+    def push_scope(self) -> None:
+        self._scopes.append((dict(self.launch_configurations), dict(self.environment)))
+
+    def pop_scope(self) -> None:
+        configs, env = self._scopes.pop()
+        self.launch_configurations = configs
+        self.environment = env
+
+    @contextmanager
+    def scope(
+        self, *, forwarding: bool = True, configs: Mapping[str, Any] | None = None
+    ) -> Iterator[None]:
+        """A scope whose configuration and environment changes are undone at exit.
+
+        Not forwarding: the scope starts with only ``configs`` and the initial environment.
+        """
+        self.push_scope()
+        try:
+            if not forwarding:
+                self.launch_configurations = {}
+                self.environment = dict(self.initial_environment)
+            if configs:
+                self.launch_configurations.update(configs)
+            yield
+        finally:
+            self.pop_scope()
+
+    @contextmanager
+    def file_locals(self, path: str) -> Iterator[None]:
+        """Locals of an included file: ThisLaunchFile and friends point at it inside."""
+        import os
+
+        saved = dict(self._locals)
+        self._locals["current_launch_file_path"] = path
+        self._locals["current_launch_file_directory"] = os.path.dirname(path)
+        try:
+            yield
+        finally:
+            self._locals = saved
+
+    def snapshot(self) -> LaunchContext:
+        """A copy frozen now, for actions resolved later (timers, event handlers).
+
+        Capturing at registration fixes ROS 2's L#501: a LaunchConfiguration inside on_exit takes
+        the value it had where it was written, not whatever was set last.
+        """
+        copy = LaunchContext(
+            environment=self.environment, argv=self.argv, log_dir=self.log_dir, warn=self._warn
+        )
+        copy.initial_environment = self.initial_environment
+        copy.launch_configurations = dict(self.launch_configurations)
+        copy._locals = dict(self._locals)
+        return copy

@@ -1,0 +1,57 @@
+"""Frontends: read a launch file into a LaunchDescription. Chosen by suffix, never by trying."""
+
+from __future__ import annotations
+
+import importlib
+import os
+from typing import Any
+
+from mlaunch.errors import LaunchFileError
+
+# suffix -> module with load(path) -> LaunchDescription. Longest suffix wins.
+FRONTENDS: dict[str, str] = {
+    ".launch.py": "mlaunch.frontends.python",
+    ".py": "mlaunch.frontends.python",
+    ".launch.yaml": "mlaunch.frontends.yaml",
+    ".launch.yml": "mlaunch.frontends.yaml",
+    ".yaml": "mlaunch.frontends.yaml",
+    ".yml": "mlaunch.frontends.yaml",
+    ".launch.xml": "mlaunch.frontends.xml",
+    ".xml": "mlaunch.frontends.xml",
+    ".launch": "mlaunch.frontends.roslaunch",
+}
+
+FORMAT_MODULES = {
+    "python": "mlaunch.frontends.python",
+    "yaml": "mlaunch.frontends.yaml",
+    "xml": "mlaunch.frontends.xml",
+}
+
+
+def frontend_for(path: str, hint: str | None = None) -> str:
+    name = os.path.basename(path).lower()
+    for suffix in sorted(FRONTENDS, key=len, reverse=True):
+        if name.endswith(suffix):
+            return FRONTENDS[suffix]
+    if hint in FORMAT_MODULES:
+        return FORMAT_MODULES[hint]
+    valid = ", ".join(
+        sorted({s for s in FRONTENDS if s.count(".") == 2} | {".py", ".xml", ".yaml", ".launch"})
+    )
+    raise LaunchFileError(
+        f"cannot tell the launch file format of {path!r} from its name; valid suffixes: {valid}"
+    )
+
+
+def load(path: str, hint: str | None = None) -> Any:
+    """The LaunchDescription in the file at ``path`` (absolute), with every error located."""
+    if not os.path.exists(path):
+        raise LaunchFileError(f"launch file {path!r} does not exist")
+    if os.path.isdir(path):
+        raise LaunchFileError(f"{path!r} is a directory, not a launch file")
+    module_name = frontend_for(path, hint)
+    try:
+        module = importlib.import_module(module_name)
+    except ModuleNotFoundError:
+        raise LaunchFileError(f"{path!r}: this mlaunch has no frontend {module_name!r} yet")
+    return module.load(path)

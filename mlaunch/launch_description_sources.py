@@ -1,0 +1,78 @@
+"""Where an included launch description comes from: a path (any format) or a built description."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.substitutions import describe, normalize, perform_substitutions
+
+if TYPE_CHECKING:
+    from mlaunch.context import LaunchContext
+
+
+class LaunchDescriptionSource:
+    """A launch description given directly, or a location loaded when the include resolves."""
+
+    format_hint: str | None = None
+
+    def __init__(
+        self,
+        launch_description: Any = None,
+        location: Any = "<script>",
+        method: str = "",
+    ) -> None:
+        self.launch_description = launch_description
+        self.location = normalize(location)
+        self.method = method
+
+    def get_launch_file_location(self, context: LaunchContext) -> str | None:
+        if self.launch_description is not None:
+            return None
+        import os
+
+        return os.path.abspath(perform_substitutions(context, self.location))
+
+    def describe(self) -> str:
+        return describe(self.location)
+
+
+class AnyLaunchDescriptionSource(LaunchDescriptionSource):
+    """A launch file of any format, chosen by its suffix."""
+
+    def __init__(self, launch_file_path: Any) -> None:
+        super().__init__(None, launch_file_path)
+
+
+class PythonLaunchDescriptionSource(AnyLaunchDescriptionSource):
+    format_hint = "python"
+
+
+class FrontendLaunchDescriptionSource(AnyLaunchDescriptionSource):
+    pass
+
+
+class XMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
+    format_hint = "xml"
+
+
+class YAMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
+    format_hint = "yaml"
+
+
+def source_for(value: Any) -> LaunchDescriptionSource:
+    """IncludeLaunchDescription also takes a bare path or a LaunchDescription."""
+    from mlaunch.actions import LaunchDescription
+
+    if isinstance(value, LaunchDescription):
+        return LaunchDescriptionSource(launch_description=value)
+    return AnyLaunchDescriptionSource(value)
+
+
+__all__ = [
+    "AnyLaunchDescriptionSource",
+    "FrontendLaunchDescriptionSource",
+    "LaunchDescriptionSource",
+    "PythonLaunchDescriptionSource",
+    "XMLLaunchDescriptionSource",
+    "YAMLLaunchDescriptionSource",
+]

@@ -1,0 +1,322 @@
+"""Resolve: a launch description + arguments + environment -> a Plan. Nothing is spawned here.
+
+The resolver visits the description depth first, evaluating conditions and substitutions
+against a LaunchContext. Deferred parts (timers, handlers, on_exit) are captured with their
+context and resolved later by ``resolve_deferred``, with the same code.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from mlaunch.context import LaunchContext
+from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
+from mlaunch.origin import user_location
+from mlaunch.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step
+from mlaunch.substitutions import Substitution, normalize, perform, perform_substitutions
+
+
+class LabelCounter:
+    """ROS 2's global ``name-N`` counter, shared by everything resolved in one run."""
+
+    def __init__(self) -> None:
+        self._next = itertools.count(1)
+
+    def next(self, base: str) -> str:
+        return f"{base}-{next(self._next)}"
+
+
+@dataclass
+class ResolveOptions:
+    """What the CLI decides about resolution."""
+
+    standins: bool = True
+    use_sim_time: bool | None = None
+    package_path: tuple[str, ...] = ()
+    temp_dir: str | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+class Resolver:
+    """Visits entities against one context, appending steps to one plan."""
+
+    def __init__(
+        self,
+        context: LaunchContext,
+        plan: Plan,
+        *,
+        labels: LabelCounter,
+        options: ResolveOptions,
+    ) -> None:
+        self.context = context
+        self.plan = plan
+        self.labels = labels
+        self.options = options
+
+    # --- visiting -----------------------------------------------------------------------------
+
+    def visit(self, entity: Any) -> None:
+        visit = getattr(entity, "visit", None)
+        if visit is None:
+            raise LaunchFileError(
+                f"{type(entity).__name__} ({entity!r:.60}) is not a launch action"
+                " (expected actions such as Node, ExecuteProcess, DeclareLaunchArgument)"
+            )
+        try:
+            more = visit(self)
+        except MlaunchError as e:
+            origin = getattr(entity, "origin", None)
+            if e.where is None and origin:
+                e.where = origin
+            if e.what is None and not isinstance(e, LaunchFileError):
+                e.what = _short(entity)
+            raise
+        if more:
+            self.visit_all(more)
+
+    def visit_all(self, entities: Iterable[Any]) -> None:
+        for entity in entities:
+            self.visit(entity)
+
+    def call_user(self, function: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        """Call launch-file code (OpaqueFunction), locating any exception in the user's file."""
+        try:
+            return function(*args, **kwargs)
+        except MlaunchError:
+            raise
+        except Exception as e:
+            where = user_location(e.__traceback__, self.context.current_launch_file_path)
+            raise MlaunchError(f"{type(e).__name__}: {e}", where=where) from e
+
+    # --- what actions use ---------------------------------------------------------------------
+
+    def add(self, step: Step) -> None:
+        self.plan.steps.append(step)
+
+    def spawn(self, spec: ProcessSpec) -> None:
+        self.add(Spawn(origin=spec.origin, spec=spec))
+
+    def warn(self, message: str) -> None:
+        self.plan.warnings.append(message)
+
+    def new_label(self, base: str) -> str:
+        return self.labels.next(base)
+
+    def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
+        return Deferred(
+            entities=list(entities),
+            context=self.context.snapshot(),
+            origin=origin,
+            callback=callback,
+        )
+
+    def float_value(self, value: Any, what: str, origin: str) -> float:
+        text = value if isinstance(value, (int, float)) else perform(self.context, value)
+        try:
+            number = float(text)
+        except (TypeError, ValueError):
+            raise MlaunchError(f"{what} is {text!r}, expected a number", where=origin)
+        if number != number or number in (float("inf"), float("-inf")):
+            raise MlaunchError(f"{what} is {text!r}, expected a finite number", where=origin)
+        return number
+
+    def load_source(self, source: Any, context: LaunchContext, origin: str) -> Any:
+        """The LaunchDescription an include names (built directly, or loaded from its file)."""
+        if source.launch_description is not None:
+            return source.launch_description
+        from mlaunch import frontends
+
+        path = source.get_launch_file_location(context)
+        if not os.path.exists(path):
+            raise LaunchFileError(f"included launch file {path!r} does not exist", where=origin)
+        return frontends.load(path, source.format_hint)
+
+    def locate_program(
+        self, argv: list[str], *, shell: bool, origin: str
+    ) -> tuple[list[str], str | None]:
+        """argv with a stand-in in place of a program that is not installed.
+
+        Returns the argv and the name of what a stand-in replaces (None when the real program
+        runs). A program that is neither installed nor covered by a stand-in is an error here,
+        before anything starts, naming the program.
+        """
+        if shell:
+            return argv, None
+        program = argv[0]
+        env = self.context.environment
+        if os.sep in program:
+            if os.access(program, os.X_OK) and not os.path.isdir(program):
+                return argv, None
+        else:
+            from mlaunch.actions import which
+
+            if which(program, env) is not None:
+                return argv, None
+        from mlaunch import standins
+
+        if self.options.standins:
+            replaced = standins.standin_for(argv)
+            if replaced is not None:
+                return replaced, os.path.basename(program)
+        hint = standins.hint_for(argv) if not self.options.standins else ""
+        if os.sep in program:
+            problem = "does not exist" if not os.path.exists(program) else "is not executable"
+            raise PackageNotFoundError(f"program {program!r} {problem}{hint}", where=origin)
+        raise PackageNotFoundError(f"program {program!r} not found on the PATH{hint}", where=origin)
+
+
+def _short(entity: Any) -> str:
+    describe = getattr(entity, "describe_short", None)
+    return describe() if describe else type(entity).__name__
+
+
+# --- entry points ------------------------------------------------------------------------------
+
+
+def resolve(
+    description: Any,
+    *,
+    path: str | None,
+    arguments: Mapping[str, str],
+    environ: Mapping[str, str],
+    log_dir: str = "",
+    options: ResolveOptions | None = None,
+    labels: LabelCounter | None = None,
+) -> Plan:
+    """Resolve a whole launch description, as the top-level include of the command line."""
+    options = options or ResolveOptions()
+    plan = Plan(temp_dir=options.temp_dir)
+    context = LaunchContext(
+        environment=environ,
+        argv=tuple(f"{k}:={v}" for k, v in arguments.items()),
+        log_dir=log_dir,
+        warn=plan.warnings.append,
+    )
+    context.launch_configurations.update(arguments)
+    resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
+    if path is None:
+        resolver.visit(description)
+    else:
+        with context.file_locals(path):
+            resolver.visit(description)
+    plan.warnings.extend(undeclared_argument_warnings(arguments, plan.arguments))
+    return plan
+
+
+def resolve_deferred(
+    deferred: Deferred,
+    *,
+    labels: LabelCounter,
+    options: ResolveOptions,
+    event: Any = None,
+) -> Plan:
+    """Resolve a timer's or handler's entities now, in the context captured when registered."""
+    context = deferred.context.snapshot()
+    plan = Plan(temp_dir=options.temp_dir)
+    context._warn = plan.warnings.append
+    if event is not None:
+        context.extend_locals({"event": event})
+    resolver = Resolver(context, plan, labels=labels, options=options)
+    entities = deferred.entities
+    if deferred.callback is not None:
+        result = resolver.call_user(deferred.callback, event, context)
+        entities = list(result) if result else []
+    resolver.visit_all(entities)
+    return plan
+
+
+def undeclared_argument_warnings(
+    given: Mapping[str, str], declared: Mapping[str, ArgumentInfo]
+) -> list[str]:
+    out = []
+    for name in given:
+        if name in declared:
+            continue
+        import difflib
+
+        close = difflib.get_close_matches(name, list(declared), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        known = f"; declared: {', '.join(sorted(declared))}" if declared and not close else ""
+        out.append(f"argument {name!r} is not declared by the launch file{hint}{known}")
+    return out
+
+
+# --- --show-args: a static walk ------------------------------------------------------------------
+
+
+def collect_arguments(
+    description: Any, *, path: str | None, arguments: Mapping[str, str], environ: Mapping[str, str]
+) -> list[ArgumentInfo]:
+    """Every DeclareLaunchArgument, following includes whose path can be resolved statically.
+
+    Conditional declarations (under a condition, in a timer or handler) are marked; nothing is
+    spawned and no command substitution beyond what an include path needs is run.
+    """
+    from mlaunch.actions import (
+        DeclareLaunchArgument,
+        GroupAction,
+        IncludeLaunchDescription,
+        LaunchDescription,
+        TimerAction,
+    )
+
+    found: dict[str, ArgumentInfo] = {}
+    context = LaunchContext(environment=environ)
+    context.launch_configurations.update(arguments)
+    seen: set[str] = set()
+
+    def walk(entities: Iterable[Any], conditional: bool) -> None:
+        for entity in entities:
+            cond = conditional or getattr(entity, "condition", None) is not None
+            if isinstance(entity, DeclareLaunchArgument):
+                info = entity.argument_info(cond)
+                found.setdefault(info.name, info)
+                if info.name not in context.launch_configurations and entity.default_value:
+                    try:
+                        context.launch_configurations[info.name] = perform_substitutions(
+                            context, entity.default_value
+                        )
+                    except MlaunchError:
+                        pass
+            elif isinstance(entity, LaunchDescription):
+                walk(entity.entities, cond)
+            elif isinstance(entity, (GroupAction, TimerAction)):
+                walk(entity.actions, cond or isinstance(entity, TimerAction))
+            elif isinstance(entity, IncludeLaunchDescription):
+                include(entity, cond)
+
+    def include(entity: Any, conditional: bool) -> None:
+        source = entity.launch_description_source
+        if source.launch_description is not None:
+            walk([source.launch_description], conditional)
+            return
+        try:
+            location = source.get_launch_file_location(context)
+        except (MlaunchError, SubstitutionFailure):
+            return
+        if location in seen or not os.path.exists(location):
+            return
+        seen.add(location)
+        from mlaunch import frontends
+
+        with context.file_locals(location):
+            walk([frontends.load(location, source.format_hint)], conditional)
+
+    if path is None:
+        walk([description], False)
+    else:
+        with context.file_locals(path):
+            walk([description], False)
+    return list(found.values())
+
+
+def substitution_text(value: Any) -> str:
+    """Literal text of a value made only of TextSubstitutions, else its description."""
+    subs = normalize(value)
+    if all(type(s).__name__ == "TextSubstitution" for s in subs):
+        return "".join(s.text for s in subs)  # type: ignore[attr-defined]
+    return " + ".join(s.describe() for s in subs if isinstance(s, Substitution))

@@ -1,0 +1,75 @@
+"""Stand-ins: small rclpy programs that take the place of ROS programs that are not installed.
+
+Each one accepts the real program's command line (including ROS arguments) and is run as
+``python -m mlaunch.standins.<module> ARGS...``. They import rclpy inside their entry points only.
+A real installation always wins: the resolver asks here only when the program is not found.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import sys
+
+# Programs found on PATH by name: name -> (module, how many leading argv items the stand-in
+# replaces, the argv[1] the real program needs for this use, if any).
+PROGRAMS: dict[str, tuple[str, int, str | None]] = {
+    "gazebo": ("sim", 1, None),
+    "gzserver": ("sim", 1, None),
+    "gz": ("sim", 2, "sim"),
+    "ign": ("sim", 2, "gazebo"),
+    "rviz2": ("viewer", 1, None),
+    "spawn_entity.py": ("spawn", 0, None),
+}
+
+# Executables of ROS packages: (package, executable) -> (module, argv items to put first).
+PACKAGE_EXECUTABLES: dict[tuple[str, str], tuple[str, tuple[str, ...]]] = {
+    ("robot_state_publisher", "robot_state_publisher"): ("rsp", ()),
+    ("joint_state_publisher", "joint_state_publisher"): ("jsp", ()),
+    ("joint_state_publisher_gui", "joint_state_publisher_gui"): ("jsp", ()),
+    ("rviz2", "rviz2"): ("viewer", ()),
+    ("gazebo_ros", "spawn_entity.py"): ("spawn", ("spawn_entity.py",)),
+    ("ros_gz_sim", "create"): ("spawn", ("create",)),
+    ("gazebo_ros", "gzserver"): ("sim", ()),
+}
+
+
+def rclpy_available() -> bool:
+    return importlib.util.find_spec("rclpy") is not None
+
+
+def _module_argv(module: str) -> list[str]:
+    return [sys.executable, "-m", f"mlaunch.standins.{module}"]
+
+
+def standin_for(argv: list[str]) -> list[str] | None:
+    """The stand-in command line for a program not found on PATH, or None."""
+    name = os.path.basename(argv[0])
+    entry = PROGRAMS.get(name)
+    if entry is None or not rclpy_available():
+        return None
+    module, consumed, needs = entry
+    if needs is not None and (len(argv) < 2 or argv[1] != needs):
+        return None
+    if module == "spawn":
+        return [*_module_argv(module), name, *argv[1:]]
+    return [*_module_argv(module), *argv[consumed:]]
+
+
+def standin_for_package(package: str, executable: str) -> list[str] | None:
+    """The argv items that replace ``<prefix>/lib/<package>/<executable>``, or None."""
+    entry = PACKAGE_EXECUTABLES.get((package, executable))
+    if entry is None or not rclpy_available():
+        return None
+    module, first = entry
+    return [*_module_argv(module), *first]
+
+
+def hint_for(argv: list[str]) -> str:
+    """A hint for the error when no stand-in was used."""
+    name = os.path.basename(argv[0])
+    if name in PROGRAMS:
+        if not rclpy_available():
+            return " (mlaunch's stand-in needs rclpy: pip install 'mlaunch[ros]')"
+        return " (mlaunch has a stand-in for it: run without --no-standins)"
+    return ""
