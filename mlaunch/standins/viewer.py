@@ -1,0 +1,485 @@
+"""Stand-in for rviz2: ``python -m mlaunch.standins.viewer [-d CONFIG] [-f FRAME] [ROS args]``.
+
+There is no RViz here, so this node serves a small web page on 127.0.0.1 that draws, top-down,
+the robot outline from ``robot_description`` at its odometry pose, the odometry trail and the
+laser scan. It takes rviz2's command line and reads the fixed frame and the LaserScan, Odometry and
+RobotModel topics from a display config. Only the standard library serves the page (http.server
+in a thread); rclpy is imported inside main() only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import threading
+import time
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
+
+if TYPE_CHECKING:
+    from nav_msgs.msg import Odometry
+    from rclpy.node import Node
+    from sensor_msgs.msg import LaserScan
+    from std_msgs.msg import String
+
+NODE_NAME = "rviz"
+PORT_ENV = "MLAUNCH_VIEWER_PORT"
+PAGE = Path(__file__).with_name("viewer.html")
+EXIT_OK = 0
+EXIT_FAILURE = 1
+TRAIL_MAX = 5000
+TRAIL_STEP = 0.02  # metres between trail points: enough for a smooth line, bounded memory
+
+Pose2D = tuple[float, float, float]  # x, y, yaw
+
+
+class ViewerError(ValueError):
+    """Unusable viewer input (port, command line); printed as one line, exit status 1."""
+
+
+# ---------------------------------------------------------------- command line and config
+
+
+@dataclass(frozen=True)
+class DisplayConfig:
+    """What the viewer takes from an .rviz file: the fixed frame and the topics it draws."""
+
+    fixed_frame: str = "odom"
+    scan_topic: str = "scan"
+    odom_topic: str = "odom"
+    description_topic: str = "robot_description"
+    warnings: tuple[str, ...] = ()
+
+
+def parse_args(args: Sequence[str]) -> argparse.Namespace:
+    """rviz2's options (ROS arguments removed); the GUI-only ones are accepted and unused."""
+    parser = argparse.ArgumentParser(
+        prog="rviz2", description="mlaunch stand-in for rviz2: a top-down view in the browser"
+    )
+    parser.add_argument("-d", "--display-config", metavar="FILE", help="an .rviz config file")
+    parser.add_argument("-f", "--fixed-frame", metavar="FRAME", help="frame to draw in")
+    parser.add_argument("-s", "--splash-screen", nargs="?", const="", metavar="IMAGE")
+    parser.add_argument("-l", "--ogre-log", action="store_true", help="(ignored)")
+    parser.add_argument("--fullscreen", action="store_true", help="(ignored)")
+    parser.add_argument("--no-stereo", action="store_true", help="(ignored)")
+    parser.add_argument("--disable-anti-aliasing", action="store_true", help="(ignored)")
+    parser.add_argument("--opengl", metavar="VERSION", help="(ignored)")
+    options, unknown = parser.parse_known_args(list(args))
+    if unknown:
+        raise ViewerError(
+            f"unknown rviz2 option {unknown[0]!r}; see python -m mlaunch.standins.viewer --help"
+        )
+    return options
+
+
+def read_display_config(path: str | None) -> DisplayConfig:
+    """The fixed frame and topics of an .rviz file; a missing or broken file gives defaults + a
+    warning, as rviz2 starts with its default config then."""
+    if not path:
+        return DisplayConfig()
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        return DisplayConfig(warnings=(f"display config {path!r} not loaded: {exc.strerror}",))
+    import yaml  # only when there is a config to read
+
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        return DisplayConfig(warnings=(f"display config {path!r} is not valid YAML: {exc}",))
+    return config_from_data(data)
+
+
+def config_from_data(data: Any) -> DisplayConfig:
+    """Pick the viewer's settings out of a loaded .rviz document (missing parts keep defaults)."""
+    manager = data.get("Visualization Manager") if isinstance(data, dict) else None
+    if not isinstance(manager, dict):
+        return DisplayConfig(warnings=("display config has no 'Visualization Manager' section",))
+    found: dict[str, Any] = {}
+    options = manager.get("Global Options")
+    if isinstance(options, dict) and isinstance(options.get("Fixed Frame"), str):
+        found["fixed_frame"] = options["Fixed Frame"]
+    for display in _displays(manager.get("Displays")):
+        kind = str(display.get("Class", "")).rsplit("/", 1)[-1]
+        if kind == "LaserScan":
+            _take(found, "scan_topic", _topic(display.get("Topic")))
+        elif kind == "Odometry":
+            _take(found, "odom_topic", _topic(display.get("Topic")))
+        elif kind == "RobotModel":
+            _take(found, "description_topic", _topic(display.get("Description Topic")))
+    return replace(DisplayConfig(), **found)
+
+
+def _displays(items: Any) -> list[dict[str, Any]]:
+    """Enabled displays, flattened out of display groups."""
+    result: list[dict[str, Any]] = []
+    for item in items if isinstance(items, list) else []:
+        if not isinstance(item, dict) or item.get("Enabled", True) is False:
+            continue
+        result.append(item)
+        result.extend(_displays(item.get("Displays")))
+    return result
+
+
+def _topic(value: Any) -> str | None:
+    """A display's topic: ``Topic: /scan`` (old files) or ``Topic: {Value: /scan, ...}``."""
+    if isinstance(value, dict):
+        value = value.get("Value")
+    return value if isinstance(value, str) and value else None
+
+
+def _take(found: dict[str, Any], key: str, value: str | None) -> None:
+    if value is not None and key not in found:  # the first enabled display of a kind wins
+        found[key] = value
+
+
+def viewer_port(environ: dict[str, str]) -> int:
+    """The port to listen on from MLAUNCH_VIEWER_PORT; 0 (the default) means any free port."""
+    text = environ.get(PORT_ENV, "").strip() or "0"
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise ViewerError(f"{PORT_ENV}={text!r} is not a port; use 0..65535 (0 = any free port)")
+    return port
+
+
+# ---------------------------------------------------------------- what the page shows
+
+
+def compose(a: Pose2D, b: Pose2D) -> Pose2D:
+    """Pose b (given in frame a) expressed in a's parent frame."""
+    ax, ay, ayaw = a
+    bx, by, byaw = b
+    c, s = math.cos(ayaw), math.sin(ayaw)
+    return (ax + c * bx - s * by, ay + s * bx + c * by, ayaw + byaw)
+
+
+def invert(a: Pose2D) -> Pose2D:
+    """The inverse 2D transform of a."""
+    x, y, yaw = a
+    c, s = math.cos(yaw), math.sin(yaw)
+    return (-(c * x + s * y), s * x - c * y, -yaw)
+
+
+def yaw_of(qx: float, qy: float, qz: float, qw: float) -> float:
+    """Heading of a quaternion (rotation about z), as rviz draws it top-down."""
+    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
+
+
+@dataclass
+class TopicStats:
+    """How many messages a topic brought and when the last one came (monotonic seconds)."""
+
+    topic: str
+    count: int = 0
+    last: float | None = None
+
+    def to_json(self, now: float) -> dict[str, Any]:
+        age = None if self.last is None else round(now - self.last, 3)
+        return {"topic": self.topic, "count": self.count, "age": age}
+
+
+@dataclass
+class ViewerState:
+    """Everything the page draws, in the odometry frame; updated from ROS callbacks, read by HTTP.
+
+    Kept free of rclpy so it can be tested with plain numbers. All access goes through the lock,
+    because callbacks run in the spinning thread and requests in the server's threads.
+    """
+
+    config: DisplayConfig
+    robot: Robot | None = None
+    robot_error: str | None = None
+    pose: Pose2D | None = None
+    odom_frame: str = ""
+    base_frame: str = ""
+    trail: deque[tuple[float, float]] = field(default_factory=lambda: deque(maxlen=TRAIL_MAX))
+    scan_points: list[tuple[float, float]] = field(default_factory=list)
+    scan_frame: str = ""
+    seq: int = 0
+    warnings: dict[str, str] = field(default_factory=dict)
+    stats: dict[str, TopicStats] = field(default_factory=dict)
+    lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+
+    def __post_init__(self) -> None:
+        for key, topic in (
+            ("description", self.config.description_topic),
+            ("odom", self.config.odom_topic),
+            ("scan", self.config.scan_topic),
+        ):
+            self.stats[key] = TopicStats(topic)
+
+    def _seen(self, key: str, now: float) -> None:
+        stats = self.stats[key]
+        stats.count += 1
+        stats.last = now
+        self.seq += 1
+
+    def set_description(self, text: str, now: float) -> None:
+        """A URDF from the description topic; an invalid one is shown on the page, not drawn."""
+        try:
+            robot, error = parse_urdf(text), None
+        except UrdfError as exc:
+            robot, error = None, str(exc)
+        with self.lock:
+            self.robot, self.robot_error = robot, error
+            self._seen("description", now)
+
+    def set_odom(self, frame: str, child: str, pose: Pose2D, now: float) -> None:
+        """The robot's pose in the odometry frame; extends the trail when it moved."""
+        with self.lock:
+            self.pose, self.odom_frame, self.base_frame = pose, frame, child
+            x, y = pose[0], pose[1]
+            if not self.trail or math.dist(self.trail[-1], (x, y)) >= TRAIL_STEP:
+                self.trail.append((round(x, 4), round(y, 4)))
+            self._seen("odom", now)
+
+    def set_scan(
+        self,
+        frame: str,
+        angle_min: float,
+        angle_increment: float,
+        ranges: Sequence[float],
+        range_limits: tuple[float, float],
+        now: float,
+    ) -> None:
+        """A laser scan, turned into points in the odometry frame at the robot's current pose."""
+        low, high = range_limits
+        with self.lock:
+            laser = compose(self.pose or (0.0, 0.0, 0.0), self._laser_in_base(frame))
+            points = []
+            for index, r in enumerate(ranges):
+                if not math.isfinite(r) or r < low or r > high:
+                    continue  # no return: rviz draws nothing there either
+                angle = angle_min + index * angle_increment
+                px, py, _ = compose(laser, (r * math.cos(angle), r * math.sin(angle), 0.0))
+                points.append((round(px, 4), round(py, 4)))
+            self.scan_points, self.scan_frame = points, frame
+            self._seen("scan", now)
+
+    def _link(self, frame: str) -> str | None:
+        """The URDF link a tf frame names, allowing for a frame_prefix such as ``r1/``."""
+        if self.robot is None or not frame:
+            return None
+        for name in (frame, frame.rsplit("/", 1)[-1]):
+            if name in self.robot.links:
+                return name
+        return None
+
+    def _in_base(self, link: str) -> Pose2D:
+        """Pose of a URDF link in the odometry child (base) frame, joints at zero."""
+        assert self.robot is not None
+        x, y, _, yaw = self.robot.link_pose_in_root(link)
+        base = self._link(self.base_frame) or self.robot.root
+        bx, by, _, byaw = self.robot.link_pose_in_root(base)
+        return compose(invert((bx, by, byaw)), (x, y, yaw))
+
+    def _laser_in_base(self, frame: str) -> Pose2D:
+        link = self._link(frame)
+        if link is None:
+            if self.robot is not None:
+                self.warnings["laser"] = (
+                    f"laser frame {frame!r} is not a link of {self.robot.name!r}: "
+                    "scan drawn at the robot's base"
+                )
+            return (0.0, 0.0, 0.0)
+        self.warnings.pop("laser", None)
+        return self._in_base(link)
+
+    def _shapes(self) -> list[dict[str, Any]]:
+        """The robot outline in the base frame (the URDF gives it in the root frame)."""
+        if self.robot is None:
+            return []
+        base = self._link(self.base_frame) or self.robot.root
+        bx, by, _, byaw = self.robot.link_pose_in_root(base)
+        to_base = invert((bx, by, byaw))
+        shapes = []
+        for shape in self.robot.footprint():
+            data = shape.to_json()
+            if isinstance(shape, Circle):
+                data["x"], data["y"] = _moved(to_base, (shape.x, shape.y))
+            else:
+                data["points"] = [_moved(to_base, p) for p in shape.points]
+            shapes.append(data)
+        return shapes
+
+    def snapshot(self, now: float) -> dict[str, Any]:
+        """The page's JSON: a consistent copy taken under the lock."""
+        with self.lock:
+            fixed = self.config.fixed_frame
+            robot = None
+            if self.robot is not None:
+                robot = {"name": self.robot.name, "root": self.robot.root, "shapes": self._shapes()}
+            pose = (
+                None if self.pose is None else dict(zip(("x", "y", "yaw"), self.pose, strict=True))
+            )
+            return {
+                "seq": self.seq,
+                "fixed_frame": fixed,
+                # A fixed frame on the robot (base_link) means the world moves around the robot.
+                "robot_centric": self._link(fixed) is not None,
+                "odom_frame": self.odom_frame,
+                "base_frame": self.base_frame,
+                "robot": robot,
+                "robot_error": self.robot_error,
+                "pose": pose,
+                "trail": [list(p) for p in self.trail],
+                "scan": {"frame": self.scan_frame, "points": [list(p) for p in self.scan_points]},
+                "topics": {key: stats.to_json(now) for key, stats in self.stats.items()},
+                "warnings": [*self.config.warnings, *self.warnings.values()],
+            }
+
+
+def _moved(transform: Pose2D, point: tuple[float, float]) -> list[float]:
+    x, y, _ = compose(transform, (point[0], point[1], 0.0))
+    return [round(x, 5), round(y, 5)]
+
+
+# ---------------------------------------------------------------- HTTP
+
+
+def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRequestHandler]:
+    """A request handler class serving the page and its JSON for this ``state``."""
+
+    class Handler(BaseHTTPRequestHandler):
+        def do_GET(self) -> None:
+            path = self.path.split("?", 1)[0]
+            if path in ("/", "/index.html"):
+                self._send(200, "text/html; charset=utf-8", page)
+            elif path == "/state.json":
+                body = json.dumps(state.snapshot(clock()), separators=(",", ":")).encode()
+                self._send(200, "application/json", body)
+            else:
+                self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
+
+        def _send(self, status: int, kind: str, body: bytes) -> None:
+            self.send_response(status)
+            self.send_header("Content-Type", kind)
+            self.send_header("Content-Length", str(len(body)))
+            self.send_header("Cache-Control", "no-store")
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, format: str, *args: Any) -> None:
+            pass  # a poll every 100 ms would flood the launch output
+
+    return Handler
+
+
+def serve(state: ViewerState, port: int, clock: Any) -> ThreadingHTTPServer:
+    """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
+    page = PAGE.read_bytes()
+    try:
+        server = ThreadingHTTPServer(("127.0.0.1", port), make_handler(state, page, clock))
+    except OSError as exc:
+        raise ViewerError(f"cannot listen on 127.0.0.1:{port}: {exc.strerror}") from None
+    server.daemon_threads = True
+    threading.Thread(target=server.serve_forever, name="viewer-http", daemon=True).start()
+    return server
+
+
+# ---------------------------------------------------------------- ROS
+
+
+def subscribe(node: Node, state: ViewerState) -> None:
+    """Subscribe to the robot description, odometry and scan with the QoS their publishers use."""
+    from nav_msgs.msg import Odometry
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from sensor_msgs.msg import LaserScan
+    from std_msgs.msg import String
+
+    latched = QoSProfile(
+        depth=1,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+    def on_description(msg: String) -> None:
+        state.set_description(msg.data, time.monotonic())
+
+    def on_odom(msg: Odometry) -> None:
+        p, q = msg.pose.pose.position, msg.pose.pose.orientation
+        pose = (p.x, p.y, yaw_of(q.x, q.y, q.z, q.w))
+        state.set_odom(msg.header.frame_id, msg.child_frame_id, pose, time.monotonic())
+
+    def on_scan(msg: LaserScan) -> None:
+        limits = (msg.range_min, msg.range_max)
+        state.set_scan(
+            msg.header.frame_id,
+            msg.angle_min,
+            msg.angle_increment,
+            msg.ranges,
+            limits,
+            time.monotonic(),
+        )
+
+    config = state.config
+    node.create_subscription(String, config.description_topic, on_description, latched)
+    # Best effort hears both best-effort (simulated sensors) and reliable publishers.
+    node.create_subscription(Odometry, config.odom_topic, on_odom, qos_profile_sensor_data)
+    node.create_subscription(LaserScan, config.scan_topic, on_scan, qos_profile_sensor_data)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the viewer until shutdown; 1 with a one-line error when its input is unusable."""
+    args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
+    import rclpy
+    from rclpy.executors import ExternalShutdownException
+    from rclpy.node import Node
+    from rclpy.utilities import remove_ros_args
+
+    try:
+        options = parse_args(remove_ros_args(args)[1:])
+        port = viewer_port(dict(os.environ))
+    except ViewerError as exc:
+        print(f"[ERROR] [{NODE_NAME}]: {exc}", file=sys.stderr)
+        return EXIT_FAILURE
+    config = read_display_config(options.display_config)
+    if options.fixed_frame:
+        config = replace(config, fixed_frame=options.fixed_frame)
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # rcl reports bad --ros-args as a generic RCLError
+        print(f"[ERROR] [{NODE_NAME}]: invalid ROS arguments: {exc}", file=sys.stderr)
+        return EXIT_FAILURE
+    node = Node(NODE_NAME)
+    server = None
+    try:
+        for warning in config.warnings:
+            node.get_logger().warn(warning)
+        state = ViewerState(config)
+        subscribe(node, state)
+        server = serve(state, port, time.monotonic)
+        node.get_logger().info(
+            f"stand-in for rviz2: fixed frame {config.fixed_frame!r}, drawing "
+            f"{config.description_topic}, {config.odom_topic}, {config.scan_topic}"
+        )
+        print(f"viewer: open http://127.0.0.1:{server.server_address[1]}/", flush=True)
+        rclpy.spin(node)
+    except ViewerError as exc:
+        node.get_logger().error(str(exc))
+        return EXIT_FAILURE
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if server is not None:
+            server.shutdown()
+            server.server_close()
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return EXIT_OK
+
+
+if __name__ == "__main__":
+    sys.exit(main())
