@@ -155,7 +155,10 @@ def start(node: Node, urdf_file: str | None) -> JointPublisher:
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
         node.create_subscription(String, "robot_description", state.on_description, latched)
+    # The timer runs on the node clock: with use_sim_time it fires only as /clock advances.
     node.create_timer(1.0 / rate, state.tick)
+    if node.get_clock().now().nanoseconds == 0:
+        state.once("clock", "use_sim_time is true: waiting for /clock before publishing")
     return state
 
 
