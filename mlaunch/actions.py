@@ -561,8 +561,8 @@ class ExecuteProcess(Action):
         env: dict[Any, Any] | None = None,
         additional_env: dict[Any, Any] | None = None,
         shell: bool = False,
-        sigterm_timeout: Any = LaunchConfiguration("sigterm_timeout", default=5),
-        sigkill_timeout: Any = LaunchConfiguration("sigkill_timeout", default=5),
+        sigterm_timeout: Any = None,
+        sigkill_timeout: Any = None,
         emulate_tty: Any = False,
         output: Any = "log",
         output_format: str = "[{this.process_description.final_name}] {line}",
@@ -587,8 +587,17 @@ class ExecuteProcess(Action):
         self.env = env
         self.additional_env = additional_env
         self.shell = shell
-        self.sigterm_timeout = sigterm_timeout
-        self.sigkill_timeout = sigkill_timeout
+        # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s.
+        self.sigterm_timeout = (
+            LaunchConfiguration("sigterm_timeout", default=5)
+            if sigterm_timeout is None
+            else sigterm_timeout
+        )
+        self.sigkill_timeout = (
+            LaunchConfiguration("sigkill_timeout", default=5)
+            if sigkill_timeout is None
+            else sigkill_timeout
+        )
         self.emulate_tty = emulate_tty
         self.output = output
         self.log_cmd = log_cmd

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -92,7 +93,7 @@ def matches_executable(executable_name: str) -> ProcessMatcher:
 
 
 # ROS 2 keeps process events in launch.events.process; both spellings resolve here.
-process = __import__(__name__, fromlist=["*"])
+process = sys.modules[__name__]
 
 __all__ = [
     "Event",

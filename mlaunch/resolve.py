@@ -197,6 +197,10 @@ def resolve(
         warn=plan.warnings.append,
     )
     context.launch_configurations.update(arguments)
+    if options.use_sim_time is not None:
+        from mlaunch.ros.actions import apply_options
+
+        apply_options(context, options)
     resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
     if path is None:
         resolver.visit(description)

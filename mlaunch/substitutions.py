@@ -36,7 +36,7 @@ class Substitution:
         return self.describe()
 
 
-SomeSubstitutionsType = Union[str, Path, Substitution, Iterable[str | Path | Substitution]]
+SomeSubstitutionsType = Union[str, Path, Substitution, Iterable[str | Path | Substitution]]  # noqa: UP007
 SomeSubstitutionsType_types_tuple = (str, Path, Substitution)
 Subs = tuple[Substitution, ...]
 

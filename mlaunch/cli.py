@@ -1,0 +1,354 @@
+"""The command line: argv -> Options -> load -> resolve -> run. The only place errors are printed.
+
+Exit status:
+  0    every process ended and nothing required failed (or a Shutdown action ended the launch)
+  1    a required process (on_exit=Shutdown / required=True) exited with a failure
+  2    bad command line or launch file: missing file, syntax error, bad argument, failed
+       substitution, missing package or executable (one line on stderr, no traceback)
+  128+N  mlaunch was stopped by signal N: 130 for Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+SUBCOMMANDS = {
+    "test": "mlaunch.smoke",
+    "convert": "mlaunch.convert",
+}
+
+
+@dataclass
+class Options:
+    """What the command line asked for."""
+
+    target: str
+    second: str | None = None
+    arguments: dict[str, str] = field(default_factory=dict)
+    show_args: bool = False
+    print_plan: bool = False
+    debug: bool = False
+    use_sim_time: bool | None = None
+    package_path: list[str] = field(default_factory=list)
+    standins: bool = True
+    status: bool = False
+    quiet: bool = False
+    color: bool | None = None
+    log_max_bytes: int | None = None
+
+
+def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Run a ROS 2 launch file (Python, YAML, XML or ROS 1 XML) and supervise it.",
+        epilog="Subcommands: 'mlaunch test FILE ...' (CI smoke run), 'mlaunch convert FILE' "
+        "(ROS 1 -> ROS 2). Exit status: 0 ok, 1 a required process failed, 2 bad input, "
+        "130 interrupted.",
+    )
+    parser.add_argument(
+        "target", help="launch file, or package name followed by a launch file name"
+    )
+    parser.add_argument("rest", nargs="*", help="[launch file name] then name:=value arguments")
+    view = parser.add_mutually_exclusive_group()
+    view.add_argument(
+        "-s",
+        "--show-args",
+        "--show-arguments",
+        action="store_true",
+        help="list the launch arguments and exit",
+    )
+    view.add_argument(
+        "-p",
+        "--print",
+        "--print-description",
+        dest="print_plan",
+        action="store_true",
+        help="print the resolved plan (argv, cwd, env, respawn, shutdown) and exit",
+    )
+    parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
+    parser.add_argument(
+        "-n", "--noninteractive", action="store_true", help="accepted for ros2 launch compatibility"
+    )
+    parser.add_argument(
+        "-a",
+        "--show-all-subprocesses-output",
+        action="store_true",
+        help="print every process's output (output=both)",
+    )
+    parser.add_argument(
+        "--use-sim-time", action="store_true", default=None, help="set use_sim_time on every node"
+    )
+    parser.add_argument(
+        "--package-path",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="extra folders to find source packages in (repeatable; also $MLAUNCH_PACKAGE_PATH)",
+    )
+    parser.add_argument(
+        "--no-standins",
+        action="store_true",
+        help="never replace a missing program with mlaunch's stand-in",
+    )
+    parser.add_argument(
+        "--launch-prefix", help="prefix for every process, e.g. 'gdb -ex run --args'"
+    )
+    parser.add_argument(
+        "--launch-prefix-filter", help="regex on executable names the prefix applies to"
+    )
+    parser.add_argument("--status", action="store_true", help="live status view of the processes")
+    parser.add_argument(
+        "-q", "--quiet", action="store_true", help="only warnings and errors from mlaunch itself"
+    )
+    parser.add_argument("--color", choices=("auto", "always", "never"), default="auto")
+    parser.add_argument(
+        "--log-max-bytes", type=int, default=None, help="rotate log files at this size"
+    )
+    return parser
+
+
+def parse_options(argv: Sequence[str]) -> Options:
+    from mlaunch.errors import UsageError
+
+    ns = build_parser().parse_args(list(argv))
+    opts = Options(
+        target=ns.target,
+        show_args=ns.show_args,
+        print_plan=ns.print_plan,
+        debug=ns.debug,
+        use_sim_time=ns.use_sim_time,
+        package_path=list(ns.package_path),
+        standins=not ns.no_standins,
+        status=ns.status,
+        quiet=ns.quiet,
+        color={"auto": None, "always": True, "never": False}[ns.color],
+        log_max_bytes=ns.log_max_bytes,
+    )
+    rest = list(ns.rest)
+    if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
+        opts.second = rest.pop(0)
+    for item in rest:
+        name, sep, value = item.partition(":=")
+        if not sep or not name or (not value and not item.endswith(":=")):
+            raise UsageError(
+                f"malformed launch argument {item!r}, expected format '<name>:=<value>'"
+            )
+        opts.arguments[name] = value  # last one wins
+    if ns.launch_prefix:
+        opts.arguments["launch-prefix"] = ns.launch_prefix
+    if ns.launch_prefix_filter:
+        if not ns.launch_prefix:
+            raise UsageError("--launch-prefix-filter needs --launch-prefix")
+        opts.arguments["launch-prefix-filter"] = ns.launch_prefix_filter
+    if ns.show_all_subprocesses_output:
+        os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
+    if opts.use_sim_time is None and "use_sim_time" in opts.arguments:
+        from mlaunch.substitutions import to_bool
+
+        try:
+            opts.use_sim_time = to_bool(opts.arguments["use_sim_time"], "use_sim_time")
+        except Exception:
+            raise UsageError(
+                f"use_sim_time is {opts.arguments['use_sim_time']!r}; valid: true, false"
+            )
+    return opts
+
+
+def find_launch_file(opts: Options) -> str:
+    """The launch file path: a file, or PKG FILE looked up in the package's share folder."""
+    from mlaunch.errors import LaunchFileError
+
+    if opts.second is None:
+        if not os.path.exists(opts.target):
+            raise LaunchFileError(f"launch file {opts.target!r} does not exist")
+        return os.path.abspath(opts.target)
+    from mlaunch.ros import packages
+
+    return packages.find_launch_file(opts.target, opts.second)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = list(sys.argv[1:] if argv is None else argv)
+    if args and args[0] in SUBCOMMANDS and not os.path.isfile(args[0]):
+        import importlib
+
+        return int(importlib.import_module(SUBCOMMANDS[args[0]]).main(args[1:]))
+    debug = "--debug" in args or "-d" in args
+    try:
+        return run_cli(args)
+    except KeyboardInterrupt:
+        return 130
+    except Exception as e:
+        return report_error(e, debug)
+
+
+def report_error(error: BaseException, debug: bool) -> int:
+    from mlaunch.errors import MlaunchError
+
+    if debug:
+        import traceback
+
+        traceback.print_exception(error)
+    if isinstance(error, MlaunchError):
+        print(f"mlaunch: error: {error}", file=sys.stderr)
+        return error.exit_code
+    print(
+        f"mlaunch: internal error: {type(error).__name__}: {error}"
+        " (run with --debug for the traceback)",
+        file=sys.stderr,
+    )
+    return 70
+
+
+def configure_packages(opts: Options, path: str) -> None:
+    """Tell the ROS layer where source packages are, before anything is resolved."""
+    try:
+        from mlaunch.ros import packages
+    except ImportError:
+        return
+    configure = getattr(packages, "configure", None)
+    if configure is not None:
+        configure(search_paths=opts.package_path, launch_file=path, environ=os.environ)
+
+
+def run_cli(argv: Sequence[str]) -> int:
+    opts = parse_options(argv)
+    if opts.second is None and os.path.exists(opts.target):
+        configure_packages(opts, os.path.abspath(opts.target))
+    path = find_launch_file(opts)
+    configure_packages(opts, path)
+    from mlaunch import frontends
+
+    description = frontends.load(path)
+    if opts.show_args:
+        from mlaunch.resolve import collect_arguments
+
+        infos = collect_arguments(
+            description, path=path, arguments=opts.arguments, environ=os.environ
+        )
+        sys.stdout.write(format_arguments(infos))
+        return 0
+    return launch(opts, path, description)
+
+
+def launch(opts: Options, path: str, description: object) -> int:
+    import shutil
+    import tempfile
+
+    from mlaunch.resolve import ResolveOptions, resolve
+
+    temp_dir = tempfile.mkdtemp(prefix="mlaunch-")
+    try:
+        environ = dict(os.environ)
+        log_dir = ""
+        if not opts.print_plan:
+            from mlaunch.output import make_run_log_dir
+
+            log_dir = make_run_log_dir(environ)
+        options = ResolveOptions(
+            standins=opts.standins,
+            use_sim_time=opts.use_sim_time,
+            package_path=tuple(opts.package_path),
+            temp_dir=temp_dir,
+        )
+        from mlaunch.resolve import LabelCounter
+
+        labels = LabelCounter()
+        plan = resolve(
+            description,
+            path=path,
+            arguments=opts.arguments,
+            environ=environ,
+            log_dir=log_dir,
+            options=options,
+            labels=labels,
+        )
+        if opts.print_plan:
+            from mlaunch.describe import describe_plan
+
+            sys.stdout.write(describe_plan(plan, path))
+            return 0
+        return supervise(opts, plan, options, labels, log_dir)
+    finally:
+        shutil.rmtree(temp_dir, ignore_errors=True)
+
+
+def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
+    from mlaunch.output import Printer, stdout_is_color_terminal
+    from mlaunch.supervisor import Supervisor
+
+    color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
+    printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet)
+    if opts.log_max_bytes is not None:
+        printer.rotate_bytes = opts.log_max_bytes
+    printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
+    supervisor = Supervisor(plan, printer, options=options, labels=labels)  # type: ignore[arg-type]
+    extensions = _extensions(opts, supervisor)
+    try:
+        code = supervisor.run()
+    finally:
+        for ext in extensions:
+            close = getattr(ext, "close", None)
+            if close is not None:
+                close()
+        printer.close()
+    return code
+
+
+def _extensions(opts: Options, supervisor: object) -> list[object]:
+    """Optional parts that attach to a running supervisor (status view, lifecycle, summary)."""
+    attached: list[object] = []
+    try:
+        from mlaunch import extensions
+    except ImportError:
+        return attached
+    for attach in extensions.ATTACH:
+        ext = attach(opts, supervisor)
+        if ext is not None:
+            attached.append(ext)
+    return attached
+
+
+def format_arguments(infos: Sequence[object]) -> str:
+    """The --show-args table: name, default, description (and choices), conditional marked."""
+    import textwrap
+
+    if not infos:
+        return "No arguments.\n"
+    rows = []
+    any_conditional = False
+    for info in infos:
+        name = info.name + ("*" if info.conditional else "")  # type: ignore[attr-defined]
+        any_conditional |= info.conditional  # type: ignore[attr-defined]
+        default = "(required)" if info.default is None else repr(info.default)  # type: ignore[attr-defined]
+        rows.append((name, default, info.description))  # type: ignore[attr-defined]
+    w_name = max(len("name"), *(len(r[0]) for r in rows))
+    w_def = min(36, max(len("default"), *(len(r[1]) for r in rows)))
+    width = max(40, _terminal_width() - w_name - w_def - 6)
+    out = ["Arguments (pass arguments as '<name>:=<value>'):", ""]
+    out.append(f"  {'name':<{w_name}}  {'default':<{w_def}}  description")
+    out.append(f"  {'-' * w_name}  {'-' * w_def}  {'-' * min(width, 40)}")
+    for name, default, description in rows:
+        lines = textwrap.wrap(description, width) or [""]
+        shown = default if len(default) <= w_def else default[: w_def - 3] + "..."
+        out.append(f"  {name:<{w_name}}  {shown:<{w_def}}  {lines[0]}")
+        pad = " " * (w_name + w_def + 6)
+        out.extend(pad + line for line in lines[1:])
+    if any_conditional:
+        out += ["", "* argument(s) which are only used if specific conditions occur"]
+    return "\n".join(out) + "\n"
+
+
+def _terminal_width() -> int:
+    try:
+        return os.get_terminal_size(1).columns
+    except OSError:
+        return 100
+
+
+if __name__ == "__main__":
+    sys.exit(main())

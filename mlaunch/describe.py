@@ -1,0 +1,134 @@
+"""--print: the resolved plan as text a person reads (and greps): what ros2 launch lacks."""
+
+from __future__ import annotations
+
+import os
+import shlex
+
+from mlaunch.plan import (
+    AddHandler,
+    EmitEvent,
+    Log,
+    Plan,
+    ProcessSpec,
+    RemoveHandler,
+    RequestShutdown,
+    Spawn,
+    StartTimer,
+)
+
+LONG_VALUE = 160
+
+HANDLER_WORDS = {
+    "process_start": "when {target} starts",
+    "process_exit": "when {target} exits",
+    "process_io": "on output of {target}",
+    "shutdown": "at shutdown",
+    "state_transition": "on a lifecycle transition of {target}",
+}
+
+
+def describe_plan(plan: Plan, path: str) -> str:
+    processes = plan.processes()
+    out = [f"Plan for {_rel(path)}: {len(processes)} process(es) at start", ""]
+    for warning in plan.warnings:
+        out.append(f"warning: {warning}")
+    if plan.warnings:
+        out.append("")
+    for step in plan.steps:
+        if isinstance(step, Spawn) and step.spec is not None:
+            out.extend(describe_process(step.spec, plan.temp_dir))
+        elif isinstance(step, Log):
+            out.append(f"log [{step.level}] {step.message}")
+        elif isinstance(step, StartTimer) and step.body is not None:
+            out.append(
+                f"timer after {step.period:g} s: {step.body.describe()}   ({_rel(step.origin)})"
+            )
+        elif isinstance(step, AddHandler) and step.body is not None:
+            target = "any process" if step.matcher is None else "its target"
+            target_action = getattr(step.handler, "target_action", None)
+            if target_action is not None and hasattr(target_action, "describe_short"):
+                target = target_action.describe_short()
+            when = HANDLER_WORDS.get(step.kind, step.kind).format(target=target)
+            what = (
+                step.body.describe() if (step.body.entities or step.body.callback) else "callbacks"
+            )
+            out.append(f"handler {when}: {what}   ({_rel(step.origin)})")
+        elif isinstance(step, RemoveHandler):
+            out.append("remove a handler")
+        elif isinstance(step, RequestShutdown):
+            out.append(f"shutdown: {step.reason}")
+        elif isinstance(step, EmitEvent):
+            out.append(f"emit {type(step.event).__name__}")
+        out.append("") if isinstance(step, Spawn) else None
+    return "\n".join(out).rstrip() + "\n"
+
+
+def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+    head = spec.label
+    if spec.standin:
+        head += f"   (stand-in for {spec.standin})"
+    lines = [head + (f"   {_rel(spec.origin)}" if spec.origin else "")]
+    argv = " ".join(spec.argv) if spec.shell else shlex.join(spec.argv)
+    lines.append(
+        f"  argv:    {_shorten(argv, 400)}" + ("   [via /bin/sh -c]" if spec.shell else "")
+    )
+    if spec.node is not None and spec.node.fully_qualified_name:
+        kind = "lifecycle node" if spec.node.lifecycle else "node"
+        auto = " (autostart)" if spec.node.autostart else ""
+        lines.append(f"  {kind}:    {spec.node.fully_qualified_name}{auto}")
+    lines.append(f"  cwd:     {spec.cwd or '(inherited)'}")
+    if spec.env_changes:
+        changes = [
+            f"{k}={_shorten(v, 60)}" if v is not None else f"-{k}"
+            for k, v in sorted(spec.env_changes.items())
+        ]
+        lines.append(f"  env:     {' '.join(changes)}")
+    lines.append(f"  output:  {spec.output}")
+    lines.append(f"  respawn: {spec.respawn.describe()}")
+    stop = (
+        f"SIGINT, SIGTERM after {spec.sigterm_timeout:g} s,"
+        f" SIGKILL after {spec.sigkill_timeout:g} s more"
+    )
+    lines.append(f"  stop:    {stop}")
+    if spec.required:
+        lines.append("  exit:    required: its exit shuts the launch down")
+    elif spec.on_exit is not None:
+        lines.append(f"  on exit: {spec.on_exit.describe()}")
+    lines.extend(_params_files(spec, temp_dir))
+    return lines
+
+
+def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+    out = []
+    for i, arg in enumerate(spec.argv[:-1]):
+        if arg != "--params-file":
+            continue
+        path = spec.argv[i + 1]
+        if not temp_dir or not path.startswith(temp_dir):
+            continue
+        try:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+        except OSError:
+            continue
+        out.append(f"  params ({os.path.basename(path)}):")
+        out.extend("    " + _shorten(line, LONG_VALUE) for line in text.splitlines())
+    return out
+
+
+def _shorten(text: str, limit: int) -> str:
+    text = text.replace("\n", "\\n")
+    if len(text) <= limit:
+        return text
+    return f"{text[: limit - 20]}... <{len(text)} chars>"
+
+
+def _rel(path: str) -> str:
+    if not path:
+        return ""
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:
+        return path
+    return rel if not rel.startswith("../../") else path
