@@ -86,7 +86,7 @@ def matches_name(target_name: str) -> ProcessMatcher:
 
 def matches_executable(executable_name: str) -> ProcessMatcher:
     def match(process: Any) -> bool:
-        argv = getattr(process, "argv", ())
+        argv: tuple[str, ...] = tuple(getattr(process, "argv", ()))
         return bool(argv) and argv[0].endswith(executable_name)
 
     return match
