@@ -88,6 +88,19 @@ PROBE = textwrap.dedent(
         spin_until(lambda: got)
         out(kind="latched", topic=spec["latched"], data=got[0])
 
+    if spec.get("publish_joints"):
+        from sensor_msgs.msg import JointState
+
+        pub = node.create_publisher(JointState, spec["publish_joints"], 10)
+        spin_until(lambda: pub.get_subscription_count())
+        # each batch of names 10 times, in order: a later batch seen means the earlier one was
+        for names in spec["batches"]:
+            for _ in range(10):
+                pub.publish(JointState(name=names, position=[0.5] * len(names)))
+                until = time.monotonic() + 0.02
+                spin_until(lambda: time.monotonic() > until)
+        out(kind="published")
+
     if spec.get("joint_states"):
         from sensor_msgs.msg import JointState
 
@@ -248,11 +261,33 @@ def test_rsp_latches_description_for_a_late_subscriber(
 def test_rsp_namespace_moves_the_topic(spawn: Callable[..., Proc], tmp_path: Path) -> None:
     params = params_file(tmp_path, {"robot_description": URDF})
     argv = standin("rsp", "--ros-args", "-r", "__ns:=/r1", "--params-file", params)
-    rsp = spawn(argv, "rsp")
+    rsp = spawn([*argv, "-p", "use_sim_time:=True"], "rsp")
     wait_until(started(rsp, "not published"), 15, "rsp to start")
-    (line,) = probe(spawn, {"latched": "/r1/robot_description"})
-    assert line["data"] == URDF
+    lines = probe(
+        spawn,
+        {
+            "latched": "/r1/robot_description",
+            "params_of": "/r1/robot_state_publisher",
+            "names": ["use_sim_time"],
+        },
+    )
+    kinds = {line["kind"]: line for line in lines}
+    assert kinds["latched"]["data"] == URDF
+    assert kinds["params"]["values"] == {"use_sim_time": True}
     assert "[r1.robot_state_publisher]" in rsp.stderr()
+
+
+def test_rsp_names_unknown_joints_once(spawn: Callable[..., Proc], tmp_path: Path) -> None:
+    params = params_file(tmp_path, {"robot_description": URDF})
+    rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
+    wait_until(started(rsp, "not published"), 15, "rsp to start")
+    batches = [["left_wheel_joint", "mystery_joint"], ["sentinel_joint"]]
+    probe(spawn, {"publish_joints": "/joint_states", "batches": batches})
+    wait_until(lambda: "'sentinel_joint'" in rsp.stderr(), 10, "rsp to name the sentinel joint")
+    warnings = [line for line in rsp.stderr().splitlines() if "mystery_joint" in line]
+    assert len(warnings) == 1, warnings
+    assert "not in robot 'probe_bot'" in warnings[0]
+    assert "left_wheel_joint" not in rsp.stderr()
 
 
 @pytest.mark.parametrize(
@@ -311,8 +346,8 @@ def test_jsp_reads_the_description_topic_and_waits_for_sim_time(
     spawn(standin("rsp", "--ros-args", "--params-file", rsp_params), "rsp")
     argv = standin("jsp", "--ros-args", "-p", "use_sim_time:=True", "-r", "__node:=jsp")
     jsp = spawn(argv, "jsp")
-    wait_until(started(jsp, "waiting for /clock"), 20, "jsp to read the URDF and want a clock")
-    assert "robot 'probe_bot': publishing joints" in jsp.stderr()
+    wait_until(started(jsp, "robot 'probe_bot': publishing joints"), 20, "jsp to read the URDF")
+    assert "use_sim_time is true: waiting for /clock" in jsp.stderr()
     lines = probe(
         spawn,
         {
