@@ -114,7 +114,7 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
 def parse_options(argv: Sequence[str]) -> Options:
     from mlaunch.errors import UsageError
 
-    ns = build_parser().parse_args(list(argv))
+    ns = build_parser().parse_intermixed_args(list(argv))
     opts = Options(
         target=ns.target,
         show_args=ns.show_args,

@@ -460,14 +460,17 @@ class Supervisor:
             returncode=code,
         )
         self._dispatch("process_exit", process, event)
-        if spec.on_exit is not None:
-            self.fire(spec.on_exit, event)
-        if spec.required and not process.stopping:
+        required = spec.required and not process.stopping
+        if required:
+            # Before on_exit runs, so the reason names the process rather than the bare
+            # Shutdown() its on_exit holds.
             if code != 0:
                 self.exit_code = max(self.exit_code, EXIT_REQUIRED_FAILED)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
-            return
-        self._maybe_respawn(process, code)
+        if spec.on_exit is not None:
+            self.fire(spec.on_exit, event)
+        if not required:
+            self._maybe_respawn(process, code)
 
     def _report_exit(self, process: Process, code: int) -> None:
         label, pid = process.label, process.pid

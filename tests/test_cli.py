@@ -1,0 +1,301 @@
+"""End-to-end runs of the mlaunch command: output, logs, exit codes, signals, and clear errors."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from procutil import Running, clean_env, mlaunch, pid_alive, run_mlaunch, wait_until
+
+PY = sys.executable
+
+
+def launch_file(tmp_path: Path, body: str, name: str = "sys.launch.py") -> str:
+    """A Python launch file whose generate_launch_description returns ``[body]``."""
+    path = tmp_path / name
+    path.write_text(
+        textwrap.dedent(
+            """
+            import sys
+            from launch import LaunchDescription
+            from launch.actions import *
+            from launch.substitutions import *
+            from launch.conditions import *
+            from launch.event_handlers import *
+            PY = sys.executable
+
+            def generate_launch_description():
+                return LaunchDescription([
+            """
+        )
+        + textwrap.indent(textwrap.dedent(body).strip(), " " * 8)
+        + "\n    ])\n"
+    )
+    return str(path)
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+
+
+def test_output_is_prefixed_decoded_and_flushed(tmp_path: Path, env: dict[str, str]) -> None:
+    script = (
+        "import sys; print('[talker] [INFO] hello [/foo]'); sys.stdout.flush();"
+        " sys.stdout.buffer.write(b'bad \\xff byte\\n'); sys.stderr.write('to stderr\\n');"
+        " sys.stdout.write('no newline at end')"
+    )
+    path = launch_file(
+        tmp_path, f"ExecuteProcess(cmd=[PY, '-c', {script!r}], name='talker', output='screen'),"
+    )
+    done = run_mlaunch(path, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    out = done.stdout
+    # Child text is data: brackets survive, invalid UTF-8 becomes U+FFFD, the partial line shows.
+    assert "[talker-1] [talker] [INFO] hello [/foo]\n" in out
+    assert "[talker-1] bad \ufffd byte\n" in out
+    assert "[talker-1] to stderr\n" in out
+    assert "[talker-1] no newline at end\n" in out
+    assert re.search(r"\[INFO\] \[talker-1\]: process started with pid \[\d+\]", out)
+    assert "[INFO] [talker-1]: process has finished cleanly" in out
+    assert out.index("no newline at end") < out.index("finished cleanly")
+
+
+def test_output_log_mode_hides_stdout_but_logs_it(tmp_path: Path, env: dict[str, str]) -> None:
+    script = "import sys; print('quiet-out'); sys.stderr.write('loud-err\\n')"
+    path = launch_file(tmp_path, f"ExecuteProcess(cmd=[PY, '-c', {script!r}], name='w'),")
+    done = run_mlaunch(path, env=env)
+    assert "quiet-out" not in done.stdout and "[w-1] loud-err" in done.stdout
+    run_dir = Path(env["ROS_LOG_DIR"]) / "latest"
+    assert run_dir.is_symlink()
+    own = (run_dir / "w-1.log").read_text()
+    assert "quiet-out\n" in own and "loud-err\n" in own
+    launch_log = (run_dir / "launch.log").read_text()
+    assert "process started with pid" in launch_log
+    assert re.search(r"^\d+\.\d{7} \[w-1\] quiet-out$", launch_log, re.M)
+
+
+def test_exit_codes(tmp_path: Path, env: dict[str, str]) -> None:
+    failing = launch_file(
+        tmp_path,
+        """
+        ExecuteProcess(cmd=[PY, '-c', 'import sys; sys.exit(3)'], name='core', on_exit=Shutdown()),
+        ExecuteProcess(cmd=[PY, '-c', 'import time; time.sleep(60)'], name='other'),
+        """,
+    )
+    done = run_mlaunch(failing, env=env)
+    assert done.returncode == 1, done.stdout
+    assert "process has died [pid" in done.stdout and "exited with status 3" in done.stdout
+    assert "shutting down: required process core-1 exited with status 3" in done.stdout
+    ok = launch_file(
+        tmp_path,
+        "ExecuteProcess(cmd=[PY, '-c', 'pass'], name='a', required=True),",
+        name="ok.launch.py",
+    )
+    assert run_mlaunch(ok, env=env).returncode == 0
+    # A non-required failure does not fail the launch (as ROS 2), but is reported.
+    soft = launch_file(
+        tmp_path,
+        "ExecuteProcess(cmd=[PY, '-c', 'import os; os.abort()'], name='c'),",
+        name="s.launch.py",
+    )
+    done = run_mlaunch(soft, env=env)
+    assert done.returncode == 0 and "killed by SIGABRT" in done.stdout
+
+
+def test_sigint_ladder_and_grandchildren(tmp_path: Path, env: dict[str, str]) -> None:
+    stubborn = (
+        "import signal, time, os; signal.signal(signal.SIGINT, signal.SIG_IGN);"
+        " print('stubborn', os.getpid(), flush=True); time.sleep(60)"
+    )
+    family = (
+        "import subprocess, time, sys; c = subprocess.Popen(['sleep', '60']);"
+        " print('family', c.pid, flush=True); time.sleep(60)"
+    )
+    path = launch_file(
+        tmp_path,
+        f"""
+        ExecuteProcess(cmd=[PY, '-c', {stubborn!r}], name='stubborn', output='screen',
+                       sigterm_timeout='0.5', sigkill_timeout='0.5'),
+        ExecuteProcess(cmd=[PY, '-c', {family!r}], name='family', output='screen'),
+        """,
+    )
+    run = Running(mlaunch(path), env=env)
+    try:
+        stubborn_pid = int(run.wait_for(r"stubborn (\d+)").group(1))
+        grandchild = int(run.wait_for(r"family (\d+)").group(1))
+        run.signal(signal.SIGINT)
+        code = run.finish(timeout=15)
+    finally:
+        run.kill()
+    assert code == 130, run.text
+    assert "escalating to SIGTERM" in run.text
+    assert "[stubborn-1]: process stopped by SIGTERM" in run.text
+    assert not pid_alive(stubborn_pid) and not pid_alive(grandchild)
+
+
+def test_sigterm_to_mlaunch_stops_everything(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(
+        tmp_path,
+        "ExecuteProcess(cmd=[PY, '-c', 'import time,os; print(\"up\", os.getpid(), flush=True); time.sleep(60)'], output='screen'),",
+    )
+    run = Running(mlaunch(path), env=env)
+    try:
+        pid = int(run.wait_for(r"up (\d+)").group(1))
+        run.signal(signal.SIGTERM)
+        assert run.finish() == 143
+    finally:
+        run.kill()
+    assert wait_until(lambda: not pid_alive(pid), 2.0)
+
+
+def test_timer_and_event_handlers_run(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(
+        tmp_path,
+        """
+        DeclareLaunchArgument('word', default_value='bye'),
+        RegisterEventHandler(OnProcessExit(on_exit=[LogInfo(msg=['exited, ', LaunchConfiguration('word')])])),
+        RegisterEventHandler(OnShutdown(on_shutdown=[LogInfo(msg='on shutdown')])),
+        TimerAction(period=0.2, actions=[ExecuteProcess(cmd=[PY, '-c', 'print(42)'], name='late', output='screen')]),
+        """,
+    )
+    done = run_mlaunch(path, "word:=ciao", env=env)
+    assert done.returncode == 0
+    out = done.stdout
+    assert "[late-1] 42" in out and "exited, ciao" in out and "on shutdown" in out
+    assert out.index("[late-1] 42") < out.index("exited, ciao")
+
+
+def test_respawn_on_failure_with_retries(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(
+        tmp_path,
+        "ExecuteProcess(cmd=[PY, '-c', 'import sys; print(\"run\"); sys.exit(2)'], name='flaky',"
+        " output='screen', respawn='on-failure', respawn_delay=0.05, respawn_max_retries=2),",
+    )
+    done = run_mlaunch(path, env=env)
+    assert done.stdout.count("[flaky-1] run") == 3
+    assert "restart 1/2" in done.stdout and "restart 2/2" in done.stdout
+    assert "giving up after 2 restarts" in done.stdout
+
+
+@pytest.mark.parametrize(
+    ("body", "args", "message"),
+    [
+        (
+            "DeclareLaunchArgument('robot'),",
+            [],
+            "required launch argument 'robot' was not provided",
+        ),
+        (
+            "DeclareLaunchArgument('m', default_value='a', choices=['a', 'b']),",
+            ["m:=c"],
+            "'c', which is not one of its choices: a, b",
+        ),
+        (
+            "ExecuteProcess(cmd=['echo', LaunchConfiguration('nope')]),",
+            [],
+            "launch configuration 'nope' does not exist",
+        ),
+        (
+            "ExecuteProcess(cmd=['no-such-program-xyz']),",
+            [],
+            "'no-such-program-xyz' not found on the PATH",
+        ),
+        (
+            "LogInfo(msg=1/0),",
+            [],
+            "ZeroDivisionError in generate_launch_description(): division by zero",
+        ),
+    ],
+)
+def test_bad_input_is_one_clear_line(
+    tmp_path: Path, env: dict[str, str], body: str, args: list[str], message: str
+) -> None:
+    path = launch_file(tmp_path, body)
+    done = run_mlaunch(path, *args, env=env)
+    assert done.returncode == 2, done.stdout + done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    assert lines[0].startswith(f"mlaunch: error: {path}:") and message in lines[0]
+
+
+def test_missing_file_syntax_error_and_malformed_argument(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    done = run_mlaunch(str(tmp_path / "nope.launch.py"), env=env)
+    assert done.returncode == 2 and "does not exist" in done.stderr
+    broken = tmp_path / "broken.launch.py"
+    broken.write_text("def generate_launch_description()\n    return 1\n")
+    done = run_mlaunch(str(broken), env=env)
+    assert done.returncode == 2 and f"{broken}:1:" in done.stderr and "syntax error" in done.stderr
+    ok = launch_file(tmp_path, "LogInfo(msg='x'),")
+    done = run_mlaunch(ok, "novalue", env=env)
+    assert done.returncode == 2 and "malformed launch argument 'novalue'" in done.stderr
+    done = run_mlaunch(ok, "--debug", "m:=1", env=env)
+    assert done.returncode == 0
+
+
+def test_undeclared_argument_warns(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(tmp_path, "DeclareLaunchArgument('use_sim_time', default_value='false'),")
+    done = run_mlaunch(path, "use_sim_tim:=true", env=env)
+    assert done.returncode == 0
+    assert (
+        "argument 'use_sim_tim' is not declared by the launch file (did you mean 'use_sim_time'?)"
+        in done.stdout
+    )
+
+
+def test_show_args_and_print(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(
+        tmp_path,
+        """
+        DeclareLaunchArgument('world', default_value='empty.world', description='World file to load'),
+        DeclareLaunchArgument('gui', default_value='true', choices=['true', 'false']),
+        ExecuteProcess(cmd=[PY, '-c', 'pass', LaunchConfiguration('world')], name='sim',
+                       respawn=True, respawn_delay=2.0, additional_env={'SIM_MODE': 'fast'}),
+        """,
+    )
+    shown = run_mlaunch(path, "--show-args", env=env)
+    assert shown.returncode == 0
+    assert re.search(r"world\s+'empty.world'\s+World file to load", shown.stdout)
+    assert "One of: ['true', 'false']" in shown.stdout
+    printed = run_mlaunch(path, "--print", "world:=maze.world", env=env)
+    assert printed.returncode == 0
+    out = printed.stdout
+    assert "sim-1" in out and "maze.world" in out and "SIM_MODE=fast" in out
+    assert "respawn: always, delay 2 s, unlimited restarts" in out
+    assert "SIGTERM after 5 s" in out
+    # Nothing was started and no log directory was made.
+    assert "process started" not in out
+    assert not (Path(env["ROS_LOG_DIR"])).exists()
+
+
+def test_plain_launch_never_imports_rclpy(tmp_path: Path, env: dict[str, str]) -> None:
+    path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'pass']),")
+    code = (
+        "import sys; from mlaunch.cli import main; rc = main([sys.argv[1]]);"
+        " heavy = sorted(m for m in ('rclpy', 'rich', 'asyncio', 'yaml') if m in sys.modules);"
+        " print('IMPORTED', heavy); sys.exit(rc)"
+    )
+    done = __import__("subprocess").run(
+        [PY, "-c", code, path], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "IMPORTED []" in done.stdout
+
+
+def test_python_m_and_console_script_agree(tmp_path: Path, env: dict[str, str]) -> None:
+    script = Path(sys.executable).parent / "mlaunch"
+    if not script.exists():
+        pytest.skip("the mlaunch console script is not installed in this environment")
+    path = launch_file(tmp_path, "LogInfo(msg='same'),")
+    done = __import__("subprocess").run(
+        [str(script), path], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0 and "[INFO] [launch.user]: same" in done.stdout
+    assert os.path.exists(env["ROS_LOG_DIR"])
