@@ -1,0 +1,174 @@
+"""The YAML frontend: a ``*.launch.yaml`` file (ROS 2's launch_yaml schema) to a LaunchDescription.
+
+The file is composed (not constructed) with PyYAML's C loader when it is there, so every tag and
+value keeps its line and column; scalars are constructed one by one as the tag builders read
+them. The root is ``launch:`` with a list of single-key maps (tag: attributes); an entity that
+holds actions is a list, or a map with a ``children:`` list.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import yaml
+from yaml.constructor import SafeConstructor
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+
+from mlaunch.errors import LaunchFileError
+from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.tags import build_description
+
+try:
+    _Base: Any = yaml.CSafeLoader
+except AttributeError:  # PyYAML built without libyaml
+    _Base = yaml.SafeLoader
+
+
+class _Loader(_Base):  # type: ignore[misc, valid-type]
+    """The safe loader (C when available); composing with it keeps node marks."""
+
+
+def load(path: str) -> Any:
+    """The LaunchDescription of the YAML launch file at ``path``."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise LaunchFileError(f"cannot read launch file: {e.strerror}", where=path)
+    return _Reader(path).description(data)
+
+
+class _Reader:
+    """Turns composed YAML nodes into Entities, located in ``path``."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self.constructor = SafeConstructor()
+
+    def description(self, data: bytes) -> Any:
+        try:
+            root = yaml.compose(data, Loader=_Loader)
+        except yaml.MarkedYAMLError as e:
+            raise self._yaml_error(e)
+        except yaml.YAMLError as e:
+            raise LaunchFileError(f"malformed YAML: {e}", where=self.path)
+        if root is None:
+            raise LaunchFileError("the file is empty; expected a 'launch:' list", where=self.path)
+        if not isinstance(root, MappingNode) or len(root.value) != 1:
+            raise self.error(root, "the root must be a map with the single key 'launch'")
+        key, value = root.value[0]
+        tag = self.key_text(key)
+        if tag != "launch":
+            raise self.error(key, f"the root key must be 'launch', not {tag!r}")
+        return build_description(self.entity(tag, key, value))
+
+    # --- nodes to entities ----------------------------------------------------------------------
+
+    def entity(self, tag: str, key: Node, value: Node) -> Entity:
+        mark = key.start_mark
+        e = Entity(
+            tag=tag,
+            path=self.path,
+            line=mark.line + 1,
+            col=mark.column + 1,
+            fmt="yaml",
+            yaml_subentities=self.subentities,
+            yaml_construct=self.construct,
+        )
+        if isinstance(value, SequenceNode):
+            e.children = self.children(value)
+        elif isinstance(value, MappingNode):
+            self.fill(e, value)
+        elif not (isinstance(value, ScalarNode) and value.tag == "tag:yaml.org,2002:null"):
+            raise self.error(
+                value,
+                f"{tag}: expected a map of attributes or a list of children, got {value.value!r}",
+            )
+        return e
+
+    def fill(self, e: Entity, mapping: MappingNode) -> None:
+        for key, value in mapping.value:
+            name = self.key_text(key)
+            if name in e.attrs or (name == "children" and e.children is not None):
+                raise self.error(key, f"{e.tag}: key {name!r} is given twice")
+            if name == "children":
+                if not isinstance(value, SequenceNode):
+                    raise self.error(value, f"{e.tag}: 'children' must be a list of entities")
+                e.children = self.children(value)
+                continue
+            e.attrs[name] = self.attr(value)
+
+    def children(self, sequence: SequenceNode) -> list[Entity]:
+        out = []
+        for item in sequence.value:
+            if not isinstance(item, MappingNode) or len(item.value) != 1:
+                keys = (
+                    ", ".join(repr(self.key_text(k)) for k, _ in item.value)
+                    if isinstance(item, MappingNode)
+                    else ""
+                )
+                got = f"a map with keys {keys}" if keys else f"{_shape(item)}"
+                raise self.error(
+                    item,
+                    f"each entity is a map with one key, its tag (- node: {{...}}); got {got}"
+                    " (check the indentation and the '-' of each entity)",
+                )
+            key, value = item.value[0]
+            out.append(self.entity(self.key_text(key), key, value))
+        return out
+
+    def subentities(self, parent: Entity, name: str, attr: Attr) -> list[Entity]:
+        """A list-of-maps attribute (``param``, ``remap``, ``env`` ...) as Entities."""
+        node = attr.value
+        if not isinstance(node, SequenceNode) or not all(
+            isinstance(i, MappingNode) for i in node.value
+        ):
+            raise parent.error(f"attribute {name!r} must be a list of maps (- {{...}} items)", attr)
+        out = []
+        for item in node.value:
+            mark = item.start_mark
+            e = Entity(
+                tag=name,
+                path=self.path,
+                line=mark.line + 1,
+                col=mark.column + 1,
+                fmt="yaml",
+                yaml_subentities=self.subentities,
+                yaml_construct=self.construct,
+            )
+            self.fill(e, item)
+            out.append(e)
+        return out
+
+    def attr(self, node: Node) -> Attr:
+        mark = node.start_mark
+        quoted = 1 if isinstance(node, ScalarNode) and node.style in ("'", '"') else 0
+        return Attr(node, mark.line + 1, mark.column + 1 + quoted)
+
+    def key_text(self, key: Node) -> str:
+        if not isinstance(key, ScalarNode) or key.tag != "tag:yaml.org,2002:str":
+            raise self.error(key, f"expected a tag or attribute name, got {_shape(key)}")
+        return str(key.value)
+
+    def construct(self, node: Node) -> Any:
+        return self.constructor.construct_object(node, deep=True)
+
+    # --- errors ---------------------------------------------------------------------------------
+
+    def error(self, node: Node, message: str) -> LaunchFileError:
+        mark = node.start_mark
+        return LaunchFileError(message, where=f"{self.path}:{mark.line + 1}:{mark.column + 1}")
+
+    def _yaml_error(self, e: yaml.MarkedYAMLError) -> LaunchFileError:
+        mark = e.problem_mark or e.context_mark
+        where = f"{self.path}:{mark.line + 1}:{mark.column + 1}" if mark else self.path
+        problem = " ".join(p for p in (e.context, e.problem) if p)
+        return LaunchFileError(f"malformed YAML: {problem}", where=where)
+
+
+def _shape(node: Node) -> str:
+    if isinstance(node, SequenceNode):
+        return "a list"
+    if isinstance(node, MappingNode):
+        return "a map"
+    return repr(node.value)
