@@ -48,9 +48,11 @@ def ros_env(monkeypatch: pytest.MonkeyPatch) -> Iterator[dict[str, str]]:
     values = {
         "ROS_DOMAIN_ID": str(domain),
         "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-        "ROS_LOCALHOST_ONLY": "0",  # deprecated in Jazzy; the range above is the setting
         "RMW_IMPLEMENTATION": "rmw_fastrtps_cpp",
     }
+    # ROS_LOCALHOST_ONLY is deprecated in Jazzy (the range above replaces it) and only makes
+    # every node print a warning.
+    monkeypatch.delenv("ROS_LOCALHOST_ONLY", raising=False)
     for key, value in values.items():
         monkeypatch.setenv(key, value)
     try:
