@@ -1,3 +1,40 @@
-"""mlaunch: a fast, trustworthy ROS 2 launcher."""
+"""mlaunch: a fast, trustworthy ROS 2 launcher.
+
+The ROS 2 launch names are available from here too (``from mlaunch import Node,
+LaunchDescription``), loaded on first use so that ``import mlaunch`` stays cheap for the CLI.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
 
 __version__ = "0.1.0"
+
+_MODULES = (
+    "mlaunch.actions",
+    "mlaunch.substitutions",
+    "mlaunch.conditions",
+    "mlaunch.event_handlers",
+    "mlaunch.launch_description_sources",
+    "mlaunch.ros.actions",
+    "mlaunch.ros.substitutions",
+    "mlaunch.ros.parameter_descriptions",
+)
+
+
+def __getattr__(name: str) -> Any:
+    if name.startswith("_"):
+        raise AttributeError(name)
+    for module_name in _MODULES:
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError:
+            continue
+        if name in getattr(module, "__all__", ()) or (
+            name[:1].isupper() and hasattr(module, name)
+        ):
+            value = getattr(module, name)
+            globals()[name] = value
+            return value
+    raise AttributeError(f"module 'mlaunch' has no attribute {name!r}")
