@@ -1,0 +1,379 @@
+"""``launch_ros.parameter_descriptions`` (also ``launch_ros.descriptions``): typed parameter values.
+
+- ``ParameterValue(value, *, value_type=None)``: a value whose type is forced when performed;
+  ``value_type=str`` keeps a substitution's text as text (a URDF from xacro stays a string,
+  never YAML-parsed). Without a type, substitution results are read with YAML rules.
+- ``Parameter(name, value, *, value_type=None)``: a single ``-p name:=value`` on the command line.
+- ``ParameterFile(param_file, *, allow_substs=False)``: a params file; with ``allow_substs`` its
+  ``$(...)`` are performed and the result is written to a new file.
+- ``ComposableNode``: the description of a component (data only for now).
+
+The typing rules are launch's ``type_utils``: plain values are checked against ``value_type``
+when built; substitutions are performed and coerced when the node is resolved (``int``/``float``
+with Python's conversion, ``bool`` and lists with YAML, ``str`` as is).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import typing
+from collections.abc import Iterable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import yaml
+
+from mlaunch.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.substitutions import (
+    Substitution,
+    describe,
+    normalize,
+    perform_substitutions,
+)
+
+if TYPE_CHECKING:
+    from mlaunch.context import LaunchContext
+
+SCALAR_TYPES = (int, float, bool, str)
+Subs = tuple[Substitution, ...]
+
+
+# --- value types --------------------------------------------------------------------------------
+
+
+def extract_type(value_type: Any) -> tuple[type | None, bool]:
+    """``int`` -> (int, False); ``List[int]`` or ``list[int]`` -> (int, True); None: YAML rules."""
+    if value_type is None:
+        return None, False
+    if typing.get_origin(value_type) is list:
+        args = typing.get_args(value_type)
+        if len(args) == 1 and args[0] in SCALAR_TYPES:
+            return args[0], True
+    elif value_type in SCALAR_TYPES:
+        return value_type, False
+    raise LaunchFileError(
+        f"value_type {value_type!r} is not a parameter type; valid: int, float, bool, str,"
+        " List[int], List[float], List[bool], List[str] (or None for YAML rules)"
+    )
+
+
+def type_name(value_type: Any) -> str:
+    scalar, is_list = extract_type(value_type)
+    if scalar is None:
+        return "None"
+    return f"List[{scalar.__name__}]" if is_list else scalar.__name__
+
+
+def is_substitution(value: Any) -> bool:
+    """A Substitution, or a non-empty list of text and substitutions (one substitution at least)."""
+    if isinstance(value, Substitution):
+        return True
+    if isinstance(value, (list, tuple)) and value:
+        return all(isinstance(v, (str, Substitution)) for v in value) and any(
+            isinstance(v, Substitution) for v in value
+        )
+    return False
+
+
+def _is_instance(value: Any, scalar: type | None, is_list: bool) -> bool:
+    if scalar is None:
+        return _valid_plain(value)
+    if is_list:
+        return isinstance(value, list) and all(isinstance(v, scalar) for v in value)
+    return isinstance(value, scalar)
+
+
+def _valid_plain(value: Any) -> bool:
+    """A scalar, or a list of one scalar type (text may mix in, as launch allows)."""
+    if isinstance(value, list):
+        kinds = {type(v) for v in value}
+        kinds.discard(str)
+        return len(kinds) <= 1 and kinds <= set(SCALAR_TYPES)
+    return isinstance(value, SCALAR_TYPES)
+
+
+def normalize_typed(value: Any, value_type: Any) -> Any:
+    """A plain value checked against ``value_type``, or substitutions kept for later.
+
+    Returns a scalar, a ``Subs`` tuple (performed later), or a list whose items are scalars or
+    ``Subs`` tuples.
+    """
+    scalar, is_list = extract_type(value_type)
+    if isinstance(value, Path):
+        value = str(value)
+    if isinstance(value, SCALAR_TYPES):
+        if not _is_instance(value, scalar, is_list):
+            raise LaunchFileError(f"value {value!r} is not of type {type_name(value_type)}")
+        return value
+    if is_substitution(value):
+        return normalize(value)
+    if not isinstance(value, Iterable) or isinstance(value, (bytes, dict)):
+        raise LaunchFileError(
+            f"a parameter value must be a scalar, a substitution or a list of them, got"
+            f" {type(value).__name__}: {value!r}"
+        )
+    items = list(value)
+    if value_type is not None and not is_list:
+        raise LaunchFileError(
+            f"value {items!r} is a list, but value_type {type_name(value_type)} is not"
+        )
+    kinds: set[type] = set()
+    out: list[Any] = []
+    for item in items:
+        if isinstance(item, SCALAR_TYPES):
+            kinds.add(type(item))
+            out.append(item)
+        elif is_substitution(item):
+            kinds.add(Substitution)
+            out.append(normalize(item))
+        else:
+            raise LaunchFileError(
+                f"list parameter item {item!r} is not a scalar or a substitution (in {items!r})"
+            )
+    _check_list_kinds(kinds, scalar, items)
+    if kinds <= {int, float, Substitution} and (float in kinds or scalar is float):
+        out = [float(v) if isinstance(v, int) else v for v in out]
+    return out
+
+
+def _check_list_kinds(kinds: set[type], scalar: type | None, items: list[Any]) -> None:
+    """A list is uniform: text, bools, ints, or numbers (floats); substitutions fit any."""
+    plain = kinds - {Substitution}
+    for allowed, fits in (({str}, str), ({bool}, bool), ({int}, int), ({int, float}, float)):
+        if plain <= allowed:
+            # ints also fit a List[float] (launch_ros refuses that; nothing depends on it)
+            if scalar is None or not plain or scalar is fits or (scalar is float and fits is int):
+                return
+            break
+    names = ", ".join(sorted(k.__name__ for k in plain))
+    want = f"List[{scalar.__name__}]" if scalar else "one type"
+    raise LaunchFileError(f"list parameter {items!r} holds {names}; expected {want}")
+
+
+def perform_typed(context: LaunchContext, value: Any, value_type: Any) -> Any:
+    """Perform a value from ``normalize_typed`` and coerce it to ``value_type``."""
+    scalar, is_list = extract_type(value_type)
+    if isinstance(value, tuple):
+        return coerce(perform_substitutions(context, value), value_type)
+    if isinstance(value, list):
+        item_type = scalar if is_list else None
+        return [
+            coerce(perform_substitutions(context, v), item_type) if isinstance(v, tuple) else v
+            for v in value
+        ]
+    return value
+
+
+def coerce(text: str, value_type: Any) -> Any:
+    """Performed text -> a value of ``value_type`` (launch's coerce_to_type)."""
+    scalar, is_list = extract_type(value_type)
+    if scalar is None:
+        loaded = _yaml(text, "a parameter value")
+        if not _valid_plain(loaded) and loaded != []:
+            raise SubstitutionFailure(
+                f"value {text!r} read as YAML gives {type(loaded).__name__}, not a parameter"
+                " type (a scalar or a uniform list); to keep it as text use"
+                " ParameterValue(value, value_type=str)"
+            )
+        return loaded
+    if is_list:
+        loaded = _yaml(text, f"a List[{scalar.__name__}]")
+        if not isinstance(loaded, list) or not all(isinstance(v, scalar) for v in loaded):
+            raise SubstitutionFailure(f"value {text!r} is not a List[{scalar.__name__}]")
+        return loaded
+    if scalar is str:
+        return text
+    if scalar in (int, float):
+        try:
+            return scalar(text)
+        except ValueError:
+            raise SubstitutionFailure(f"value {text!r} is not {scalar.__name__}")
+    loaded = _yaml(text, "a bool")
+    if not isinstance(loaded, bool):
+        raise SubstitutionFailure(f"value {text!r} is not a bool (true/false)")
+    return loaded
+
+
+def _yaml(text: str, what: str) -> Any:
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        problem = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise SubstitutionFailure(f"value {text[:200]!r} cannot be read as {what}: {problem}")
+
+
+def describe_value(value: Any) -> str:
+    if isinstance(value, tuple):
+        return describe(value)
+    if isinstance(value, list):
+        return "[" + ", ".join(describe_value(v) for v in value) + "]"
+    return repr(value)
+
+
+# --- descriptions -------------------------------------------------------------------------------
+
+
+class ParameterValue:
+    """A parameter value with an optional forced type (``value_type``)."""
+
+    def __init__(self, value: Any, *, value_type: Any = None) -> None:
+        self._value = normalize_typed(value, value_type)
+        self.value_type = value_type
+        self._evaluated: Any = None
+
+    @property
+    def value(self) -> Any:
+        return self._evaluated if self._evaluated is not None else self._value
+
+    def evaluate(self, context: LaunchContext) -> Any:
+        self._evaluated = perform_typed(context, self._value, self.value_type)
+        return self._evaluated
+
+    def __str__(self) -> str:
+        return (
+            f"launch_ros.description.ParameterValue(value={describe_value(self._value)},"
+            f" value_type={type_name(self.value_type)})"
+        )
+
+    __repr__ = __str__
+
+
+class Parameter:
+    """One parameter given on the command line as ``-p name:=value``."""
+
+    def __init__(self, name: Any, value: Any, *, value_type: Any = None) -> None:
+        if not isinstance(name, (str, Path, Substitution, list, tuple)):
+            raise LaunchFileError(f"parameter name must be text or substitutions, got {name!r}")
+        self._name = normalize(name)
+        self._value = ParameterValue(value, value_type=value_type)
+        self._evaluated_name: str | None = None
+
+    @property
+    def name(self) -> Any:
+        return self._evaluated_name if self._evaluated_name is not None else list(self._name)
+
+    @property
+    def value(self) -> Any:
+        return self._value.value
+
+    @property
+    def value_type(self) -> Any:
+        return self._value.value_type
+
+    def evaluate(self, context: LaunchContext) -> tuple[str, Any]:
+        name = perform_substitutions(context, self._name)
+        value = self._value.evaluate(context)
+        self._evaluated_name = name
+        return name, value
+
+    def __str__(self) -> str:
+        return (
+            f"launch_ros.description.Parameter(name={describe(self._name)},"
+            f" value={describe_value(self._value._value)},"
+            f" value_type={type_name(self.value_type)})"
+        )
+
+    __repr__ = __str__
+
+
+class ParameterFile:
+    """A params file; with ``allow_substs`` its ``$(...)`` are performed into a new file."""
+
+    def __init__(self, param_file: Any, *, allow_substs: Any = False) -> None:
+        if isinstance(param_file, bytes):
+            param_file = os.fsdecode(param_file)
+        elif isinstance(param_file, os.PathLike):
+            param_file = os.fspath(param_file)
+        self._param_file = normalize(param_file)
+        if isinstance(allow_substs, bool):
+            self._allow_substs: Any = allow_substs
+        else:
+            self._allow_substs = normalize_typed(allow_substs, bool)
+        self._evaluated: Path | None = None
+
+    @property
+    def param_file(self) -> Any:
+        return self._evaluated if self._evaluated is not None else list(self._param_file)
+
+    @property
+    def allow_substs(self) -> Any:
+        return self._allow_substs
+
+    def evaluate(self, context: LaunchContext, temp_dir: str | None = None) -> Path:
+        """The file to pass: the file itself, or its substituted copy in ``temp_dir``."""
+        path = Path(perform_substitutions(context, self._param_file))
+        if perform_typed(context, self._allow_substs, bool):
+            path = Path(substituted_copy(context, path, temp_dir))
+        self._evaluated = path
+        return path
+
+    def __str__(self) -> str:
+        return (
+            f"launch_ros.description.ParameterFile(param_file={describe(self._param_file)},"
+            f" allow_substs={describe_value(self._allow_substs)})"
+        )
+
+    __repr__ = __str__
+
+
+def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -> str:
+    """Perform the ``$(...)`` in a params file and write the result to a new file."""
+    from mlaunch.frontends.subst import TemplateError, parse_template
+
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as e:
+        raise SubstitutionFailure(
+            f"parameter file {str(path)!r} cannot be read (allow_substs): {e.strerror}"
+        )
+    try:
+        parts = parse_template(text)
+    except TemplateError as e:
+        line = text.count("\n", 0, e.index) + 1
+        raise SubstitutionFailure(f"{path}:{line}: {e.message}")
+    performed = perform_substitutions(context, normalize(parts))
+    try:
+        yaml.safe_load(performed)
+    except yaml.YAMLError as e:
+        raise SubstitutionFailure(
+            f"parameter file {str(path)!r} is not valid YAML once substituted: {e}"
+        )
+    with tempfile.NamedTemporaryFile(
+        mode="w", prefix="launch_params_", dir=temp_dir, delete=False, encoding="utf-8"
+    ) as f:
+        f.write(performed)
+        return f.name
+
+
+class ComposableNode:
+    """A component to load into a container (described here; loading comes later)."""
+
+    def __init__(
+        self,
+        *,
+        package: Any,
+        plugin: Any,
+        name: Any = None,
+        namespace: Any = None,
+        parameters: Any = None,
+        remappings: Any = None,
+        extra_arguments: Any = None,
+        condition: Any = None,
+    ) -> None:
+        self.package = normalize(package)
+        self.node_plugin = normalize(plugin)
+        self.node_name = None if name is None else normalize(name)
+        self.node_namespace = None if namespace is None else normalize(namespace)
+        self.parameters = None if parameters is None else list(parameters)
+        self.remappings = None if remappings is None else list(remappings)
+        self.extra_arguments = None if extra_arguments is None else list(extra_arguments)
+        self.condition = condition
+
+
+__all__ = [
+    "ComposableNode",
+    "Parameter",
+    "ParameterFile",
+    "ParameterValue",
+]
