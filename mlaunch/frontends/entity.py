@@ -14,6 +14,7 @@ written as text, a map or list where text is wanted is an error).
 from __future__ import annotations
 
 import difflib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,12 +36,20 @@ _YAML_NULL = "tag:yaml.org,2002:null"
 class Attr:
     """An attribute value and where its text starts (1-based line and column).
 
-    ``value`` is the XML string, or the YAML node (``yaml.Node``) for YAML files.
+    ``value`` is the XML string, or the YAML node (``yaml.Node``) for YAML files. ``locate``,
+    when given, computes the position on demand (XML: only an error needs it).
     """
 
     value: Any
     line: int
     col: int
+    locate: Callable[[], tuple[int, int]] | None = None
+
+    def position(self) -> tuple[int, int]:
+        if self.locate is not None:
+            self.line, self.col = self.locate()
+            self.locate = None
+        return self.line, self.col
 
 
 @dataclass(eq=False)
@@ -78,7 +87,7 @@ class Entity:
     def where(self, attr: Attr | None = None, index: int = 0) -> str:
         if attr is None:
             return f"{self.path}:{self.line}:{self.col}"
-        line, col = attr.line, attr.col
+        line, col = attr.position()
         text = attr.value if isinstance(attr.value, str) else getattr(attr.value, "value", "")
         if isinstance(text, str) and index:
             prefix = text[:index]

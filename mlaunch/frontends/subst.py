@@ -26,6 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import mlaunch.substitutions as core
 from mlaunch.substitutions import Substitution
 
 Part = str | Substitution
@@ -33,8 +34,10 @@ Parts = list[Part]
 
 _ESCAPABLE = frozenset("$()'\"\\")
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
-# Where top-level text can stop being plain: a backslash or a '$'.
+# Runs of characters that are plain text in each context (the scanner jumps over them).
 _TOP_SPECIAL = re.compile(r"[\\$]")
+_UNQUOTED_PLAIN = re.compile(r"[^ ()\\$'\"]+")
+_QUOTED_PLAIN = {q: re.compile(rf"[^{q}\\$]+") for q in "'\""}
 
 
 class TemplateError(Exception):
@@ -59,12 +62,6 @@ class SubstitutionSpec:
     build: Callable[[list[Any]], Substitution]
 
 
-def _core() -> Any:
-    import mlaunch.substitutions as core
-
-    return core
-
-
 def _ros() -> Any:
     # launch_ros substitutions: imported only when a file uses one.
     import mlaunch.ros.substitutions as ros
@@ -83,35 +80,30 @@ class _Joined(Substitution):
     """Several parts performed and concatenated into one value (for a list-taking keyword)."""
 
     def __init__(self, parts: list[Part]) -> None:
-        from mlaunch.substitutions import normalize
-
-        self.parts = normalize(parts)
+        self.parts = core.normalize(parts)
 
     def perform(self, context: Any) -> str:
-        from mlaunch.substitutions import perform_substitutions
-
-        return perform_substitutions(context, self.parts)
+        return core.perform_substitutions(context, self.parts)
 
     def describe(self) -> str:
         return " + ".join(p.describe() for p in self.parts)
 
 
 def _var(a: list[Any]) -> Substitution:
-    return _core().LaunchConfiguration(a[0], default=a[1] if len(a) > 1 else None)
+    return core.LaunchConfiguration(a[0], default=a[1] if len(a) > 1 else None)
 
 
 def _env(a: list[Any]) -> Substitution:
-    return _core().EnvironmentVariable(a[0], default_value=a[1] if len(a) > 1 else None)
+    return core.EnvironmentVariable(a[0], default_value=a[1] if len(a) > 1 else None)
 
 
 def _eval(a: list[Any]) -> Substitution:
     if len(a) > 1:
-        return _core().PythonExpression(a[0], python_modules=_modules_value(a[1]))
-    return _core().PythonExpression(a[0])
+        return core.PythonExpression(a[0], python_modules=_modules_value(a[1]))
+    return core.PythonExpression(a[0])
 
 
 def _command(a: list[Any]) -> Substitution:
-    core = _core()
     if len(a) > 1:
         if isinstance(a[1], str) and a[1] not in core.Command.ON_STDERR:
             raise ValueError(
@@ -122,7 +114,7 @@ def _command(a: list[Any]) -> Substitution:
 
 
 def _if(a: list[Any]) -> Substitution:
-    return _core().IfElseSubstitution(a[0], a[1], a[2] if len(a) > 2 else "")
+    return core.IfElseSubstitution(a[0], a[1], a[2] if len(a) > 2 else "")
 
 
 SUBSTITUTIONS: dict[str, SubstitutionSpec] = {
@@ -131,26 +123,26 @@ SUBSTITUTIONS: dict[str, SubstitutionSpec] = {
     "eval": SubstitutionSpec("$(eval 'expression' [modules])", 1, 2, _eval),
     "command": SubstitutionSpec("$(command 'cmd args' [fail|warn|ignore|capture])", 1, 2, _command),
     "find-exec": SubstitutionSpec(
-        "$(find-exec name)", 1, 1, lambda a: _core().FindExecutable(name=a[0])
+        "$(find-exec name)", 1, 1, lambda a: core.FindExecutable(name=a[0])
     ),
-    "anon": SubstitutionSpec("$(anon name)", 1, 1, lambda a: _core().AnonName(a[0])),
-    "dirname": SubstitutionSpec("$(dirname)", 0, 0, lambda a: _core().ThisLaunchFileDir()),
-    "filename": SubstitutionSpec("$(filename)", 0, 0, lambda a: _core().ThisLaunchFile()),
-    "log_dir": SubstitutionSpec("$(log_dir)", 0, 0, lambda a: _core().LaunchLogDir()),
-    "launch_log_dir": SubstitutionSpec("$(launch_log_dir)", 0, 0, lambda a: _core().LaunchLogDir()),
+    "anon": SubstitutionSpec("$(anon name)", 1, 1, lambda a: core.AnonName(a[0])),
+    "dirname": SubstitutionSpec("$(dirname)", 0, 0, lambda a: core.ThisLaunchFileDir()),
+    "filename": SubstitutionSpec("$(filename)", 0, 0, lambda a: core.ThisLaunchFile()),
+    "log_dir": SubstitutionSpec("$(log_dir)", 0, 0, lambda a: core.LaunchLogDir()),
+    "launch_log_dir": SubstitutionSpec("$(launch_log_dir)", 0, 0, lambda a: core.LaunchLogDir()),
     "file-content": SubstitutionSpec(
-        "$(file-content path)", 1, 1, lambda a: _core().FileContent(a[0])
+        "$(file-content path)", 1, 1, lambda a: core.FileContent(a[0])
     ),
-    "not": SubstitutionSpec("$(not value)", 1, 1, lambda a: _core().NotSubstitution(a[0])),
-    "and": SubstitutionSpec("$(and a b)", 2, 2, lambda a: _core().AndSubstitution(a[0], a[1])),
-    "or": SubstitutionSpec("$(or a b)", 2, 2, lambda a: _core().OrSubstitution(a[0], a[1])),
-    "any": SubstitutionSpec("$(any a b ...)", 1, None, lambda a: _core().AnySubstitution(*a)),
-    "all": SubstitutionSpec("$(all a b ...)", 1, None, lambda a: _core().AllSubstitution(*a)),
+    "not": SubstitutionSpec("$(not value)", 1, 1, lambda a: core.NotSubstitution(a[0])),
+    "and": SubstitutionSpec("$(and a b)", 2, 2, lambda a: core.AndSubstitution(a[0], a[1])),
+    "or": SubstitutionSpec("$(or a b)", 2, 2, lambda a: core.OrSubstitution(a[0], a[1])),
+    "any": SubstitutionSpec("$(any a b ...)", 1, None, lambda a: core.AnySubstitution(*a)),
+    "all": SubstitutionSpec("$(all a b ...)", 1, None, lambda a: core.AllSubstitution(*a)),
     "equals": SubstitutionSpec(
-        "$(equals a b)", 2, 2, lambda a: _core().EqualsSubstitution(a[0], a[1])
+        "$(equals a b)", 2, 2, lambda a: core.EqualsSubstitution(a[0], a[1])
     ),
     "not-equals": SubstitutionSpec(
-        "$(not-equals a b)", 2, 2, lambda a: _core().NotEqualsSubstitution(a[0], a[1])
+        "$(not-equals a b)", 2, 2, lambda a: core.NotEqualsSubstitution(a[0], a[1])
     ),
     "if": SubstitutionSpec("$(if condition value [else-value])", 2, 3, _if),
     "find-pkg-share": SubstitutionSpec(
@@ -164,6 +156,12 @@ SUBSTITUTIONS: dict[str, SubstitutionSpec] = {
         2,
         2,
         lambda a: _ros().ExecutableInPackage(a[0], a[1]),
+    ),
+    "param": SubstitutionSpec(
+        "$(param name [default])",
+        1,
+        2,
+        lambda a: _ros().Parameter(a[0], default=a[1] if len(a) > 1 else None),
     ),
 }
 
@@ -299,7 +297,14 @@ class _Scanner:
     def unquoted(self, i: int, name: str, start: int, quote: str | None, value: Parts) -> int:
         s, n = self.s, self.n
         buf: list[str] = []
+        plain = _UNQUOTED_PLAIN.match
         while i < n:
+            m = plain(s, i)
+            if m is not None:
+                buf.append(m.group())
+                i = m.end()
+                if i >= n:
+                    break
             c = s[i]
             if c == " " or c == ")":
                 break
@@ -343,7 +348,14 @@ class _Scanner:
         open_at = i
         i += 1
         buf: list[str] = []
+        plain = _QUOTED_PLAIN[q].match
         while i < n:
+            m = plain(s, i)
+            if m is not None:
+                buf.append(m.group())
+                i = m.end()
+                if i >= n:
+                    break
             c = s[i]
             if c == q:
                 _flush(buf, value)

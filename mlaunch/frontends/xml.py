@@ -8,6 +8,7 @@ coerced by the type each tag declares for them (``mlaunch.frontends.entity``).
 from __future__ import annotations
 
 import re
+from functools import partial
 from typing import Any
 from xml.parsers import expat
 
@@ -61,10 +62,9 @@ class _TreeBuilder:
         p = self.parser
         line, col = p.CurrentLineNumber, p.CurrentColumnNumber + 1
         e = Entity(tag=tag, path=self.path, line=line, col=col, fmt="xml")
-        positions = self.value_positions(p.CurrentByteIndex, line, col)
+        index = p.CurrentByteIndex
         for name, value in attributes.items():
-            vline, vcol = positions.get(name, (line, col))
-            e.attrs[name] = Attr(value, vline, vcol)
+            e.attrs[name] = Attr(value, line, col, partial(self.locate, index, line, col, name))
         if self.stack:
             parent = self.stack[-1]
             if parent.children is None:
@@ -86,6 +86,10 @@ class _TreeBuilder:
                 where=f"{self.path}:{p.CurrentLineNumber}:{p.CurrentColumnNumber + 1}",
                 what=e.what,
             )
+
+    def locate(self, index: int, line: int, col: int, name: str) -> tuple[int, int]:
+        """Where the value of attribute ``name`` of the start tag at ``index`` begins."""
+        return self.value_positions(index, line, col).get(name, (line, col))
 
     def value_positions(self, index: int, line: int, col: int) -> dict[str, tuple[int, int]]:
         """Line and column where each attribute value of the start tag at ``index`` begins."""
