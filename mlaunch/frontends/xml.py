@@ -41,7 +41,8 @@ class _TreeBuilder:
         self.path = path
         self.data = data
         self.parser = expat.ParserCreate()
-        self.parser.buffer_text = True
+        # Unbuffered text: the handler runs where the text is, so its position is right.
+        self.parser.buffer_text = False
         self.parser.StartElementHandler = self.start
         self.parser.EndElementHandler = self.end
         self.parser.CharacterDataHandler = self.text

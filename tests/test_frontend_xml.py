@@ -1,0 +1,418 @@
+"""The XML frontend: every tag builds the Python API's action, typing, and every error located."""
+
+from __future__ import annotations
+
+import os
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from mlaunch import actions, frontends
+from mlaunch.conditions import IfCondition, UnlessCondition
+from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError
+from mlaunch.plan import Log, Plan, RequestShutdown, StartTimer
+from mlaunch.resolve import ResolveOptions, resolve
+
+ENV = {"PATH": os.environ["PATH"], "HOME": "/home/u", "KEEP": "k"}
+
+
+def write(tmp_path: Path, body: str, name: str = "t.launch.xml") -> Path:
+    path = tmp_path / name
+    path.write_text(textwrap.dedent(body).lstrip("\n"))
+    return path
+
+
+def load(tmp_path: Path, body: str, name: str = "t.launch.xml") -> actions.LaunchDescription:
+    return frontends.load(str(write(tmp_path, body, name)))
+
+
+def plan_of(tmp_path: Path, body: str, **args: str) -> Plan:
+    path = write(tmp_path, body)
+    description = frontends.load(str(path))
+    return resolve(
+        description, path=str(path), arguments=args, environ=ENV, options=ResolveOptions()
+    )
+
+
+def error(tmp_path: Path, body: str) -> LaunchFileError:
+    path = write(tmp_path, body)
+    with pytest.raises(LaunchFileError) as caught:
+        frontends.load(str(path))
+    return caught.value
+
+
+def logs(plan: Plan) -> list[str]:
+    return [s.message for s in plan.steps if isinstance(s, Log)]
+
+
+# --- core tags -------------------------------------------------------------------------------
+
+
+def test_arg_with_default_description_and_choices(tmp_path: Path) -> None:
+    ld = load(
+        tmp_path,
+        """
+        <launch>
+          <arg name="mode" default="sim" description="Where to run">
+            <choice value="sim"/>
+            <choice value="real"/>
+          </arg>
+          <arg name="robot"/>
+        </launch>
+        """,
+    )
+    mode, robot = ld.entities
+    assert isinstance(mode, actions.DeclareLaunchArgument)
+    assert mode.name == "mode" and mode.choices == ("sim", "real")
+    assert mode.description == "Where to run. Valid choices are: ['sim', 'real']"
+    assert mode.origin.endswith("t.launch.xml:2")
+    assert robot.default_value is None
+
+
+def test_arg_choices_and_required_checked_when_resolving(tmp_path: Path) -> None:
+    body = """
+        <launch>
+          <arg name="mode" default="sim"><choice value="sim"/><choice value="real"/></arg>
+          <log message="mode=$(var mode)"/>
+        </launch>
+    """
+    assert logs(plan_of(tmp_path, body, mode="real")) == ["mode=real"]
+    with pytest.raises(LaunchArgumentError, match="not one of its choices: sim, real") as caught:
+        plan_of(tmp_path, body, mode="fake")
+    assert caught.value.where is not None and caught.value.where.endswith("t.launch.xml:2")
+    with pytest.raises(LaunchArgumentError, match="'robot' was not provided"):
+        plan_of(tmp_path, '<launch><arg name="robot"/></launch>')
+
+
+def test_let_and_log(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <let name="who" value="world"/>
+          <let name="greeting" value="hello $(var who)"/>
+          <log message="$(var greeting)!"/>
+        </launch>
+        """,
+    )
+    assert logs(plan) == ["hello world!"]
+
+
+def test_group_scoped_forwarding_and_keep(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <let name="outer" value="o"/>
+          <group>
+            <let name="inner" value="i"/>
+            <set_env name="SCOPED" value="1"/>
+            <log message="$(var outer)$(var inner)"/>
+          </group>
+          <log message="$(var inner gone) $(env SCOPED unset)"/>
+          <group forwarding="false">
+            <keep name="given" value="g$(var outer)"/>
+            <log message="$(var outer hidden) $(var given)"/>
+          </group>
+          <group scoped="0"><let name="leak" value="yes"/></group>
+          <log message="$(var leak)"/>
+        </launch>
+        """,
+    )
+    assert logs(plan) == ["oi", "gone unset", "hidden go", "yes"]
+
+
+def test_include_passes_arg_and_let_and_crosses_formats(tmp_path: Path) -> None:
+    write(
+        tmp_path,
+        """
+        launch:
+        - arg: {name: who}
+        - arg: {name: extra, default: none}
+        - log: {message: "included $(var who) $(var extra) from $(filename)"}
+        """,
+        "inner.launch.yaml",
+    )
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <include file="$(dirname)/inner.launch.yaml">
+            <arg name="who" value="me"/>
+            <let name="extra" value="x"/>
+          </include>
+          <log message="after: $(var who)"/>
+        </launch>
+        """,
+    )
+    assert logs(plan) == [f"included me x from {tmp_path}/inner.launch.yaml", "after: me"]
+
+
+def test_executable_every_attribute(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        f"""
+        <launch>
+          <executable cmd="sh -c 'echo $(var word) &quot;two words&quot;' --flag"
+                      cwd="{tmp_path}" name="worker" output="screen" launch-prefix="nice -n 5"
+                      respawn="true" respawn_delay="1.5" respawn_max_retries="3"
+                      sigterm_timeout="2" sigkill_timeout="0.5" emulate_tty="true"
+                      on_exit="shutdown">
+            <env name="ROBOT" value="r$(var word)"/>
+          </executable>
+          <executable cmd="true" shell="true" respawn="on-failure" required="yes"/>
+        </launch>
+        """,
+        word="1",
+    )
+    first, second = plan.processes()
+    assert first.argv == ("nice", "-n", "5", "sh", "-c", 'echo 1 "two words"', "--flag")
+    assert first.label == "worker-1" and first.cwd == str(tmp_path) and first.output == "screen"
+    assert first.respawn.mode == "always" and first.respawn.delay == 1.5
+    assert first.respawn.max_retries == 3
+    assert (first.sigterm_timeout, first.sigkill_timeout) == (2.0, 0.5)
+    assert first.env_changes["ROBOT"] == "r1"
+    assert first.env["RCUTILS_COLORIZED_OUTPUT"] == "1"
+    assert first.required and first.on_exit is not None
+    (shutdown,) = first.on_exit.entities
+    assert isinstance(shutdown, actions.Shutdown) and shutdown.origin.endswith(":2")
+    assert second.shell and second.respawn.mode == "on-failure" and second.required
+    assert second.label == "true-2"
+
+
+def test_cmd_splitting_with_substitutions_and_quotes(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <let name="d" value="/opt/x"/>
+          <executable cmd="echo $(var d)/bin a'$(var d) b'c  &quot;&quot; $(var d)$(var d)"/>
+        </launch>
+        """,
+    )
+    (spec,) = plan.processes()
+    assert spec.argv == ("echo", "/opt/x/bin", "a/opt/x bc", "", "/opt/x/opt/x")
+
+
+def test_environment_tags(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <set_env name="A" value="1"/>
+          <append_env name="P" value="x"/>
+          <append_env name="P" value="y" separator=";"/>
+          <append_env name="P" value="w" prepend="true"/>
+          <unset_env name="KEEP"/>
+          <executable cmd="true"/>
+          <reset_env/>
+          <executable cmd="true"/>
+        </launch>
+        """,
+    )
+    before, after = plan.processes()
+    assert before.env_changes["A"] == "1" and before.env_changes["P"] == "w:x;y"
+    assert before.env_changes["KEEP"] is None
+    assert "A" not in after.env_changes and "KEEP" not in after.env_changes
+
+
+def test_timer_shutdown_and_reset(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <let name="a" value="1"/>
+          <let name="b" value="2"/>
+          <reset><keep name="a" value="$(var a)"/></reset>
+          <log message="$(var a) $(var b none)"/>
+          <timer period="2.5" cancel_on_shutdown="false">
+            <log message="later"/>
+          </timer>
+          <shutdown reason="done here"/>
+          <shutdown/>
+        </launch>
+        """,
+    )
+    assert logs(plan) == ["1 none"]
+    timer = next(s for s in plan.steps if isinstance(s, StartTimer))
+    assert timer.period == 2.5 and not timer.cancel_on_shutdown
+    assert timer.body is not None and isinstance(timer.body.entities[0], actions.LogInfo)
+    reasons = [s.reason for s in plan.steps if isinstance(s, RequestShutdown)]
+    assert reasons == ["done here", "reason not given"]
+
+
+def test_if_and_unless_on_actions(tmp_path: Path) -> None:
+    body = """
+        <launch>
+          <arg name="on" default="true"/>
+          <log message="if" if="$(var on)"/>
+          <log message="unless" unless="$(var on)"/>
+          <group if="$(not $(var on))"><log message="group"/></group>
+          <executable cmd="true" unless="true"/>
+          <timer period="1" if="false"><log message="never"/></timer>
+          <let name="x" value="1" if="1"/>
+          <set_env name="E" value="1" if="0"/>
+        </launch>
+    """
+    plan = plan_of(tmp_path, body)
+    assert logs(plan) == ["if"] and not plan.processes()
+    assert logs(plan_of(tmp_path, body, on="false")) == ["unless", "group"]
+    ld = load(tmp_path, body)
+    assert isinstance(ld.entities[1].condition, IfCondition)
+    assert isinstance(ld.entities[2].condition, UnlessCondition)
+
+
+def test_origins_are_the_tag_lines(tmp_path: Path) -> None:
+    ld = load(
+        tmp_path,
+        """
+        <launch>
+
+          <log
+             message="x"/>
+          <group>
+            <executable cmd="true"/>
+          </group>
+        </launch>
+        """,
+    )
+    log, group = ld.entities
+    assert log.origin == f"{tmp_path}/t.launch.xml:3"
+    assert group.actions[0].origin == f"{tmp_path}/t.launch.xml:6"
+    assert ld.origin == f"{tmp_path}/t.launch.xml:1"
+
+
+# --- typing of attributes --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("text", "value"), [("true", True), ("1", True), ("No", False), ("0", False)]
+)
+def test_bool_attributes_take_yaml_style_words(tmp_path: Path, text: str, value: bool) -> None:
+    (process,) = load(
+        tmp_path, f'<launch><executable cmd="true" shell="{text}"/></launch>'
+    ).entities
+    assert process.shell is value
+
+
+def test_typed_attributes_with_substitutions_are_performed_later(tmp_path: Path) -> None:
+    plan = plan_of(
+        tmp_path,
+        """
+        <launch>
+          <arg name="t" default="3"/>
+          <arg name="r" default="false"/>
+          <executable cmd="true" sigterm_timeout="$(var t)" respawn="$(var r)"
+                      emulate_tty="$(var r)"/>
+          <timer period="$(var t)"><log message="x"/></timer>
+        </launch>
+        """,
+        r="true",
+    )
+    (spec,) = plan.processes()
+    assert spec.sigterm_timeout == 3.0 and spec.respawn.mode == "always"
+    assert next(s for s in plan.steps if isinstance(s, StartTimer)).period == 3.0
+
+
+@pytest.mark.parametrize(
+    ("attrs", "message"),
+    [
+        ('shell="maybe"', "attribute 'shell' is 'maybe', expected a boolean"),
+        ('shell="$(var s)"', "'shell' cannot hold substitutions"),
+        ('sigterm_timeout="soon"', "attribute 'sigterm_timeout' is 'soon', expected a number"),
+        ('respawn_delay="-1"', "attribute 'respawn_delay' is -1.0, must be >= 0"),
+        ('respawn_max_retries="2.5"', "'respawn_max_retries' is '2.5', expected an integer"),
+        ('output="loud"', "output='loud' is not an output mode; valid: log, screen, both"),
+        ('respawn="sometimes"', "respawn='sometimes' is not valid; valid: true, false, always"),
+        ('on_exit="restart"', "on_exit='restart' is not supported; the only value is 'shutdown'"),
+        ('if="yes"', "if='yes' is not a condition value; valid: true, false, 1, 0"),
+        ('if="1" unless="0"', "'if' and 'unless' cannot both be given"),
+    ],
+)
+def test_attribute_value_errors(tmp_path: Path, attrs: str, message: str) -> None:
+    err = error(tmp_path, f'<launch>\n  <executable cmd="true" {attrs}/>\n</launch>\n')
+    assert message in err.message
+    assert err.what == "<executable>"
+    assert err.where is not None and err.where.startswith(f"{tmp_path}/t.launch.xml:2:")
+
+
+# --- strictness: errors with file:line:col ---------------------------------------------------
+
+
+def test_unknown_attribute_names_the_valid_ones(tmp_path: Path) -> None:
+    err = error(tmp_path, '<launch>\n  <executable cmd="true" nmae="x"/>\n</launch>\n')
+    assert err.where == f"{tmp_path}/t.launch.xml:2:32"
+    assert err.what == "<executable>"
+    assert err.message.startswith("unknown attribute 'nmae' (did you mean 'name'?)")
+    assert "valid attributes: name, cwd, launch-prefix, output, shell" in err.message
+    assert str(err).startswith(f"{tmp_path}/t.launch.xml:2:32: <executable>: unknown attribute")
+
+
+def test_unknown_tag_with_did_you_mean(tmp_path: Path) -> None:
+    err = error(tmp_path, '<launch>\n  <group>\n    <exectuable cmd="x"/>\n  </group>\n</launch>')
+    assert err.where == f"{tmp_path}/t.launch.xml:3:5"
+    assert "unknown tag 'exectuable' (did you mean 'executable'?)" in err.message
+    assert "valid tags: append_env, arg, executable" in err.message
+
+
+@pytest.mark.parametrize(
+    ("body", "where", "message"),
+    [
+        ("<launch>\n<log/>\n</launch>", "2:1", "missing required attribute 'message'"),
+        ('<launch>\n<log mesage="x"/>\n</launch>', "2:1", "'message' (found 'mesage': a typo?)"),
+        ("<launch>\n<param name='a' value='1'/>\n</launch>", "2:1", "use set_parameter"),
+        ("<launch>\n<node_container/>\n</launch>", "2:1", "not supported by mlaunch"),
+        ("<launch>\n<rosparam/>\n</launch>", "2:1", "that is ROS 1"),
+        ("<ros>\n</ros>", "1:1", "the root must be 'launch', not 'ros'"),
+        ("<launch>\n<log message='x'>hello</log>\n</launch>", "2:18", "unexpected text 'hello'"),
+        ("<launch>\n<log message='x'/>\n", "3:1", "malformed XML: no element found"),
+        ("<launch>\n<log message='x' message='y'/>\n</launch>", "2:18", "duplicate attribute"),
+        ("<launch>\n  <log message='x'>\n</launch>", "3:3", "malformed XML: mismatched tag"),
+        (
+            "<launch>\n<executable cmd='true'>\n  <remap from='a' to='b'/>\n</executable>\n</launch>",
+            "3:3",
+            "unexpected tag inside <executable>; valid children: <env>",
+        ),
+        (
+            "<launch>\n<executable cmd='true'>\n  <env name='A'/>\n</executable>\n</launch>",
+            "3:3",
+            "missing required attribute 'value'",
+        ),
+        (
+            '<launch>\n<executable cmd="echo \'open"/>\n</launch>',
+            "2:18",
+            "attribute 'cmd': the quote ' is not closed",
+        ),
+        ("<launch>\n<arg name='$(var x)'/>\n</launch>", "2:12", "must be plain text"),
+        ("<launch>\n<timer><log message='x'/></timer>\n</launch>", "2:1", "'period'"),
+        ("<launch>\n<include file='x.py'><arg name='a'/></include>\n</launch>", "2:22", "'value'"),
+    ],
+)
+def test_errors_are_located(tmp_path: Path, body: str, where: str, message: str) -> None:
+    err = error(tmp_path, body)
+    assert message in err.message, err.message
+    assert err.where == f"{tmp_path}/t.launch.xml:{where}"
+    assert "\n" not in str(err)
+
+
+def test_included_file_errors_name_the_included_file(tmp_path: Path) -> None:
+    write(tmp_path, "<launch>\n  <lgo message='x'/>\n</launch>\n", "bad.launch.xml")
+    path = write(tmp_path, '<launch><include file="$(dirname)/bad.launch.xml"/></launch>')
+    with pytest.raises(MlaunchError) as caught:
+        resolve(frontends.load(str(path)), path=str(path), arguments={}, environ=ENV, options=None)
+    assert caught.value.where == f"{tmp_path}/bad.launch.xml:2:3"
+    assert "did you mean 'log'?" in str(caught.value)
+
+
+def test_schema_attributes_on_the_root_are_ignored(tmp_path: Path) -> None:
+    ld = load(
+        tmp_path,
+        """
+        <launch xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
+                xsi:noNamespaceSchemaLocation="launch.xsd" deprecated="use other.launch.xml">
+          <log message="x"/>
+        </launch>
+        """,
+    )
+    assert ld.deprecated_reason == "use other.launch.xml"
