@@ -141,6 +141,12 @@ class Entity:
         attr = self._take(name, required)
         if attr is None:
             return None
+        if self.yaml_native(attr, (_YAML_BOOL,)) is not None:
+            raise self.error(
+                f"attribute {name!r} is {attr.value.value!r}, which YAML reads as a boolean;"
+                " quote it to mean the text",
+                attr,
+            )
         text = self.scalar_text(attr, name)
         if "$(" in text:
             raise self.error(
@@ -227,7 +233,7 @@ class Entity:
         for name, attr in self.attrs.items():
             if name not in self._used:
                 raise self.error(self._unknown_attribute(name), attr)
-        if self.children and not self._actions_read:
+        if self.children is not None and not self._actions_read:
             if self.fmt == "yaml":
                 raise self.error(f"{self.tag} takes no child entities")
             for child in self.children:

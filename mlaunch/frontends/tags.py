@@ -48,6 +48,8 @@ def build_action(e: Entity) -> Any:
     builder = ACTIONS.get(e.tag)
     if builder is None:
         raise e.error(_unknown_tag(e.tag))
+    if e.fmt == "yaml" and e.children is not None and e.tag not in TAKES_ACTIONS:
+        raise e.error(f"{e.tag} takes no child entities (only {', '.join(TAKES_ACTIONS)} do)")
     when = e.condition_text("if")
     unless = e.condition_text("unless")
     if when is not None and unless is not None:
@@ -714,6 +716,9 @@ ACTIONS: dict[str, Builder] = {
     "set_parameters_from_file": _set_parameters_from_file,
     "set_remap": _set_remap,
 }
+
+# The tags whose children are actions.
+TAKES_ACTIONS = ("group", "timer")
 
 # ROS 2 tags mlaunch knows but does not implement, with what to do instead.
 UNSUPPORTED: dict[str, str] = {
