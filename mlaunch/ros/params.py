@@ -1,0 +1,334 @@
+"""Node parameters evaluated exactly as launch_ros does, and the params files written for them.
+
+``Node(parameters=[...])`` takes, in order, dicts (each becomes one temporary params file),
+params-file paths or ``ParameterFile`` (passed with ``--params-file``) and ``Parameter``
+descriptions (passed with ``-p name:=value``). The typing rules of a dict value:
+
+- ``bool``, ``int``, ``float``, ``bytes`` and plain ``str`` keep their Python type;
+- a substitution (or a list of text and substitutions, which concatenates) is performed and the
+  text read with YAML (``'true'`` -> bool, ``'1.0'`` -> float, ``''`` -> empty string);
+  anything YAML reads as a map or null is an error that suggests ``ParameterValue(...,
+  value_type=str)``;
+- a list must be uniform: all ints, all bools, all text, or ints and floats (-> floats); a list
+  mixing text with substitutions is one concatenated string unless each item is its own list;
+- ``ParameterValue`` forces its type;
+- nested dicts are flattened to dotted names (``{'a': {'b': 1}}`` -> ``a.b: 1``).
+
+A file is ``{<key>: {ros__parameters: {...}}}`` dumped by ``yaml.dump(default_flow_style=
+False)`` (sorted keys), where the key is the node's full name when both its name and namespace
+are known, else ``/**``. Deliberate difference: lists are written as YAML lists, where launch_ros
+writes Python tuples (``!!python/tuple``, which only rcl's lenient parser accepts).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import yaml
+
+from mlaunch.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.ros.parameter_descriptions import (
+    Parameter,
+    ParameterFile,
+    ParameterValue,
+    is_substitution,
+)
+from mlaunch.substitutions import (
+    Substitution,
+    TextSubstitution,
+    describe,
+    normalize,
+    perform_substitutions,
+)
+
+if TYPE_CHECKING:
+    from mlaunch.context import LaunchContext
+
+Subs = tuple[Substitution, ...]
+PARAMS_FILE_PREFIX = "launch_params_"
+_HINT = (
+    "; if the parameter is meant to be a string, wrap it in"
+    " launch_ros.parameter_descriptions.ParameterValue(value, value_type=str)"
+)
+
+
+# --- normalized values (built with the Node, performed when it is resolved) ---------------------
+
+
+@dataclass(frozen=True)
+class Plain:
+    """A value that is already typed (bool, int, float, bytes, str, or a uniform tuple)."""
+
+    value: Any
+
+
+@dataclass(frozen=True)
+class Text:
+    """Substitutions performed to one string, then read with YAML."""
+
+    subs: Subs
+
+
+@dataclass(frozen=True)
+class Items:
+    """A list whose items are typed values or substitutions, each read with YAML."""
+
+    items: tuple[Any, ...]  # scalars, or Subs tuples
+
+
+NormalizedValue = Plain | Text | Items | ParameterValue
+NormalizedDict = dict[Subs, NormalizedValue]
+NormalizedEntry = NormalizedDict | ParameterFile | Parameter
+
+
+def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
+    """``Node(parameters=...)`` checked and normalized when the Node is built."""
+    if isinstance(parameters, (str, Mapping)) or not isinstance(parameters, Sequence):
+        raise LaunchFileError(
+            f"parameters must be a list of dicts, params-file paths and Parameter entries,"
+            f" got {type(parameters).__name__}: {parameters!r:.120}"
+        )
+    out: list[NormalizedEntry] = []
+    for entry in parameters:
+        if isinstance(entry, Mapping):
+            out.append(normalize_dict(entry))
+        elif isinstance(entry, (Parameter, ParameterFile)):
+            out.append(entry)
+        elif isinstance(entry, (str, Path, Substitution)) or is_substitution(entry):
+            out.append(ParameterFile(entry))
+        else:
+            raise LaunchFileError(
+                f"a parameters entry must be a dict, a params-file path or a Parameter, got"
+                f" {type(entry).__name__}: {entry!r:.120}"
+            )
+    return tuple(out)
+
+
+def normalize_dict(params: Mapping[Any, Any], prefix: Subs | None = None) -> NormalizedDict:
+    """Names become substitution tuples (nested dicts joined with '.'), values normalized."""
+    out: NormalizedDict = {}
+    for raw_name, value in params.items():
+        name = normalize(raw_name)
+        if prefix:
+            name = (*prefix, TextSubstitution(text="."), *name)
+        if isinstance(value, Mapping):
+            out.update(normalize_dict(value, name))
+        else:
+            out[name] = normalize_value(value, name)
+    return out
+
+
+def normalize_value(value: Any, name: Subs = ()) -> NormalizedValue:
+    if isinstance(value, ParameterValue):
+        return value
+    if isinstance(value, (bool, int, float, bytes, str)):
+        return Plain(value)
+    if isinstance(value, Path):
+        return Plain(str(value))
+    if isinstance(value, Substitution):
+        return Text((value,))
+    if isinstance(value, Sequence):
+        return _normalize_list(value, name)
+    raise LaunchFileError(
+        f"parameter {describe(name)}: a value must be a scalar, a substitution, a list or a dict,"
+        f" got {type(value).__name__}: {value!r:.120}"
+    )
+
+
+def _normalize_list(value: Sequence[Any], name: Subs) -> NormalizedValue:
+    kinds = {_kind(item, name) for item in value}
+    if kinds == {int}:
+        return Plain(tuple(int(v) for v in value))
+    if kinds in ({float}, {int, float}):
+        return Plain(tuple(float(v) for v in value))
+    if Substitution in kinds and kinds <= {str, Substitution}:
+        return Text(normalize(value))  # text and substitutions concatenate into one string
+    if kinds == {bool}:
+        return Plain(tuple(bool(v) for v in value))
+    # Each item on its own (text, numbers, lists of substitutions): read each with YAML later.
+    return Items(tuple(normalize(v) if _kind(v, name) is tuple else v for v in value))
+
+
+def _kind(item: Any, name: Subs) -> type:
+    if isinstance(item, Substitution):
+        return Substitution
+    if isinstance(item, (str, bool, int, float)):
+        return type(item)
+    if isinstance(item, (list, tuple)) and all(isinstance(i, (str, Substitution)) for i in item):
+        return tuple
+    raise LaunchFileError(
+        f"parameter {describe(name)}: list item {item!r:.80} is not a scalar, a substitution or a"
+        " list of substitutions"
+    )
+
+
+# --- evaluation -----------------------------------------------------------------------------
+
+
+def evaluate_dict(context: LaunchContext, params: NormalizedDict) -> dict[str, Any]:
+    """Names performed, values typed: the dict written to a params file."""
+    out: dict[str, Any] = {}
+    for raw_name, value in params.items():
+        name = perform_substitutions(context, raw_name)
+        try:
+            out[name] = evaluate_value(context, value, name)
+        except SubstitutionFailure as e:
+            if not e.message.startswith("parameter "):
+                e.message = f"parameter {name!r}: {e.message}"
+                e.args = (e.message,)
+            raise
+    return out
+
+
+def evaluate_value(context: LaunchContext, value: NormalizedValue, name: str) -> Any:
+    if isinstance(value, Plain):
+        return value.value
+    if isinstance(value, ParameterValue):
+        return value.evaluate(context)
+    if isinstance(value, Text):
+        return _typed_text(perform_substitutions(context, value.subs), name)
+    items = [
+        _yaml(perform_substitutions(context, v), name) if isinstance(v, tuple) else v
+        for v in value.items
+    ]
+    return _uniform(items, name)
+
+
+def _typed_text(text: str, name: str) -> Any:
+    """launch_ros's rule for a performed value: YAML, and only a scalar or a uniform list."""
+    loaded = _yaml(text if text else "''", name)
+    if type(loaded) in (bool, int, float, str, bytes):
+        return loaded
+    if isinstance(loaded, list):
+        return _uniform(loaded, name)
+    raise SubstitutionFailure(
+        f"parameter {name!r} is {text[:120]!r}, which YAML reads as"
+        f" {type(loaded).__name__}: allowed are bool, int, float, str and uniform lists{_HINT}"
+    )
+
+
+def _yaml(text: str, name: str) -> Any:
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        first = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise SubstitutionFailure(
+            f"parameter {name!r}: cannot read {text[:120]!r} as YAML ({first}){_HINT}"
+        )
+
+
+def _uniform(items: Sequence[Any], name: str) -> tuple[Any, ...]:
+    """A non-empty list of one type among bool, int, float, str (launch_ros's check)."""
+    if items and type(items[0]) in (bool, int, float, str):
+        first = type(items[0])
+        if all(isinstance(i, first) for i in items):
+            return tuple(items)
+    kinds = ", ".join(sorted({type(i).__name__ for i in items})) or "nothing"
+    raise SubstitutionFailure(
+        f"parameter {name!r} is the list {list(items)!r:.160} of {kinds}: a list parameter must"
+        " be non-empty and of one type (bool, int, float or str)"
+    )
+
+
+@dataclass(frozen=True)
+class ParamsArgument:
+    """One params argument of a node, in order: a file (``--params-file``) or a rule (``-p``)."""
+
+    flag: str  # "--params-file" or "-p"
+    value: str
+    written: bool = False  # a file mlaunch wrote (to clean up), not one the user gave
+
+
+def parameter_arguments(
+    context: LaunchContext,
+    entries: Sequence[NormalizedEntry],
+    *,
+    node_key: str,
+    temp_dir: str | None,
+    warn: Any,
+) -> list[ParamsArgument]:
+    """The node's own parameters as arguments: one file per dict, files, ``-p`` rules.
+
+    A params file that does not exist is skipped with a warning (``warn(message)``), as in ROS 2.
+    """
+    out: list[ParamsArgument] = []
+    for entry in entries:
+        if isinstance(entry, Parameter):
+            name, value = entry.evaluate(context)
+            out.append(ParamsArgument("-p", parameter_rule(name, value)))
+        elif isinstance(entry, ParameterFile):
+            path = str(entry.evaluate(context, temp_dir))
+            if not os.path.isfile(path):
+                warn(f"Parameter file path is not a file: {path} (skipped)")
+                continue
+            out.append(ParamsArgument("--params-file", path, written=entry.created))
+        else:
+            path = write_params_file(node_key, evaluate_dict(context, entry), temp_dir)
+            out.append(ParamsArgument("--params-file", path, written=True))
+    return out
+
+
+def parameter_rule(name: str, value: Any) -> str:
+    """``name:=value`` for ``-p``, the value dumped by YAML as launch_ros does (``...`` and all)."""
+    return f"{name}:={yaml.dump(_plain(value))}"
+
+
+def global_parameter_rule(name: str, value: Any) -> str:
+    """``name:=value`` for a SetParameter global: Python's str() as launch_ros (``True``).
+
+    Deliberate difference: a list is written as a YAML flow list (``[1, 2]``); launch_ros
+    writes the tuple's str() ``(1, 2)``, which the node reads as a string.
+    """
+    if isinstance(value, (list, tuple)):
+        text = yaml.safe_dump(_plain(value), default_flow_style=True, width=2**31).strip()
+        return f"{name}:={text}"
+    return f"{name}:={value}"
+
+
+# --- params files -------------------------------------------------------------------------------
+
+
+def params_file_text(node_key: str, params: Mapping[str, Any]) -> str:
+    """The YAML of one params file, exactly as launch_ros dumps it (keys sorted, block style)."""
+    document = {node_key: {"ros__parameters": _plain(dict(params))}}
+    return yaml.dump(document, default_flow_style=False)
+
+
+def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | None) -> str:
+    """Write one params file (``launch_params_XXXXXXXX``) in ``temp_dir``; return its path."""
+    with tempfile.NamedTemporaryFile(
+        mode="w", prefix=PARAMS_FILE_PREFIX, dir=temp_dir, delete=False, encoding="utf-8"
+    ) as f:
+        f.write(params_file_text(node_key, params))
+        return f.name
+
+
+def _plain(value: Any) -> Any:
+    """Tuples as lists, so the file is plain YAML any reader accepts."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+__all__ = [
+    "Items",
+    "ParamsArgument",
+    "Plain",
+    "Text",
+    "evaluate_dict",
+    "evaluate_value",
+    "global_parameter_rule",
+    "normalize_dict",
+    "normalize_parameters",
+    "parameter_arguments",
+    "parameter_rule",
+    "params_file_text",
+    "write_params_file",
+]
