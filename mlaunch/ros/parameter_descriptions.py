@@ -291,6 +291,7 @@ class ParameterFile:
         else:
             self._allow_substs = normalize_typed(allow_substs, bool)
         self._evaluated: Path | None = None
+        self.created = False  # evaluate() wrote a substituted copy
 
     @property
     def param_file(self) -> Any:
@@ -303,7 +304,8 @@ class ParameterFile:
     def evaluate(self, context: LaunchContext, temp_dir: str | None = None) -> Path:
         """The file to pass: the file itself, or its substituted copy in ``temp_dir``."""
         path = Path(perform_substitutions(context, self._param_file))
-        if perform_typed(context, self._allow_substs, bool):
+        self.created = bool(perform_typed(context, self._allow_substs, bool))
+        if self.created:
             path = Path(substituted_copy(context, path, temp_dir))
         self._evaluated = path
         return path

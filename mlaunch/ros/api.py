@@ -1,0 +1,76 @@
+"""The top-level ``launch_ros`` namespace (and ``launch_ros.utilities``) inside mlaunch.
+
+``import launch_ros`` then ``launch_ros.actions.Node(...)`` works as with ROS 2: the submodules
+load on first attribute access, so ``import launch_ros`` alone stays cheap.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from mlaunch.ros.actions import make_namespace_absolute, prefix_namespace
+from mlaunch.ros.params import evaluate_dict as evaluate_parameter_dict
+from mlaunch.ros.params import normalize_dict as normalize_parameter_dict
+from mlaunch.ros.params import normalize_parameters
+
+_SUBMODULES = {
+    "actions": "mlaunch.ros.actions",
+    "substitutions": "mlaunch.ros.substitutions",
+    "parameter_descriptions": "mlaunch.ros.parameter_descriptions",
+    "descriptions": "mlaunch.ros.parameter_descriptions",
+    "events": "mlaunch.ros.events",
+    "event_handlers": "mlaunch.ros.events",
+    "utilities": "mlaunch.ros.api",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _SUBMODULES:
+        return importlib.import_module(_SUBMODULES[name])
+    raise AttributeError(f"module 'launch_ros' (mlaunch) has no attribute {name!r}")
+
+
+def get_default_launch_description(*, prefix_output_with_name: bool = False) -> Any:
+    """launch_ros's default description adds ROS logging setup; mlaunch needs none of it."""
+    from mlaunch.actions import LaunchDescription
+
+    return LaunchDescription([])
+
+
+def is_namespace_absolute(ns: str) -> bool:
+    return ns.startswith("/")
+
+
+def is_root_namespace(ns: str) -> bool:
+    return ns == "/"
+
+
+def evaluate_parameters(context: Any, parameters: Any) -> list[Any]:
+    """launch_ros.utilities.evaluate_parameters: dicts evaluated, files as paths, Parameters."""
+    from pathlib import Path
+
+    from mlaunch.ros.parameter_descriptions import ParameterFile
+
+    out: list[Any] = []
+    for entry in parameters:
+        if isinstance(entry, dict):
+            out.append(evaluate_parameter_dict(context, entry))
+        elif isinstance(entry, ParameterFile):
+            out.append(Path(entry.evaluate(context)))
+        else:
+            out.append(entry)
+    return out
+
+
+__all__ = [
+    "evaluate_parameter_dict",
+    "evaluate_parameters",
+    "get_default_launch_description",
+    "is_namespace_absolute",
+    "is_root_namespace",
+    "make_namespace_absolute",
+    "normalize_parameter_dict",
+    "normalize_parameters",
+    "prefix_namespace",
+]
