@@ -1,0 +1,31 @@
+"""Includes across formats: Python includes YAML (which includes Python, which includes XML)
+and Python directly. Run: mlaunch launches/examples/include.launch.py robot:=r2
+"""
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription, LogInfo
+from launch.launch_description_sources import (
+    PythonLaunchDescriptionSource,
+    YAMLLaunchDescriptionSource,
+)
+from launch.substitutions import LaunchConfiguration, PathJoinSubstitution, ThisLaunchFileDir
+
+
+def generate_launch_description():
+    robot = LaunchConfiguration("robot")
+    parts = PathJoinSubstitution([ThisLaunchFileDir(), "parts"])
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument("robot", default_value="scout"),
+            IncludeLaunchDescription(
+                YAMLLaunchDescriptionSource(parts / "sensors.launch.yaml"),
+                launch_arguments=[("camera", "front"), ("robot", robot)],
+            ),
+            # Includes are not scoped (as in ROS 2): the included file's let is visible here.
+            LogInfo(msg=[robot, " has ", LaunchConfiguration("sensor_count"), " sensor(s)"]),
+            IncludeLaunchDescription(
+                PythonLaunchDescriptionSource(parts / "driver.launch.py"),
+                launch_arguments={"port": "/dev/ttyACM0"}.items(),
+            ),
+        ]
+    )
