@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import textwrap
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -416,3 +417,230 @@ def test_schema_attributes_on_the_root_are_ignored(tmp_path: Path) -> None:
         """,
     )
     assert ld.deprecated_reason == "use other.launch.xml"
+
+
+# --- launch_ros tags -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def ros_plan(tmp_path: Path) -> object:
+    """Resolve XML text against a fake install prefix holding package 'demo' (talker, listener)."""
+    prefix = tmp_path / "prefix"
+    (prefix / "share" / "ament_index" / "resource_index" / "packages").mkdir(parents=True)
+    (prefix / "share" / "ament_index" / "resource_index" / "packages" / "demo").touch()
+    (prefix / "share" / "demo").mkdir()
+    (prefix / "share" / "demo" / "params.yaml").write_text("/**:\n  ros__parameters: {a: 1}\n")
+    lib = prefix / "lib" / "demo"
+    lib.mkdir(parents=True)
+    for exe in ("talker", "listener"):
+        (lib / exe).write_text("#!/bin/sh\n")
+        (lib / exe).chmod(0o755)
+    temp = tmp_path / "run"
+    temp.mkdir()
+
+    def run(body: str, **args: str) -> Plan:
+        path = write(tmp_path, body)
+        env = {**ENV, "AMENT_PREFIX_PATH": str(prefix)}
+        options = ResolveOptions(temp_dir=str(temp), standins=False)
+        return resolve(
+            frontends.load(str(path)), path=str(path), arguments=args, environ=env, options=options
+        )
+
+    run.prefix = prefix  # type: ignore[attr-defined]
+    return run
+
+
+def params_of(argv: tuple[str, ...]) -> list[str]:
+    """The content of each --params-file, in order."""
+    return [Path(argv[i + 1]).read_text() for i, a in enumerate(argv) if a == "--params-file"]
+
+
+def test_node_command_line_and_children(ros_plan: Any) -> None:
+    plan = ros_plan(
+        """
+        <launch>
+          <arg name="ns" default="r1"/>
+          <push-ros-namespace namespace="$(var ns)"/>
+          <node pkg="demo" exec="talker" name="talker" namespace="sub" exec_name="speaker"
+                args="--count 3 'two words'" ros_args="--log-level debug" output="screen"
+                respawn="true" respawn_delay="1" sigterm_timeout="2">
+            <param name="rate" value="10.5"/>
+            <param from="$(find-pkg-share demo)/params.yaml"/>
+            <remap from="chatter" to="chat"/>
+            <env name="MODE" value="x"/>
+          </node>
+        </launch>
+        """
+    )
+    (spec,) = plan.processes()
+    exe = str(ros_plan.prefix / "lib" / "demo" / "talker")
+    share = ros_plan.prefix / "share" / "demo"
+    assert spec.argv[:4] == (exe, "--count", "3", "two words")
+    assert spec.argv[4:7] == ("--ros-args", "--log-level", "debug")
+    assert spec.argv[7:12] == ("--ros-args", "-r", "__node:=talker", "-r", "__ns:=/r1/sub")
+    assert spec.argv[-4:] == ("--params-file", f"{share}/params.yaml", "-r", "chatter:=chat")
+    assert params_of(spec.argv)[0] == "/r1/sub/talker:\n  ros__parameters:\n    rate: 10.5\n"
+    assert spec.label == "speaker-1" and spec.output == "screen"
+    assert spec.respawn.delay == 1.0 and spec.sigterm_timeout == 2.0
+    assert spec.env_changes["MODE"] == "x"
+    assert spec.node is not None and spec.node.fully_qualified_name == "/r1/sub/talker"
+
+
+def test_global_ros_tags_both_namespace_spellings_and_scopes(ros_plan: Any) -> None:
+    plan = ros_plan(
+        """
+        <launch>
+          <group>
+            <push_ros_namespace namespace="a"/>
+            <push-ros-namespace namespace="b"/>
+            <set_parameter name="use_sim_time" value="true"/>
+            <set_parameter name="level" value="3"/>
+            <set_parameters_from_file filename="$(find-pkg-share demo)/params.yaml"/>
+            <set_remap from="/tf" to="tf"/>
+            <node pkg="demo" exec="listener"/>
+          </group>
+          <node pkg="demo" exec="listener" name="plain"/>
+        </launch>
+        """
+    )
+    inner, outer = plan.processes()
+    share = ros_plan.prefix / "share" / "demo"
+    assert inner.argv[1:] == (
+        "--ros-args", "-r", "__ns:=/a/b", "-p", "use_sim_time:=True", "-p", "level:=3",
+        "--params-file", f"{share}/params.yaml", "-r", "/tf:=tf",
+    )  # fmt: skip
+    assert outer.argv[1:] == ("--ros-args", "-r", "__node:=plain")
+
+
+def test_lifecycle_node_needs_name_and_namespace(ros_plan: Any, tmp_path: Path) -> None:
+    plan = ros_plan(
+        '<launch><lifecycle_node pkg="demo" exec="talker" name="lc" namespace="/"'
+        ' autostart="true"/></launch>'
+    )
+    (spec,) = plan.processes()
+    assert spec.node is not None and spec.node.lifecycle and spec.node.autostart
+    err = error(
+        tmp_path, '<launch>\n<lifecycle_node pkg="demo" exec="talker" name="lc"/>\n</launch>'
+    )
+    assert err.where == f"{tmp_path}/t.launch.xml:2:1"
+    assert "missing required attribute 'namespace'" in err.message
+
+
+@pytest.mark.parametrize(
+    ("param", "content"),
+    [
+        ('name="p" value="7"', "p: 7"),
+        ('name="p" value="7.0"', "p: 7.0"),
+        ('name="p" value="True"', "p: true"),
+        ('name="p" value="text"', "p: text"),
+        ('name="p" value="[1, 2]"', "p:\n    - 1\n    - 2"),
+        ('name="p" value="7" type="str"', "p: '7'"),
+        ('name="p" value="true" type="str"', "p: 'true'"),
+        ('name="p" value="3" type="float"', "p: 3.0"),
+        ('name="p" value="yes" type="bool"', "p: true"),
+        ('name="p" value="0" type="bool"', "p: false"),
+        ('name="p" value="[1, 2]" type="list_of_float"', "p:\n    - 1.0\n    - 2.0"),
+        ('name="p" value="1;2" value-sep=";" type="list_of_int"', "p:\n    - 1\n    - 2"),
+        ('name="p" value="a,b" value-sep=","', "p:\n    - a\n    - b"),
+        ('name="p" value="1,2" value-sep="," type="list_of_str"', "p:\n    - '1'\n    - '2'"),
+        ('name="p" value="$(var x)"', "p: 42"),
+        ('name="p" value="$(var x)" type="str"', "p: '42'"),
+        ('name="p" value="$(var x),1" value-sep=","', "p:\n    - 42\n    - 1"),
+        ('name="p" value="{a: 1}" type="yaml"', "p: '{a: 1}'"),
+    ],
+)
+def test_param_typing(ros_plan: Any, param: str, content: str) -> None:
+    plan = ros_plan(
+        f'<launch><node pkg="demo" exec="talker"><param {param}/></node></launch>', x="42"
+    )
+    (spec,) = plan.processes()
+    assert params_of(spec.argv) == [f"/**:\n  ros__parameters:\n    {content}\n"]
+
+
+def test_nested_params_are_dotted_names(ros_plan: Any) -> None:
+    plan = ros_plan(
+        """
+        <launch>
+          <node pkg="demo" exec="talker">
+            <param name="arm">
+              <param name="joints" value="[j1, j2]"/>
+              <param name="limits"><param name="speed" value="0.5"/></param>
+            </param>
+            <param name="b" value="1"/>
+          </node>
+        </launch>
+        """
+    )
+    (spec,) = plan.processes()
+    assert params_of(spec.argv) == [
+        "/**:\n  ros__parameters:\n    arm.joints:\n    - j1\n    - j2\n    arm.limits.speed: 0.5\n",
+        "/**:\n  ros__parameters:\n    b: 1\n",
+    ]
+
+
+def test_param_from_file_with_allow_substs(ros_plan: Any, tmp_path: Path) -> None:
+    source = tmp_path / "subst.yaml"
+    source.write_text("/**:\n  ros__parameters:\n    robot: $(var robot)\n")
+    plan = ros_plan(
+        f'<launch><node pkg="demo" exec="talker"><param from="{source}" allow_substs="true"/>'
+        "</node></launch>",
+        robot="r9",
+    )
+    (spec,) = plan.processes()
+    assert params_of(spec.argv) == ["/**:\n  ros__parameters:\n    robot: r9\n"]
+
+
+@pytest.mark.parametrize(
+    ("param", "message"),
+    [
+        ('name="p" value="x" type="integer"', "type='integer' is not a parameter type; valid: str"),
+        ('name="p" value="abc" type="int"', "parameter value 'abc' is not of type int"),
+        ('name="p" value="2.5" type="int"', "parameter value '2.5' is not of type int"),
+        ('name="p" value="maybe" type="bool"', "parameter value 'maybe' is not of type bool"),
+        ('name="p" value="1" type="list_of_int"', "is not a list; write [a, b] or split it"),
+        ('name="p" value="1,a" value-sep=","', "must hold one type, this one mixes int, str"),
+        ('name="p" value="1" value-sep=""', "value-sep is empty"),
+        ('name="p"', "param 'p' needs 'value' (or nested params)"),
+        ('value="1"', "a param needs 'name'"),
+        ('name="p" from="x.yaml"', "'from' and 'name' cannot both be given"),
+        ('name="p" value="1" allow_substs="true"', "'allow_substs' is only valid with 'from'"),
+        ('name="p" value="1" vlaue="2"', "unknown attribute 'vlaue' (did you mean 'value'?)"),
+    ],
+)
+def test_param_errors(tmp_path: Path, param: str, message: str) -> None:
+    err = error(
+        tmp_path,
+        f'<launch>\n<node pkg="demo" exec="talker">\n  <param {param}/>\n</node>\n</launch>',
+    )
+    assert message in err.message
+    assert err.where is not None and err.where.startswith(f"{tmp_path}/t.launch.xml:3:")
+    assert err.what == "<param>"
+
+
+def test_nested_param_errors(tmp_path: Path) -> None:
+    err = error(
+        tmp_path,
+        '<launch>\n<node pkg="demo" exec="talker">\n  <param name="a" value="1">\n'
+        '    <param name="b" value="2"/>\n  </param>\n</node>\n</launch>',
+    )
+    assert "a param with nested params cannot have 'value'" in err.message
+    assert err.where is not None and err.where.startswith(f"{tmp_path}/t.launch.xml:3:")
+
+
+@pytest.mark.parametrize(
+    ("tag", "message"),
+    [
+        ('<node exec="talker" cmd="x"/>', "unknown attribute 'cmd'"),
+        ('<node pkg="demo"/>', "missing required attribute 'exec'"),
+        ('<node pkg="demo" exe="talker"/>', "missing required attribute 'exec' (found 'exe'"),
+        ('<node exec="x"><choice value="a"/></node>', "valid children: <env>, <param>, <remap>"),
+        ('<set_remap from="a"/>', "missing required attribute 'to'"),
+        ('<set_parameters_from_file file="x"/>', "missing required attribute 'filename'"),
+        ('<push_ros_namespace ns="x"/>', "missing required attribute 'namespace'"),
+        ('<node exec="x"><remap from="a" to="b" if="1"/></node>', "unknown attribute 'if'"),
+    ],
+)
+def test_ros_tag_errors(tmp_path: Path, tag: str, message: str) -> None:
+    err = error(tmp_path, f"<launch>\n  {tag}\n</launch>")
+    assert message in err.message
+    assert err.where is not None and err.where.startswith(f"{tmp_path}/t.launch.xml:2:")

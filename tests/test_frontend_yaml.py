@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import textwrap
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -303,3 +304,105 @@ def test_a_yaml_file_without_nodes_does_not_import_the_ros_layer(tmp_path: Path)
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     ).stdout
     assert out.strip() == "[]"
+
+
+# --- launch_ros tags -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def ros_plan(tmp_path: Path) -> Any:
+    """Resolve YAML text against a fake install prefix holding package 'demo' (talker)."""
+    prefix = tmp_path / "prefix"
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "demo").touch()
+    lib = prefix / "lib" / "demo"
+    lib.mkdir(parents=True)
+    (lib / "talker").write_text("#!/bin/sh\n")
+    (lib / "talker").chmod(0o755)
+    temp = tmp_path / "run"
+    temp.mkdir()
+
+    def run(body: str, **args: str) -> Plan:
+        path = write(tmp_path, body)
+        env = {**ENV, "AMENT_PREFIX_PATH": str(prefix)}
+        options = ResolveOptions(temp_dir=str(temp), standins=False)
+        return resolve(
+            frontends.load(str(path)), path=str(path), arguments=args, environ=env, options=options
+        )
+
+    return run
+
+
+def params_of(argv: tuple[str, ...]) -> list[str]:
+    return [Path(argv[i + 1]).read_text() for i, a in enumerate(argv) if a == "--params-file"]
+
+
+def test_node_params_keep_their_yaml_types(ros_plan: Any) -> None:
+    plan = ros_plan(
+        """
+        launch:
+        - push-ros-namespace: {namespace: team}
+        - set_parameter: {name: level, value: 3}
+        - set_parameter: {name: flag, value: true}
+        - node:
+            pkg: demo
+            exec: talker
+            name: t
+            param:
+            - {name: i, value: 10}
+            - {name: s, value: "10"}
+            - {name: forced, value: 10, type: str}
+            - {name: l, value: [1, 2.5]}
+            - {name: names, value: [a, "$(var who)"]}
+            - name: nested
+              param:
+              - {name: deep, value: off}
+            remap:
+            - {from: a, to: b}
+        """,
+        who="me",
+    )
+    (spec,) = plan.processes()
+    assert spec.argv[1:8] == (
+        "--ros-args", "-r", "__node:=t", "-r", "__ns:=/team", "-p", "level:=3",
+    )  # fmt: skip
+    assert spec.argv[8:10] == ("-p", "flag:=True") and spec.argv[-2:] == ("-r", "a:=b")
+    head = "/team/t:\n  ros__parameters:\n    "
+    assert params_of(spec.argv) == [
+        head + "i: 10\n",
+        head + "s: 10\n",  # a text value is read with YAML, as launch_ros does
+        head + "forced: '10'\n",
+        head + "l:\n    - 1.0\n    - 2.5\n",
+        head + "names:\n    - a\n    - me\n",
+        head + "nested.deep: false\n",
+    ]
+
+
+def test_lifecycle_node_in_yaml(ros_plan: Any) -> None:
+    plan = ros_plan(
+        "launch:\n- lifecycle_node: {pkg: demo, exec: talker, name: lc, namespace: ns}\n"
+    )
+    (spec,) = plan.processes()
+    assert spec.node is not None and spec.node.lifecycle and not spec.node.autostart
+
+
+@pytest.mark.parametrize(
+    ("param", "where", "message"),
+    [
+        ("{name: p, value: {a: 1}}", "4:30", "a parameter value cannot be a map"),
+        ("{name: p, value: }", "4:30", "the parameter value is empty (null)"),
+        ("{name: p, value: [1, a]}", "4:30", "must hold one type, this one mixes int, str"),
+        ("{name: p, value: [[1]]}", "4:30", "a list parameter holds plain values"),
+        ("{name: p, value: abc, type: int}", "4:30", "parameter value 'abc' is not of type int"),
+        ("{name: p, value: 1, type: list_of_int}", "4:30", "is not a list"),
+        ("{name: p, from: x.yaml}", "4:20", "'from' and 'name' cannot both be given"),
+        ("{value: 1}", "4:13", "a param needs 'name'"),
+    ],
+)
+def test_param_errors(tmp_path: Path, param: str, where: str, message: str) -> None:
+    body = f"launch:\n- node:\n    exec: x\n    param: [{param}]\n"
+    err = error(tmp_path, body)
+    assert message in err.message
+    assert err.where == f"{tmp_path}/t.launch.yaml:{where}"
+    assert err.what == "param"
