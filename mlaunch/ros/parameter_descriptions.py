@@ -179,7 +179,10 @@ def coerce(text: str, value_type: Any) -> Any:
         return loaded
     if is_list:
         loaded = _yaml(text, f"a List[{scalar.__name__}]")
-        if not isinstance(loaded, list) or not all(isinstance(v, scalar) for v in loaded):
+        if isinstance(loaded, list) and scalar is float:
+            # ints are floats here too (launch_ros refuses '[1, 2]' as List[float])
+            loaded = [float(v) if type(v) is int else v for v in loaded]
+        if not isinstance(loaded, list) or not all(_is_scalar(v, scalar) for v in loaded):
             raise SubstitutionFailure(f"value {text!r} is not a List[{scalar.__name__}]")
         return loaded
     if scalar is str:
@@ -193,6 +196,10 @@ def coerce(text: str, value_type: Any) -> Any:
     if not isinstance(loaded, bool):
         raise SubstitutionFailure(f"value {text!r} is not a bool (true/false)")
     return loaded
+
+
+def _is_scalar(value: Any, scalar: type) -> bool:
+    return isinstance(value, scalar) and not (scalar is int and isinstance(value, bool))
 
 
 def _yaml(text: str, what: str) -> Any:
