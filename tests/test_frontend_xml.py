@@ -644,3 +644,20 @@ def test_ros_tag_errors(tmp_path: Path, tag: str, message: str) -> None:
     err = error(tmp_path, f"<launch>\n  {tag}\n</launch>")
     assert message in err.message
     assert err.where is not None and err.where.startswith(f"{tmp_path}/t.launch.xml:2:")
+
+
+def test_set_use_sim_time_and_set_ros_log_dir(ros_plan: Any) -> None:
+    plan = ros_plan(
+        """
+        <launch>
+          <set_use_sim_time value="true"/>
+          <set_ros_log_dir new_log_dir="/var/log/robot"/>
+          <node pkg="demo" exec="talker"/>
+        </launch>
+        """
+    )
+    (spec,) = plan.processes()
+    assert spec.env_changes["ROS_LOG_DIR"] == "/var/log/robot"
+    # As in Jazzy, set_use_sim_time does not reach the nodes; mlaunch says so.
+    assert spec.argv[1:] == ("--ros-args",)
+    assert any("SetUseSimTime(True)" in w for w in plan.warnings)

@@ -33,12 +33,10 @@ def build_description(root: Entity) -> Any:
     """The LaunchDescription of a root ``launch`` entity."""
     if root.tag != "launch":
         raise root.error(f"the root must be 'launch', not {root.tag!r}")
-    reason = root.text("deprecated")
+    reason = root.literal("deprecated")
     actions = [build_action(child) for child in root.actions()]
     root.finish()
-    description = core.LaunchDescription(
-        actions, deprecated_reason=reason if isinstance(reason, str) else None
-    )
+    description = core.LaunchDescription(actions, deprecated_reason=reason)
     description.origin = root.origin
     return description
 
@@ -457,6 +455,18 @@ def _set_remap(e: Entity) -> Any:
     return ros.SetRemap(src=_value(e, "from"), dst=_value(e, "to"))
 
 
+def _set_use_sim_time(e: Entity) -> Any:
+    ros = _ros_actions()
+    if not e.has("value"):
+        raise e.error("missing required attribute 'value'")
+    return ros.SetUseSimTime(e.flag("value"))
+
+
+def _set_ros_log_dir(e: Entity) -> Any:
+    ros = _ros_actions()
+    return ros.SetROSLogDir(_value(e, "new_log_dir"))
+
+
 # --- parameters ------------------------------------------------------------------------------
 
 
@@ -715,6 +725,8 @@ ACTIONS: dict[str, Builder] = {
     "set_parameter": _set_parameter,
     "set_parameters_from_file": _set_parameters_from_file,
     "set_remap": _set_remap,
+    "set_use_sim_time": _set_use_sim_time,
+    "set_ros_log_dir": _set_ros_log_dir,
 }
 
 # The tags whose children are actions.
@@ -726,8 +738,6 @@ UNSUPPORTED: dict[str, str] = {
     "load_composable_node": "composable nodes are not implemented",
     "composable_node": "composable nodes are not implemented",
     "ros_timer": "use <timer>",
-    "set_ros_log_dir": "set ROS_LOG_DIR with <set_env>",
-    "set_use_sim_time": "use <set_parameter name='use_sim_time' value='true'/>",
 }
 
 # Tags that are valid only inside another tag, or only in ROS 1.
