@@ -17,7 +17,9 @@ import os
 import pathlib
 import warnings
 
-from mlaunch.ros import packages
+# Not bound as ``packages``: compat serves ``ament_index_python.packages`` with this very module
+# and the import system then sets ``<this module>.packages`` to the module itself.
+from mlaunch.ros import packages as _packages
 from mlaunch.ros.packages import PackageNotFoundError
 
 RESOURCE_INDEX_SUBFOLDER = "share/ament_index/resource_index"
@@ -32,14 +34,14 @@ class InvalidResourceNameError(ValueError):
     """A resource name with a path separator in it."""
 
 
-def _index() -> packages.PackageIndex:
+def _index() -> _packages.PackageIndex:
     # No launch context here: the launch file being loaded is found on the call stack.
-    return packages.index(from_callers=True)
+    return _packages.index(from_callers=True)
 
 
 def get_search_paths() -> list[str]:
     """The existing prefixes of AMENT_PREFIX_PATH (an OSError when it is unset, as in ROS 2)."""
-    environ = packages.configured_environ()
+    environ = _packages.configured_environ()
     if not environ.get(AMENT_PREFIX_PATH_ENV_VAR):
         raise OSError(f"Environment variable '{AMENT_PREFIX_PATH_ENV_VAR}' is not set or empty")
     return _index().ament_prefixes()
@@ -47,13 +49,13 @@ def get_search_paths() -> list[str]:
 
 def get_package_prefix(package_name: str) -> str:
     """The install prefix of a package (a source package's own folder)."""
-    packages.check_name(package_name)
+    _packages.check_name(package_name)
     return _index().get(package_name).prefix
 
 
 def get_package_share_directory(package_name: str, print_warning: bool = True) -> str:
     """The share directory of a package (a source package's own folder)."""
-    packages.check_name(package_name)
+    _packages.check_name(package_name)
     path = _index().get(package_name).share_directory
     if print_warning and not os.path.exists(path):
         warnings.warn(f"Share directory for {package_name} ({path}) does not exist.", stacklevel=2)
