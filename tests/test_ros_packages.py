@@ -305,3 +305,14 @@ def test_configured_launch_file_tree_serves_plain_lookups(tmp_path: Path) -> Non
     ld = LaunchDescription([LogInfo(msg=FindPackageShare("conf_desc"))])
     plan = resolve(ld, path=None, arguments={}, environ={}, options=ResolveOptions())
     assert [s.message for s in plan.steps if isinstance(s, Log)] == [str(desc)]
+
+
+def test_symlinked_packages_are_found_and_loops_do_not_hang(tmp_path: Path) -> None:
+    elsewhere = source(tmp_path / "elsewhere" / "linked_pkg", "linked_pkg")
+    src = tmp_path / "ws" / "src"
+    src.mkdir(parents=True)
+    (src / "linked_pkg").symlink_to(elsewhere)
+    (src / "loop").mkdir()
+    (src / "loop" / "back").symlink_to(src)
+    found = packages.scan(str(src))
+    assert found == {"linked_pkg": str(src / "linked_pkg")}

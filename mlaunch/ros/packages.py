@@ -345,19 +345,26 @@ def scan(path: str) -> dict[str, str]:
 
     A folder with a package.xml is a package and is not searched further (packages do not
     nest); hidden folders, build/install/log, virtualenvs and anything marked COLCON_IGNORE
-    are skipped.
+    are skipped. Symlinked folders are followed (packages are often linked into a ``src``),
+    each real folder once.
     """
     path = os.path.abspath(path)
     cached = _scan_cache.get(path)
     if cached is not None:
         return cached
     found: dict[str, str] = {}
-    _scan_into(path, found, depth=0, top=True)
+    _scan_into(path, found, depth=0, seen=set(), top=True)
     _scan_cache[path] = found
     return found
 
 
-def _scan_into(folder: str, found: dict[str, str], depth: int, top: bool = False) -> None:
+def _scan_into(
+    folder: str, found: dict[str, str], depth: int, seen: set[str], top: bool = False
+) -> None:
+    real = os.path.realpath(folder)
+    if real in seen:  # a symlink loop, or a folder linked twice
+        return
+    seen.add(real)
     manifest = os.path.join(folder, "package.xml")
     if os.path.isfile(manifest):
         name = package_name(manifest)
@@ -374,9 +381,8 @@ def _scan_into(folder: str, found: dict[str, str], depth: int, top: bool = False
     if not top and any(m in names for m in IGNORE_MARKERS):
         return
     for entry in entries:
-        if _skipped(entry):
-            continue
-        _scan_into(entry.path, found, depth + 1)
+        if not _skipped(entry):
+            _scan_into(entry.path, found, depth + 1, seen)
 
 
 def _skipped(entry: os.DirEntry[str]) -> bool:
@@ -384,7 +390,7 @@ def _skipped(entry: os.DirEntry[str]) -> bool:
     if name.startswith(".") or name in SKIPPED_DIRS:
         return True
     try:
-        if not entry.is_dir(follow_symlinks=False):
+        if not entry.is_dir():
             return True
     except OSError:
         return True
