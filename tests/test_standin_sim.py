@@ -209,7 +209,9 @@ def test_classic_gazebo_command_line() -> None:
         ]
     )
     assert options.flavor == "gazebo" and options.world == "/w/jt.world"
-    assert options.ignored == ["--server-plugin libgazebo_ros_init.so libgazebo_ros_factory.so"]
+    assert options.ignored == []  # the stand-in provides /clock and spawning itself
+    options = parse_sim_args(["-u", "-s", "libgazebo_ros_state.so", "w.world", "extra"])
+    assert options.ignored == ["-u", "-s libgazebo_ros_state.so", "argument 'extra'"]
     assert parse_sim_args(["gzserver", "--seed", "5", "a.world"]).seed == 5
     assert parse_sim_args([]).world is None
 
@@ -385,6 +387,8 @@ def test_spawn_drive_scan_collide_and_stop(
         str(world_file),
         "-s",
         "libgazebo_ros_init.so",
+        "-s",
+        "libgazebo_ros_state.so",
         "--ros-args",
         "-p",
         "use_sim_time:=true",
@@ -443,7 +447,7 @@ def test_spawn_drive_scan_collide_and_stop(
     out = sim.stdout()
     assert "world 'test_world'" in out and "1 shapes" in out
     assert "spawned model 'testbot'" in out and "lidar /scan @10 Hz" in out
-    assert "--server-plugin libgazebo_ros_init.so" in sim.stderr()
+    assert "ignored by the stand-in: -s libgazebo_ros_state.so\n" in sim.stderr()
 
     sent = time.monotonic()
     sim.proc.send_signal(signal.SIGINT)

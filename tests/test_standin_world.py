@@ -432,3 +432,38 @@ def test_bad_plugin_parameters_are_named() -> None:
 
 def test_empty_world_summary() -> None:
     assert "0 shapes" in World().summary()
+
+
+def test_gz_sim_diff_drive_and_lidar_topics() -> None:
+    text = """<robot name="gzbot">
+      <link name="chassis"/><link name="l"/><link name="r"/><link name="lidar_link"/>
+      <joint name="lj" type="continuous"><parent link="chassis"/><child link="l"/>
+        <origin xyz="0 0.2 0"/></joint>
+      <joint name="rj" type="continuous"><parent link="chassis"/><child link="r"/>
+        <origin xyz="0 -0.2 0"/></joint>
+      <joint name="lidar_joint" type="fixed"><parent link="chassis"/><child link="lidar_link"/>
+      </joint>
+      <gazebo>
+        <plugin filename="gz-sim-diff-drive-system" name="gz::sim::systems::DiffDrive">
+          <left_joint>lj</left_joint><right_joint>rj</right_joint>
+          <wheel_separation>0.4</wheel_separation><wheel_radius>0.06</wheel_radius>
+          <topic>cmd_vel</topic>
+        </plugin>
+        <plugin filename="libsomething_else.so" name="x"/>
+      </gazebo>
+      <gazebo reference="lidar_link">
+        <sensor name="gpu_lidar" type="gpu_lidar"><topic>scan</topic><update_rate>8</update_rate>
+          <lidar><scan><horizontal><samples>10</samples><min_angle>-1</min_angle>
+            <max_angle>1</max_angle></horizontal></scan><range><min>0.1</min><max>9</max></range>
+          </lidar>
+        </sensor>
+      </gazebo>
+    </robot>"""
+    spec = describe_model(parse_urdf(text), "gzbot")
+    assert spec.drive is not None
+    assert spec.drive.cmd_topic == "/cmd_vel"
+    assert spec.drive.odom_topic == "/model/gzbot/odometry"
+    assert spec.drive.wheel_diameter == pytest.approx(0.12)
+    assert spec.drive.robot_base_frame == "gzbot/chassis" and spec.drive.publish_odom
+    assert spec.lidars[0].topic == "/scan" and spec.lidars[0].frame_id == "lidar_link"
+    assert spec.warnings == ["plugin 'libsomething_else.so' is not simulated by the stand-in"]

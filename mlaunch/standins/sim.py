@@ -61,6 +61,9 @@ CLOCK_RATE = 100.0  # /clock messages per second of sim time
 # caught up in a burst: the simulation just runs slower than asked, as Gazebo does.
 MAX_LAG_S = 0.25
 EMPTY_WORLDS = ("empty.world", "empty.sdf")
+# Gazebo system plugins whose ROS side the stand-in itself provides (/clock, spawning).
+PROVIDED_PLUGINS = ("libgazebo_ros_init.so", "libgazebo_ros_factory.so")
+STEPS_BETWEEN_SPINS = 10  # at most this many steps back to back before serving callbacks
 
 
 class SimUsageError(Exception):
@@ -106,7 +109,7 @@ def _classic_parser() -> argparse.ArgumentParser:
     ):
         p.add_argument(flag, action="store_true", dest=f"ignored_{flag.lstrip('-')}")
     for pair in (("-s", "--server-plugin"), ("-g", "--gui-plugin")):
-        p.add_argument(*pair, action="append", default=[], dest=f"ignored_{pair[1][2:]}")
+        p.add_argument(*pair, action="append", default=[], dest=f"plugins_{pair[0][1:]}")
     valued: list[tuple[str, ...]] = [("-e", "--physics"), ("-p", "--play"), ("-o", "--profile")]
     valued += [(f,) for f in ("--iters", "--record_path", "--record_period", "--record_filter")]
     valued.append(("--record_encoding",))
@@ -169,7 +172,11 @@ def parse_sim_args(args: Sequence[str]) -> SimOptions:
     for token in unknown:
         options.ignored.append(f"unknown option {token}")
     for key, value in sorted(vars(namespace).items()):
-        if key.startswith("ignored_") and value:
+        if key.startswith("plugins_"):  # -s / -g LIB, repeated
+            flag = key.removeprefix("plugins_")
+            libs = [lib for lib in value if Path(lib).name not in PROVIDED_PLUGINS]
+            options.ignored.extend(f"-{flag} {lib}" for lib in libs)
+        elif key.startswith("ignored_") and value:
             flag = key.removeprefix("ignored_")
             shown = value if isinstance(value, list) else ([] if value is True else [value])
             options.ignored.append(
@@ -584,16 +591,20 @@ def _loop(sim: Simulation, bridge: RosBridge, executor: Any, rtf: float, stop: _
     wall_step = sim.step_ns / 1e9 / rtf
     next_wall = time.monotonic()
     bridge.publish_due()
+    unserved = 0
     while not stop.requested:
         now = time.monotonic()
-        if now >= next_wall:
+        if now >= next_wall and unserved < STEPS_BETWEEN_SPINS:
             if now - next_wall > MAX_LAG_S:
                 next_wall = now
             sim.step()
             bridge.publish_due()
             next_wall += wall_step
+            unserved += 1
             continue
-        executor.spin_once(timeout_sec=next_wall - now)
+        # Behind schedule (a high real-time factor) callbacks still get a turn now and then.
+        executor.spin_once(timeout_sec=max(0.0, next_wall - now))
+        unserved = 0
 
 
 def _publisher(node: Any, msg_type: Any, topic: str, qos: Any) -> Any:
@@ -639,6 +650,7 @@ class RosBridge:
         self.spawned_pub = _publisher(node, String, SPAWNED_TOPIC, latched)
         _subscription(node, String, SPAWN_TOPIC, self.on_spawn, latched)
         self.outputs: list[Output] = []
+        self.answered: dict[str, str] = {}  # request id -> reply
         self.tf = _tf_support()
 
     # -- spawning
@@ -650,14 +662,24 @@ class RosBridge:
         try:
             request = parse_spawn_request(msg.data)
             request_id, name = request.id, request.name
+            if request_id is not None and request_id in self.answered:
+                # The same request again (a spawner's latched message seen twice): same answer.
+                self.spawned_pub.publish(self.String(data=self.answered[request_id]))
+                return
             name = self.spawn(request)
             reply: dict[str, object] = {"name": name, "ok": True, "error": ""}
         except (ValueError, ModelError) as exc:
             warn(f"spawn of {name or '?'!r} refused: {exc}")
             reply = {"name": name, "ok": False, "error": str(exc)}
+        except Exception as exc:  # a bug must cost one model, not the whole simulation
+            warn(f"spawn of {name or '?'!r} failed: {type(exc).__name__}: {exc}")
+            reply = {"name": name, "ok": False, "error": f"internal error: {exc!r}"}
         if request_id is not None:
             reply["id"] = request_id
-        self.spawned_pub.publish(self.String(data=json.dumps(reply)))
+        text = json.dumps(reply)
+        if request_id is not None:
+            self.answered[request_id] = text
+        self.spawned_pub.publish(self.String(data=text))
 
     def spawn(self, request: SpawnRequest) -> str:
         """Validate and add the model; return its (possibly renamed) name."""
