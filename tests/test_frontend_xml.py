@@ -386,6 +386,7 @@ def test_unknown_tag_with_did_you_mean(tmp_path: Path) -> None:
             "attribute 'cmd': the quote ' is not closed",
         ),
         ("<launch>\n<arg name='$(var x)'/>\n</launch>", "2:12", "must be plain text"),
+        ("<launch>\n<executable cmd='  '/>\n</launch>", "2:18", "attribute 'cmd' is empty"),
         ("<launch>\n<timer><log message='x'/></timer>\n</launch>", "2:1", "'period'"),
         ("<launch>\n<include file='x.py'><arg name='a'/></include>\n</launch>", "2:22", "'value'"),
     ],

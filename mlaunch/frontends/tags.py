@@ -233,6 +233,8 @@ def _reset(e: Entity) -> Any:
 def _executable(e: Entity) -> Any:
     kwargs = _process_kwargs(e, label="name")
     cmd = split_command(e, "cmd")
+    if not cmd:
+        raise e.error("attribute 'cmd' is empty; it names the program to run", e.attrs["cmd"])
     return core.ExecuteProcess(cmd=cmd, **kwargs)
 
 
