@@ -24,16 +24,16 @@ _MODULES = (
 
 
 def __getattr__(name: str) -> Any:
-    if name.startswith("_"):
+    # Only the ROS class names live here; a lowercase name is a submodule (``from mlaunch import
+    # frontends``), which Python imports itself once this raises.
+    if not name[:1].isupper():
         raise AttributeError(name)
     for module_name in _MODULES:
         try:
             module = importlib.import_module(module_name)
         except ImportError:
             continue
-        if name in getattr(module, "__all__", ()) or (
-            name[:1].isupper() and hasattr(module, name)
-        ):
+        if name in getattr(module, "__all__", ()) or hasattr(module, name):
             value = getattr(module, name)
             globals()[name] = value
             return value
