@@ -635,7 +635,11 @@ def message_class(type_name: str) -> Any:
             "e.g. 'sensor_msgs/msg/LaserScan'"
         )
     package, name = match.groups()
-    module = _import(f"{package}.msg", f"message type {type_name!r} needs package {package!r}")
+    module = _import(
+        f"{package}.msg",
+        f"message type {type_name!r} needs the ROS package {package!r}",
+        f"install its Python messages (e.g. the ros-<distro>-{package.replace('_', '-')} wheel)",
+    )
     cls = getattr(module, name, None)
     if cls is None:
         raise RosInputError(
@@ -644,11 +648,11 @@ def message_class(type_name: str) -> Any:
     return cls
 
 
-def _import(module: str, why: str = "the ROS bridge needs rclpy") -> Any:
+def _import(module: str, why: str = "the ROS bridge needs rclpy", hint: str = INSTALL_HINT) -> Any:
     try:
         return importlib.import_module(module)
     except ImportError as exc:
-        raise RosUnavailable(f"{why}, and importing {module} failed ({exc}): {INSTALL_HINT}")
+        raise RosUnavailable(f"{why}, and importing {module} failed ({exc}): {hint}")
 
 
 def _qos_for(publishers: list[Any]) -> Any:
