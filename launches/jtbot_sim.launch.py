@@ -76,7 +76,7 @@ def generate_launch_description():
                 package="robot_state_publisher",
                 executable="robot_state_publisher",
                 output="screen",
-                parameters=[{"robot_description": robot_description, "use_sim_time": use_sim_time}],
+                parameters=[{"robot_description": robot_description}, {"use_sim_time": use_sim_time}],
             ),
             Node(
                 package="gazebo_ros",

@@ -100,6 +100,7 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
 
 
 def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+    """The parameters in the params files mlaunch wrote for this process, one per line."""
     out = []
     for i, arg in enumerate(spec.argv[:-1]):
         if arg != "--params-file":
@@ -108,13 +109,39 @@ def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         if not temp_dir or not path.startswith(temp_dir):
             continue
         try:
+            import yaml
+
             with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except OSError:
+                data = yaml.safe_load(f)
+        except (OSError, ValueError):
             continue
-        out.append(f"  params ({os.path.basename(path)}):")
-        out.extend("    " + _shorten(line, LONG_VALUE) for line in text.splitlines())
+        for node, section in (data or {}).items():
+            params = (section or {}).get("ros__parameters", {})
+            for name, value in _flatten(params):
+                out.append(f"  param:   {name} = {_value_text(value)}   [{node}]")
     return out
+
+
+def _flatten(params: dict[str, object], prefix: str = "") -> list[tuple[str, object]]:
+    items: list[tuple[str, object]] = []
+    for key, value in params.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            items.extend(_flatten(value, name + "."))
+        else:
+            items.append((name, value))
+    return items
+
+
+def _value_text(value: object) -> str:
+    if isinstance(value, str):
+        if len(value) > 80 or "\n" in value:
+            first = value.strip().splitlines()[0] if value.strip() else ""
+            return f"<string, {len(value)} chars: {_shorten(first, 50)}>"
+        return repr(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value)
 
 
 def _shorten(text: str, limit: int) -> str:
