@@ -681,8 +681,10 @@ class ExecuteProcess(Action):
         if self.additional_env:
             env.update({perform(ctx, k): perform(ctx, v) for k, v in _items(self.additional_env)})
         # Timely output from pipes (ROS 2's L#188): children line-buffer unless told otherwise.
+        # Jazzy's rcutils reads RCUTILS_LOGGING_BUFFERED_STREAM (1 = line buffered) and warns
+        # about the older RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED, so only the new one is set.
         env.setdefault("PYTHONUNBUFFERED", "1")
-        env.setdefault("RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED", "1")
+        env.setdefault("RCUTILS_LOGGING_BUFFERED_STREAM", "1")
         if _truthy(ctx, self.emulate_tty) or _truthy(
             ctx, ctx.launch_configurations.get("emulate_tty", False)
         ):

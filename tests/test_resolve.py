@@ -159,7 +159,7 @@ def test_environment_actions_affect_later_processes_only() -> None:
     assert "A" not in before.env
     assert after.env["A"] == os.pathsep.join(["0", "1", "2"]) and after.env["B"] == "b"
     assert "HOME" not in after.env and after.env_changes["HOME"] is None
-    assert set(clean.env) == {"ONLY", "PYTHONUNBUFFERED", "RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED"}
+    assert set(clean.env) == {"ONLY", "PYTHONUNBUFFERED", "RCUTILS_LOGGING_BUFFERED_STREAM"}
     # mlaunch never touches its own environment for these.
     assert "A" not in os.environ or os.environ["A"] != logs(plan)[0]
 
@@ -178,7 +178,7 @@ def test_labels_count_globally_and_processes_get_line_buffering() -> None:
     spec = plan.processes()[1]
     assert spec.argv == ("/bin/echo", "x")
     assert spec.env["PYTHONUNBUFFERED"] == "1"
-    assert spec.env["RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED"] == "1"
+    assert spec.env["RCUTILS_LOGGING_BUFFERED_STREAM"] == "1"
 
 
 def test_process_settings() -> None:
