@@ -265,6 +265,11 @@ def test_lifecycle_configure_activate(ros_env: dict[str, str], tmp_path: Path) -
         )
         events: list[TransitionEvent] = []
         graph.on_transition("/r1/camera", events.append)
+
+        def broken(event: TransitionEvent) -> None:
+            raise ValueError(f"broken callback saw {event.goal_state}")
+
+        graph.on_transition("/r1/camera", broken)  # must not stop the others
         assert graph.lifecycle_state("/r1/camera", STARTUP) == "unconfigured"
 
         configured = graph.change_state("/r1/camera", "configure", 5)
@@ -285,6 +290,8 @@ def test_lifecycle_configure_activate(ros_env: dict[str, str], tmp_path: Path) -
             ("activate", "activating", "active"),
         ]
         assert all(e.node == "/r1/camera" for e in events)
+        where, error = graph.callback_errors[0]
+        assert where == "/r1/camera/transition_event" and isinstance(error, ValueError)
 
         again = graph.change_state("/r1/camera", "activate", 5)
         assert not again.ok and again.state == "active", again
@@ -344,13 +351,20 @@ def test_close_releases_waiters_threads_and_context(ros_env: dict[str, str]) -> 
     graph.start()
     watch = graph.watch_topic("/never", "std_msgs/msg/String")
     results: list[bool] = []
-    waiter = threading.Thread(target=lambda: results.append(watch.wait_count(1, 30)))
-    waiter.start()
-    assert set(threading.enumerate()) - threads_before - {waiter}, "the spin thread runs"
+    waiters = [
+        threading.Thread(target=lambda: results.append(watch.wait_count(1, 30))),
+        threading.Thread(
+            target=lambda: results.append(graph.wait_for(lambda g: "/x" in g.node_names(), 30))
+        ),
+    ]
+    for waiter in waiters:
+        waiter.start()
+    assert set(threading.enumerate()) - threads_before - set(waiters), "the spin thread runs"
     closing = time.monotonic()
     graph.close()
-    waiter.join(timeout=5)
-    assert results == [False] and time.monotonic() - closing < 3
+    for waiter in waiters:
+        waiter.join(timeout=5)
+    assert results == [False, False] and time.monotonic() - closing < 3
     assert set(threading.enumerate()) == threads_before
     # The context is destroyed with close(), and the DDS participant's threads with it.
     assert len(os.listdir("/proc/self/task")) == native_before

@@ -39,6 +39,7 @@ POLL_PERIOD = 0.05
 ENTITY_TIMEOUT = 5.0
 # The read-back of the state after a transition never waits longer than this.
 STATE_READBACK_TIMEOUT = 1.0
+MAX_RECORDED_ERRORS = 100
 MAX_DOMAIN_ID = 232  # highest id whose Fast DDS / Cyclone DDS port numbers stay valid
 TRANSITION_IDS = {  # lifecycle_msgs/msg/Transition ids; 'shutdown' depends on the state
     "configure": 1,
@@ -269,7 +270,8 @@ class RosGraph:
             except ExternalShutdownException:
                 break
             except Exception as exc:  # a dying spin thread would freeze every watch silently
-                self.callback_errors.append(("executor", exc))
+                self._record_error("executor", exc)
+                self._stopping.wait(0.01)  # back off: never spin hot on a repeating error
 
     def close(self) -> None:
         """Stop the thread, destroy the node and shut the context down. Idempotent."""
@@ -285,6 +287,11 @@ class RosGraph:
         if self._thread is not None:
             self._thread.join(timeout=ENTITY_TIMEOUT)
         self._destroy()
+
+    def _record_error(self, where: str, exc: BaseException) -> None:
+        # Bounded: a callback failing on every message must not grow memory without end.
+        if len(self.callback_errors) < MAX_RECORDED_ERRORS:
+            self.callback_errors.append((where, exc))
 
     def _release_waiters(self) -> None:
         for call in list(self._calls):
@@ -355,37 +362,49 @@ class RosGraph:
 
     # -- graph queries -------------------------------------------------------------------------
 
+    def _query(self, ask: Callable[[Any], Any]) -> Any:
+        """ask(node) from the caller's thread (rcl graph calls are thread-safe)."""
+        node = self._require_running()
+        try:
+            return ask(node)
+        except Exception:
+            # close() from another thread destroyed the node under us: say that, not InvalidHandle.
+            self._require_running()
+            raise
+
     def node_names(self) -> set[str]:
         """Fully qualified names ('/ns/name') of every node in the domain except this one."""
-        node = self._require_running()
-        names = {_join(ns, name) for name, ns in node.get_node_names_and_namespaces()}
-        names.discard(self.fqn)
-        return names
+        pairs = self._query(lambda node: node.get_node_names_and_namespaces())
+        return {_join(ns, name) for name, ns in pairs} - {self.fqn}
 
     def topic_types(self) -> dict[str, list[str]]:
         """Every topic in the graph with its type names ('pkg/msg/Type')."""
-        node = self._require_running()
-        return {name: list(types) for name, types in node.get_topic_names_and_types()}
+        pairs = self._query(lambda node: node.get_topic_names_and_types())
+        return {name: list(types) for name, types in pairs}
 
     def service_names(self) -> set[str]:
         """Every service in the graph (this bridge serves none)."""
-        node = self._require_running()
+        pairs = self._query(lambda node: node.get_service_names_and_types())
         own = self.fqn + "/"
-        return {
-            name for name, _types in node.get_service_names_and_types() if not name.startswith(own)
-        }
+        return {name for name, _types in pairs if not name.startswith(own)}
 
     def wait_for(self, predicate: Callable[[RosGraph], bool], timeout: float) -> bool:
         """Wait until predicate(self) is true; False at the deadline or when closed.
 
         Re-checked on every message or transition event and at least every POLL_PERIOD (the
-        graph itself gives Python no change notification).
+        graph itself gives Python no change notification). An exception from the predicate
+        propagates, unless the graph was closed meanwhile.
         """
         self._require_running()
         deadline = time.monotonic() + timeout
         while True:
-            if predicate(self):
-                return True
+            try:
+                if predicate(self):
+                    return True
+            except Exception:
+                if self._state != "running":
+                    return False  # closed under the predicate's feet
+                raise
             remaining = deadline - time.monotonic()
             if remaining <= 0 or self._state != "running":
                 return False
@@ -467,7 +486,7 @@ class RosGraph:
             try:
                 callback(arg)
             except Exception as exc:
-                self.callback_errors.append((where, exc))
+                self._record_error(where, exc)
 
         return guarded
 
