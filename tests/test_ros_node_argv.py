@@ -825,3 +825,38 @@ def test_find_package_share_joins_with_slash(prefix: Path, temp_dir: str) -> Non
     ctx = LaunchContext(environment={"AMENT_PREFIX_PATH": str(prefix)})
     joined = FindPackageShare("demo") / "launch" / TextSubstitution(text="x.launch.py")
     assert perform(ctx, joined) == str(prefix / "share" / "demo" / "launch" / "x.launch.py")
+
+
+def test_text_values_rcl_would_retype_are_quoted(prefix: Path, temp_dir: str) -> None:
+    """launch_ros writes plain y, 1e3, inf: rcl reads a bool or doubles. mlaunch quotes them."""
+    from mlaunch.ros.params import rcl_reads_as_text
+
+    node = Node(
+        package="demo",
+        executable="talker",
+        parameters=[
+            {"y": "y", "sci": "1e3", "words": ["n", "inf", "ok"], "plain": "ok", "n": 2},
+            Parameter("axis", "Y"),
+        ],
+    )
+    spec = only(run([node], prefix, temp_dir))
+    ros = ros_part(spec)
+    assert ros[2][5:] == textwrap.dedent(
+        """\
+        /**:
+          ros__parameters:
+            n: 2
+            plain: ok
+            sci: '1e3'
+            words:
+            - 'n'
+            - 'inf'
+            - ok
+            y: 'y'
+        """
+    )
+    assert ros[3:] == ["-p", "axis:='Y'\n"]
+    for text in ("y", "N", "TRUE", "Off", "1e3", "-inf", "NaN", "0x1A", "017", "08", " 5", ".5"):
+        assert not rcl_reads_as_text(text), text
+    for text in ("5 ", "abc", "1_000", "0x", "1e", "y2", "true story"):
+        assert rcl_reads_as_text(text), text

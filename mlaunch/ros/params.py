@@ -23,6 +23,7 @@ writes Python tuples (``!!python/tuple``, which only rcl's lenient parser accept
 from __future__ import annotations
 
 import os
+import re
 import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -274,8 +275,11 @@ def parameter_arguments(
 
 
 def parameter_rule(name: str, value: Any) -> str:
-    """``name:=value`` for ``-p``, the value dumped by YAML as launch_ros does (``...`` and all)."""
-    return f"{name}:={yaml.dump(_plain(value))}"
+    """``name:=value`` for ``-p``, the value dumped by YAML as launch_ros does (``...`` and all).
+
+    Text rcl would retype is quoted (see ``params_file_text``).
+    """
+    return f"{name}:={yaml.dump(_plain(value), Dumper=_ParamsDumper)}"
 
 
 def global_parameter_rule(name: str, value: Any) -> str:
@@ -294,9 +298,16 @@ def global_parameter_rule(name: str, value: Any) -> str:
 
 
 def params_file_text(node_key: str, params: Mapping[str, Any]) -> str:
-    """The YAML of one params file, exactly as launch_ros dumps it (keys sorted, block style)."""
+    """The YAML of one params file as launch_ros dumps it (keys sorted, block style).
+
+    Deliberate fix: a text value that rcl would read as something else is single-quoted.
+    PyYAML quotes what *its* resolver would retype ('true', '1.0'), but rcl also reads plain
+    ``y``/``n``/``Y``/``N`` as bools and anything C's strtol/strtod accept (``1e3``, ``inf``,
+    ``0x1A``, `` 5``) as numbers, so launch_ros hands the node a bool or a double where the
+    launch file said text. Every other value is written byte for byte as launch_ros writes it.
+    """
     document = {node_key: {"ros__parameters": _plain(dict(params))}}
-    return yaml.dump(document, default_flow_style=False)
+    return yaml.dump(document, Dumper=_ParamsDumper, default_flow_style=False)
 
 
 def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | None) -> str:
@@ -309,12 +320,53 @@ def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | 
 
 
 def _plain(value: Any) -> Any:
-    """Tuples as lists, so the file is plain YAML any reader accepts."""
+    """Tuples as lists (plain YAML any reader accepts); text values marked for rcl quoting."""
     if isinstance(value, dict):
         return {k: _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
+    if isinstance(value, str):
+        return _TextValue(value)
     return value
+
+
+class _TextValue(str):
+    """A text parameter value (not a key): quoted when rcl would not read it as text."""
+
+
+# rcl's bool words (YAML 1.1 style, in three spellings each, plus y/n).
+_RCL_BOOLS = frozenset(
+    {"Y", "y", "N", "n"}
+    | {v for w in ("yes", "true", "on", "no", "false", "off") for v in (w, w.title(), w.upper())}
+)
+_C_SPACE = r"[ \t\n\v\f\r]*"
+# What C's strtol(base 0) or strtod consume completely (after leading white space).
+_RCL_NUMBER = re.compile(
+    _C_SPACE
+    + r"[+-]?(?:"
+    + r"0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?[0-9]+)?"
+    + r"|(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+    + r"|inf(?:inity)?|nan(?:\([0-9A-Za-z_]*\))?"
+    + r")",
+    re.IGNORECASE,
+)
+
+
+def rcl_reads_as_text(text: str) -> bool:
+    """Whether rcl's params parser keeps a plain (unquoted) YAML scalar as a string."""
+    return text not in _RCL_BOOLS and _RCL_NUMBER.fullmatch(text) is None
+
+
+class _ParamsDumper(yaml.Dumper):
+    """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype."""
+
+
+def _represent_text(dumper: yaml.Dumper, data: _TextValue) -> yaml.ScalarNode:
+    style = None if rcl_reads_as_text(data) else "'"
+    return dumper.represent_scalar("tag:yaml.org,2002:str", str(data), style=style)
+
+
+_ParamsDumper.add_representer(_TextValue, _represent_text)
 
 
 __all__ = [
