@@ -518,6 +518,7 @@ def _serve(argv: list[str], options: SimOptions, world: World, stop: _Stop) -> i
     node = None
     try:
         node = rclpy.create_node("gazebo")
+        _default_sim_time(node)
         _ignore_own_clock(node)
         seed = int(
             _number_param(
@@ -541,6 +542,20 @@ def _serve(argv: list[str], options: SimOptions, world: World, stop: _Stop) -> i
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
+
+
+def _default_sim_time(node: Any) -> None:
+    """use_sim_time is true unless the command line says otherwise, as gazebo_ros's nodes.
+
+    The simulator is the clock: Gazebo's own ROS nodes run on sim time by default, and a launch
+    file never passes parameters to an ExecuteProcess, so this is what makes every node of a
+    simulated launch agree on the clock.
+    """
+    from rclpy.parameter import Parameter
+
+    given = getattr(node, "_parameter_overrides", {})
+    if "use_sim_time" not in given:
+        node.set_parameters([Parameter("use_sim_time", Parameter.Type.BOOL, True)])
 
 
 def _ignore_own_clock(node: Any) -> None:
