@@ -278,17 +278,33 @@ def launch(opts: Options, path: str, description: object) -> int:
 
 
 def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
-    from mlaunch.output import Printer, stdout_is_color_terminal
+    from mlaunch.errors import UsageError
+    from mlaunch.guard import Guard, new_run_id
+    from mlaunch.output import DEFAULT_ROTATE_BYTES, Printer, stdout_is_color_terminal
     from mlaunch.supervisor import Supervisor
 
+    if opts.log_max_bytes is not None and opts.log_max_bytes < 0:
+        raise UsageError(
+            f"--log-max-bytes is {opts.log_max_bytes}; valid: 0 (never rotate) or more"
+        )
+    # The guard first, before any child exists: if mlaunch is killed it ends what mlaunch began.
+    run_id = new_run_id()
+    guard = Guard.start(run_id, temp_dir=getattr(options, "temp_dir", None))
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
-    printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet)
-    if opts.log_max_bytes is not None:
-        printer.rotate_bytes = opts.log_max_bytes
+    rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
+    printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet, rotate_bytes=rotate)
     printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
-    supervisor = Supervisor(plan, printer, options=options, labels=labels)  # type: ignore[arg-type]
-    extensions = _extensions(opts, supervisor)
+    supervisor = Supervisor(
+        plan,  # type: ignore[arg-type]
+        printer,
+        options=options,  # type: ignore[arg-type]
+        labels=labels,  # type: ignore[arg-type]
+        guard=guard,
+        run_id=run_id,
+    )
+    extensions: list[object] = []
     try:
+        extensions = _extensions(opts, supervisor)
         code = supervisor.run()
     finally:
         for ext in extensions:
@@ -296,6 +312,8 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
             if close is not None:
                 close()
         printer.close()
+        # Everything the run started has ended (run() kills what is left even when it fails).
+        guard.close()
     return code
 
 

@@ -3,18 +3,22 @@
 Child output is data, never markup: bytes in, invalid UTF-8 replaced, each line prefixed with its
 process label, written with one call per chunk. A chunk is prefixed with a single
 ``bytes.replace`` instead of a per-line Python loop, which is what lets mlaunch pass hundreds of
-thousands of lines a second while the children keep running. rich is used only for tables and
-the status view, and imported only when one is shown.
+thousands of lines a second while the children keep running. The terminal never blocks the
+supervisor (Screen: a bounded, non-blocking queue); the log files get every line. rich is used
+only by the status view, and imported only when it is shown.
 """
 
 from __future__ import annotations
 
 import os
+import select
 import socket
+import stat
 import sys
 import time
+from collections import deque
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import IO
 
 # Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
@@ -35,10 +39,19 @@ RESET = b"\x1b[0m"
 
 DEFAULT_ROTATE_BYTES = 64 * 1024 * 1024
 DEFAULT_ROTATE_KEEP = 3
+# Per log file: a hundred processes must not pin a hundred large buffers.
+LOG_BUFFER = 64 * 1024
+# Screen output queued for a terminal that is behind, at most; beyond it lines are dropped
+# from the screen (never from the logs).
+SCREEN_BACKLOG = 4 * 1024 * 1024
+# Queued screen output is written once this much has gathered, else when the loop goes idle.
+SCREEN_CHUNK = 256 * 1024
 
 
 def clean(data: bytes) -> bytes:
     """Valid UTF-8, with U+FFFD for whatever was not."""
+    if data.isascii():
+        return data  # the common case, checked without building a str
     try:
         data.decode("utf-8")
         return data
@@ -51,24 +64,187 @@ def prefix_lines(prefix: bytes, data: bytes) -> bytes:
     return prefix + data[:-1].replace(b"\n", b"\n" + prefix) + b"\n"
 
 
-class LogFile:
-    """An append-only log file that rotates at a size limit (name -> name.1 -> name.2 ...)."""
+class Screen:
+    """The terminal (fd 1) for a supervisor that must never block on it.
 
-    def __init__(self, path: str, *, rotate_bytes: int, keep: int) -> None:
+    Output is queued and handed to the fd without blocking: O_NONBLOCK is set only around the
+    write, so the shell sharing the terminal never inherits it. If the reader falls behind (a
+    slow ssh link, a terminal paused with Ctrl-S, a pipe nobody reads) the queue grows up to
+    ``limit`` bytes; beyond that, output is dropped from the screen only, counted, and reported
+    once the terminal catches up. The children keep running and the log files keep every line.
+    """
+
+    def __init__(self, fd: int = 1, *, limit: int = SCREEN_BACKLOG) -> None:
+        self.fd = fd
+        self.limit = limit
+        self.dropped_lines = 0
+        self.dropped_bytes = 0
+        self.gone = False  # the reader went away (EPIPE, EIO): the screen is dropped for good
+        self._queue: deque[bytes] = deque()
+        self._size = 0
+        try:
+            self._regular = stat.S_ISREG(os.fstat(fd).st_mode)
+        except OSError:
+            self._regular = False
+
+    def __call__(self, data: bytes) -> None:
+        self.write(data)
+
+    def write(self, data: bytes) -> None:
+        if self.gone:
+            return
+        if self._size + len(data) > self.limit:
+            self.dropped_lines += data.count(b"\n")
+            self.dropped_bytes += len(data)
+            return
+        self._queue.append(data)
+        self._size += len(data)
+        if self._size >= SCREEN_CHUNK:
+            self.flush()
+
+    @property
+    def blocked(self) -> bool:
+        """Output is waiting for the terminal."""
+        return bool(self._queue) and not self.gone
+
+    def flush(self) -> None:
+        """Write what the terminal takes now; keep the rest queued."""
+        if not self._queue or self.gone:
+            return
+        nonblocking = not self._regular and os.get_blocking(self.fd)
+        if nonblocking:
+            os.set_blocking(self.fd, False)
+        try:
+            self._write_queue()
+            if not self._queue and self.dropped_lines + self.dropped_bytes:
+                self._queue.append(self._drop_notice())
+                self._size += len(self._queue[-1])
+                self._write_queue()
+        finally:
+            if nonblocking:
+                try:
+                    os.set_blocking(self.fd, True)
+                except OSError:
+                    pass
+
+    def _write_queue(self) -> None:
+        queue = self._queue
+        while queue:
+            if len(queue) > 1 and len(queue[0]) < SCREEN_CHUNK:
+                # Many small pieces (one per line burst) go out in one write.
+                parts, size = [], 0
+                while queue and size < SCREEN_CHUNK:
+                    size += len(queue[0])
+                    parts.append(queue.popleft())
+                queue.appendleft(b"".join(parts))
+            head = queue[0]
+            try:
+                n = os.write(self.fd, head)
+            except BlockingIOError:
+                return
+            except OSError:
+                self.gone = True
+                queue.clear()
+                self._size = 0
+                return
+            self._size -= n
+            if n < len(head):
+                queue[0] = head[n:]
+                return
+            queue.popleft()
+
+    def _drop_notice(self) -> bytes:
+        lines, size = self.dropped_lines, self.dropped_bytes
+        self.dropped_lines = self.dropped_bytes = 0
+        return (
+            f"[WARNING] [launch]: the terminal fell behind: {lines} lines ({size / 1e6:.1f} MB)"
+            " were not shown; the log files have them\n"
+        ).encode()
+
+    def close(self, timeout: float = 2.0) -> None:
+        """Give the terminal up to ``timeout`` seconds to take what is still queued."""
+        deadline = time.monotonic() + timeout
+        self.flush()
+        while self.blocked:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                break
+            select.select([], [self.fd], [], left)
+            self.flush()
+
+
+class LogFile:
+    """An append-only log file that rotates at a size limit (name -> name.1 -> name.2 ...).
+
+    It is opened on the first write (so starting a hundred processes does not first open a
+    hundred files). A write error (disk full) stops this file, once, through ``on_error``;
+    it never stops the run.
+    """
+
+    def __init__(
+        self,
+        path: str,
+        *,
+        rotate_bytes: int,
+        keep: int,
+        lazy: bool = False,
+        on_error: Callable[[str, OSError], None] | None = None,
+    ) -> None:
         self.path = path
         self.rotate_bytes = rotate_bytes
         self.keep = keep
-        self._file: IO[bytes] = open(path, "ab", buffering=256 * 1024)  # noqa: SIM115
+        self.on_error = on_error
+        self.error: OSError | None = None
+        self.size = 0
+        self._file: IO[bytes] | None = None
+        if not lazy:
+            self._open()
+
+    def _open(self) -> None:
+        self._file = open(self.path, "ab", buffering=LOG_BUFFER)  # noqa: SIM115
         self.size = self._file.tell()
 
     def write(self, data: bytes) -> None:
-        if self.rotate_bytes and self.size + len(data) > self.rotate_bytes and self.size:
-            self.rotate()
+        if self.error is not None:
+            return
+        try:
+            if self._file is None:
+                self._open()
+            limit = self.rotate_bytes
+            while limit and self.size + len(data) > limit:
+                # Fill this file up to the limit at a line boundary, then start the next one;
+                # only a single line longer than the limit makes a file exceed it.
+                cut = data.rfind(b"\n", 0, max(0, limit - self.size)) + 1
+                if cut:
+                    self._append(data[:cut])
+                    data = data[cut:]
+                if self.size:
+                    self.rotate()
+                elif not cut:
+                    break
+            if data:
+                self._append(data)
+        except OSError as e:
+            self._failed(e)
+
+    def _append(self, data: bytes) -> None:
+        assert self._file is not None
         self._file.write(data)
         self.size += len(data)
 
+    def _failed(self, error: OSError) -> None:
+        self.error = error
+        if self._file is not None:
+            try:
+                self._file.close()
+            except OSError:
+                pass  # the buffered rest cannot be written either
+        if self.on_error is not None:
+            self.on_error(self.path, error)
+
     def rotate(self) -> None:
-        self._file.close()
+        if self._file is not None:
+            self._file.close()
         for i in range(self.keep - 1, 0, -1):
             older = f"{self.path}.{i}"
             if os.path.exists(older):
@@ -77,14 +253,21 @@ class LogFile:
             os.replace(self.path, f"{self.path}.1")
         else:
             os.unlink(self.path)
-        self._file = open(self.path, "ab", buffering=256 * 1024)  # noqa: SIM115
+        self._open()
         self.size = 0
 
     def flush(self) -> None:
-        self._file.flush()
+        if self._file is None or self.error is not None:
+            return
+        try:
+            self._file.flush()
+        except OSError as e:
+            self._failed(e)
 
     def close(self) -> None:
-        self._file.close()
+        self.flush()
+        if self._file is not None and self.error is None:
+            self._file.close()
 
 
 def log_base_dir(environ: Mapping[str, str]) -> str:
@@ -118,9 +301,13 @@ def make_run_log_dir(environ: Mapping[str, str]) -> str:
 
 @dataclass
 class Printer:
-    """Owns the terminal and the log files of a run."""
+    """Owns the terminal and the log files of a run.
 
-    out: Callable[[bytes], object] = field(default=lambda data: os.write(1, data))
+    ``out`` receives every byte meant for the screen; None means the real terminal through a
+    Screen (non-blocking, bounded). Tests pass a callable that collects bytes.
+    """
+
+    out: Callable[[bytes], object] | None = None
     color: bool = False
     log_dir: str | None = None
     rotate_bytes: int = DEFAULT_ROTATE_BYTES
@@ -129,19 +316,47 @@ class Printer:
     clock: Callable[[], float] = time.time
 
     def __post_init__(self) -> None:
+        self._write: Callable[[bytes], object] = Screen() if self.out is None else self.out
         self._launch_log: LogFile | None = None
         self._own: dict[str, LogFile] = {}
         self._prefix: dict[str, bytes] = {}
-        self._dirty = False
+        self._dirty: set[LogFile] = set()
+        self._log_errors: list[str] = []
         self.hooks: list[Callable[[str, str, bytes], None]] = []
         if self.log_dir:
-            self._launch_log = self._open("launch.log")
+            self._launch_log = self._open("launch.log", lazy=False)
 
-    def _open(self, name: str) -> LogFile:
+    def _open(self, name: str, *, lazy: bool = True) -> LogFile:
         assert self.log_dir is not None
         return LogFile(
-            os.path.join(self.log_dir, name), rotate_bytes=self.rotate_bytes, keep=self.rotate_keep
+            os.path.join(self.log_dir, name),
+            rotate_bytes=self.rotate_bytes,
+            keep=self.rotate_keep,
+            lazy=lazy,
+            on_error=self._log_failed,
         )
+
+    def _log_failed(self, path: str, error: OSError) -> None:
+        # Said on screen only (the log is what failed), and only once per file.
+        text = (
+            f"[ERROR] [launch]: cannot write {path}: {error.strerror or error}; not logging to it"
+        )
+        self._write(text.encode("utf-8", "replace") + b"\n")
+
+    # --- where screen output goes -------------------------------------------------------------
+
+    @property
+    def screen(self) -> Callable[[bytes], object]:
+        return self._write
+
+    def set_screen(self, out: Callable[[bytes], object]) -> Callable[[bytes], object]:
+        """Send screen output to ``out`` from now on (the status view); returns the previous one."""
+        previous, self._write = self._write, out
+        return previous
+
+    def blocked(self) -> bool:
+        """The screen has output waiting for the terminal (the supervisor then polls)."""
+        return bool(getattr(self._write, "blocked", False))
 
     # --- launch's own messages ----------------------------------------------------------------
 
@@ -150,12 +365,22 @@ class Printer:
         line = f"[{level}] [{source}]: {text}\n".encode("utf-8", "replace")
         if not self.quiet or level in ("WARNING", "ERROR"):
             if self.color and LEVEL_COLORS.get(level):
-                self.out(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
+                self._write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
             else:
-                self.out(line)
+                self._write(line)
         if self._launch_log is not None:
             self._launch_log.write(b"%.7f " % self.clock() + line)
-            self._dirty = True
+            self._dirty.add(self._launch_log)
+
+    def block(self, text: str) -> None:
+        """Lines of launch's own (the exit summary) as they are, on screen and in launch.log."""
+        data = text.encode("utf-8", "replace")
+        if not data.endswith(b"\n"):
+            data += b"\n"
+        self._write(data)
+        if self._launch_log is not None:
+            self._launch_log.write(data)
+            self._dirty.add(self._launch_log)
 
     # --- process output ------------------------------------------------------------------------
 
@@ -176,28 +401,28 @@ class Printer:
         """Complete lines from a process (bytes ending in newline)."""
         data = clean(data)
         if stream in SCREEN_STREAMS.get(mode, ()) and not self.quiet:
-            self.out(prefix_lines(self._prefix[label], data))
+            self._write(prefix_lines(self._prefix[label], data))
         own = self._own.get(label)
         if own is not None:
             own.write(data)
-            self._dirty = True
+            self._dirty.add(own)
         if self._launch_log is not None and mode in LAUNCH_LOG_MODES:
             self._launch_log.write(
                 prefix_lines(b"%.7f [%s] " % (self.clock(), label.encode()), data)
             )
-            self._dirty = True
+            self._dirty.add(self._launch_log)
         for hook in self.hooks:
             hook(label, stream, data)
 
     def flush(self) -> None:
-        """Push buffered log lines to disk (called when the supervisor is about to wait)."""
-        if not self._dirty:
-            return
-        if self._launch_log is not None:
-            self._launch_log.flush()
-        for f in self._own.values():
-            f.flush()
-        self._dirty = False
+        """Push buffered lines to disk and screen (called when the supervisor is about to wait)."""
+        if self._dirty:
+            for f in self._dirty:
+                f.flush()
+            self._dirty.clear()
+        flush = getattr(self._write, "flush", None)
+        if flush is not None:
+            flush()
 
     def close(self) -> None:
         self.flush()
@@ -205,6 +430,9 @@ class Printer:
             self._launch_log.close()
         for f in self._own.values():
             f.close()
+        close = getattr(self._write, "close", None)
+        if close is not None:
+            close()
 
 
 def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:

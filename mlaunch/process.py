@@ -6,7 +6,7 @@ import os
 import signal
 import subprocess
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
 from mlaunch.plan import ProcessSpec
@@ -29,6 +29,114 @@ def signal_name(number: int) -> str:
         return signal.Signals(number).name
     except ValueError:
         return f"signal {number}"
+
+
+# Signals whose default action writes a core dump (signal(7)).
+CORE_SIGNALS = frozenset(
+    {signal.SIGQUIT, signal.SIGILL, signal.SIGTRAP, signal.SIGABRT, signal.SIGBUS,
+     signal.SIGFPE, signal.SIGSEGV, signal.SIGXCPU, signal.SIGXFSZ, signal.SIGSYS}
+)  # fmt: skip
+
+
+def read_core_pattern() -> tuple[str, bool]:
+    """``/proc/sys/kernel/core_pattern`` and ``core_uses_pid`` (empty/False where unreadable)."""
+    try:
+        with open("/proc/sys/kernel/core_pattern") as f:
+            pattern = f.read().strip()
+    except OSError:
+        return "", False
+    try:
+        with open("/proc/sys/kernel/core_uses_pid") as f:
+            uses_pid = f.read().strip() == "1"
+    except OSError:
+        uses_pid = False
+    return pattern, uses_pid
+
+
+def core_limit() -> int:
+    """The soft RLIMIT_CORE children inherit from mlaunch (-1 for unlimited)."""
+    import resource
+
+    soft, _ = resource.getrlimit(resource.RLIMIT_CORE)
+    return -1 if soft == resource.RLIM_INFINITY else soft
+
+
+def core_dump_hint(
+    *,
+    pid: int,
+    signal_number: int,
+    dumped: bool,
+    executable: str,
+    cwd: str,
+    pattern: str,
+    uses_pid: bool = False,
+    limit: int = -1,
+) -> str | None:
+    """Where the core dump of a crashed process went, or why there is none (None: no core signal).
+
+    rosmon's habit: read core_pattern. A ``|systemd-coredump`` pipe means ``coredumpctl gdb PID``;
+    another pipe names its handler; a path pattern gives the expected file (relative paths are
+    relative to the process's working directory); RLIMIT_CORE 0 means core dumps are off.
+    """
+    if signal_number not in CORE_SIGNALS:
+        return None
+    if not dumped:
+        if limit == 0:
+            return "core dumps are off (ulimit -c is 0; 'ulimit -c unlimited' turns them on)"
+        return "no core dump was written"
+    if pattern.startswith("|"):
+        handler = pattern[1:].split()[0] if pattern[1:].split() else "?"
+        if "systemd-coredump" in handler:
+            return f"core dump kept by systemd-coredump: coredumpctl gdb {pid}"
+        return f"core dump handed to {handler}"
+    path = expand_core_pattern(pattern or "core", pid=pid, executable=executable)
+    if uses_pid and "%p" not in pattern:
+        path += f".{pid}"
+    if not os.path.isabs(path):
+        path = os.path.join(cwd, path)
+    return f"core dump expected at {path} (gdb {executable} {path})"
+
+
+def expand_core_pattern(pattern: str, *, pid: int, executable: str) -> str:
+    """The ``%`` specifiers of core(5) we can know; the others (time, ...) become ``*``."""
+    known = {
+        "p": str(pid),
+        "P": str(pid),
+        "i": str(pid),
+        "I": str(pid),
+        "e": os.path.basename(executable)[:15],
+        "u": str(os.getuid()),
+        "g": str(os.getgid()),
+        "h": os.uname().nodename,
+        "%": "%",
+    }
+    out = []
+    i = 0
+    while i < len(pattern):
+        ch = pattern[i]
+        if ch == "%" and i + 1 < len(pattern):
+            out.append(known.get(pattern[i + 1], "*"))
+            i += 2
+            continue
+        out.append(ch)
+        i += 1
+    return "".join(out)
+
+
+def utf8_safe_cut(buf: bytes) -> int:
+    """How much of ``buf`` to pass on so that it does not end inside a UTF-8 character.
+
+    Used when an endless line is cut into pieces: the next piece starts with the rest.
+    """
+    n = len(buf)
+    for back in range(1, min(4, n) + 1):
+        byte = buf[n - back]
+        if byte < 0x80:
+            return n  # ASCII: nothing is cut
+        if byte >= 0xC0:  # the lead byte of the last character
+            need = 2 if byte < 0xE0 else 3 if byte < 0xF0 else 4
+            return n if back >= need else n - back
+    return n
 
 
 @dataclass
@@ -58,6 +166,8 @@ class Process:
     signals_sent: list[int] = field(default_factory=list)
     group_alive: bool = True
     core_dumped: bool = False
+    peak_rss: int = 0  # bytes, from wait4's rusage (the peak, not a sample)
+    cpu_time: float = 0.0  # user + system seconds
 
     @property
     def label(self) -> str:
@@ -75,22 +185,28 @@ class Process:
     def running(self) -> bool:
         return self.pid != 0 and self.returncode is None
 
-    def spawn(self, clock: Callable[[], float] = time.monotonic) -> None:
+    def spawn(
+        self,
+        clock: Callable[[], float] = time.monotonic,
+        extra_env: Mapping[str, str] | None = None,
+    ) -> None:
         """Start the child in a new session (its own process group), output on pipes.
 
-        Raises OSError when the program cannot be started.
+        ``extra_env`` is added to the spec's environment (the run's marker). Raises OSError when
+        the program cannot be started.
         """
         spec = self.spec
         args: list[str] | str = list(spec.argv)
         if spec.shell:
             # ROS 2 joins the command with spaces and hands it to /bin/sh, unquoted.
             args = " ".join(spec.argv)
+        env = {**spec.env, **extra_env} if extra_env else spec.env
         self.popen = subprocess.Popen(
             args,
             stdin=subprocess.DEVNULL,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
-            env=spec.env,
+            env=env,
             cwd=spec.cwd,
             shell=spec.shell,
             start_new_session=True,
@@ -119,17 +235,16 @@ class Process:
             return (rest + b"\n" if rest else b""), True
         buf = stream.partial + data if stream.partial else data
         cut = buf.rfind(b"\n")
+        if len(buf) - cut - 1 > MAX_PARTIAL:
+            # An endless line: pass it on in pieces (bounded memory, output not held back),
+            # never splitting a UTF-8 character between two pieces.
+            end = utf8_safe_cut(buf)
+            stream.partial = buf[end:]
+            return buf[:end] + b"\n", False
         if cut < 0:
-            if len(buf) > MAX_PARTIAL:
-                stream.partial = b""
-                return buf + b"\n", False
             stream.partial = buf
             return b"", False
         stream.partial = buf[cut + 1 :]
-        if len(stream.partial) > MAX_PARTIAL:
-            complete = buf + b"\n"
-            stream.partial = b""
-            return complete, False
         return buf[: cut + 1], False
 
     def close_stream(self, fd: int) -> None:
@@ -137,18 +252,30 @@ class Process:
         if stream is not None and stream.file is not None:
             stream.file.close()  # type: ignore[attr-defined]
 
-    def reaped(self, status: int, clock: Callable[[], float] = time.monotonic) -> None:
-        """Record the wait status of the leader (raw, from os.waitpid)."""
+    def reaped(
+        self,
+        status: int,
+        clock: Callable[[], float] = time.monotonic,
+        rusage: object | None = None,
+    ) -> None:
+        """Record the wait status of the leader (raw, from os.wait4) and its resource usage."""
         code = os.waitstatus_to_exitcode(status)
         self.returncode = code
         self.core_dumped = os.WIFSIGNALED(status) and os.WCOREDUMP(status)
         self.ended_at = clock()
+        if rusage is not None:
+            self.peak_rss = int(rusage.ru_maxrss) * 1024  # type: ignore[attr-defined]  # KiB
+            self.cpu_time = rusage.ru_utime + rusage.ru_stime  # type: ignore[attr-defined]
         if self.popen is not None:
             # We reaped it ourselves; tell Popen so it never waits for this pid again.
             self.popen.returncode = code
 
-    def signal_group(self, sig: int) -> bool:
-        """Send ``sig`` to the child's process group; False when nothing is left in it."""
+    def signal_group(self, sig: int, *, wake: bool = False) -> bool:
+        """Send ``sig`` to the child's process group; False when nothing is left in it.
+
+        ``wake`` adds SIGCONT, so that a stopped (SIGSTOP, Ctrl-Z) member handles ``sig`` now
+        instead of whenever someone continues it.
+        """
         if not self.pid:
             return False
         try:
@@ -159,6 +286,11 @@ class Process:
         except PermissionError:
             return False
         self.signals_sent.append(sig)
+        if wake and sig not in (signal.SIGKILL, signal.SIGCONT):
+            try:
+                os.killpg(self.pid, signal.SIGCONT)
+            except OSError:
+                pass
         return True
 
     def check_group(self) -> bool:

@@ -2,9 +2,20 @@
 
 One thread, one ``selectors`` loop. Signal handlers only record the signal (and wake the loop
 through ``signal.set_wakeup_fd``); the loop acts on them. Every child runs in its own session, so
-the stop ladder (SIGINT, then SIGTERM after sigterm_timeout, then SIGKILL after sigkill_timeout)
-reaches its whole process group, and mlaunch is the children's subreaper, so grandchildren that
-escape into sessions of their own still come back to it and are ended before it exits.
+the stop ladder (SIGINT, then SIGTERM after sigterm_timeout, then SIGKILL after sigkill_timeout,
+each with SIGCONT so a stopped process wakes up to die) reaches its whole process group.
+
+Nothing is left behind:
+- mlaunch becomes the children's subreaper, so a grandchild that escapes into a session of its
+  own is re-parented to mlaunch, not to init;
+- every child's environment carries ``MLAUNCH_RUN_ID=<run id>`` (inherited by grandchildren), so
+  at shutdown any process of the run is found in /proc even if it escaped before the subreaper
+  was set, and is ended (SIGTERM, SIGKILL after STRAY_GRACE);
+- a guard process (mlaunch.guard, a constructor seam) ends the run if mlaunch itself is killed;
+- if the loop itself fails, every group is killed before the error propagates.
+
+The per-label ProcessRecord (state, restarts, run time, peak memory) is what the status view and
+the exit summary read; peak memory and CPU time come from wait4's rusage, so nothing is sampled.
 """
 
 from __future__ import annotations
@@ -20,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from mlaunch import events as ev
+from mlaunch import guard as guards
 from mlaunch.errors import MlaunchError
 from mlaunch.output import Printer
 from mlaunch.plan import (
@@ -31,11 +43,19 @@ from mlaunch.plan import (
     ProcessSpec,
     RemoveHandler,
     RequestShutdown,
+    RespawnPolicy,
     Spawn,
     StartTimer,
     Step,
 )
-from mlaunch.process import Process, describe_status, signal_name
+from mlaunch.process import (
+    Process,
+    core_dump_hint,
+    core_limit,
+    describe_status,
+    read_core_pattern,
+    signal_name,
+)
 from mlaunch.resolve import LabelCounter, ResolveOptions, resolve_deferred
 
 EXIT_OK = 0
@@ -43,9 +63,22 @@ EXIT_REQUIRED_FAILED = 1
 EXIT_LAUNCH_ERROR = 2
 # A crash loop's backoff starts over once a process has stayed up this long.
 STABLE_UPTIME = 10.0
+# With respawn_backoff > 1 but no respawn_delay, the backoff grows from this (0 * 2**n is 0).
+BACKOFF_BASE = 0.1
 # How long an escaped descendant gets between SIGTERM and SIGKILL at shutdown.
 STRAY_GRACE = 2.0
+# How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
+POLL = 0.05
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+PR_SET_CHILD_SUBREAPER = 36
+
+# ProcessRecord.state values.
+RUNNING = "running"
+STOPPING = "stopping"
+RESTARTING = "restarting"
+FINISHED = "finished"
+FAILED = "failed"
+GAVE_UP = "gave up"
 
 
 @dataclass(order=True)
@@ -59,19 +92,46 @@ class _Timer:
 
 
 @dataclass
-class Summary:
-    """What happened to one process over the run (for the exit table)."""
+class ProcessRecord:
+    """One process label over the whole run (all its respawns): for the status view and summary."""
 
     label: str
-    returncode: int | None = None
+    spec: ProcessSpec
+    state: str = RUNNING
+    pid: int = 0
+    started_at: float = 0.0
     restarts: int = 0
+    # Quick exits in a row: the exponent of the crash-loop backoff.
+    streak: int = 0
+    returncode: int | None = None
+    outcome: str = ""
+    failed: bool = False
     run_time: float = 0.0
     peak_rss: int = 0
+    cpu_time: float = 0.0
+    restart_at: float | None = None
     signals: list[int] = field(default_factory=list)
 
 
+def respawn_delay(policy: RespawnPolicy, streak: int) -> float:
+    """The wait before the next start: ``delay``, then growing by ``backoff`` per quick exit.
+
+    Capped at ``max_delay`` (or ``delay`` if that is larger).
+    """
+    if streak <= 0 or policy.backoff <= 1.0:
+        return policy.delay
+    base = policy.delay or BACKOFF_BASE
+    cap = max(policy.max_delay, policy.delay)
+    return min(base * policy.backoff ** min(streak, 64), cap)
+
+
 class Supervisor:
-    """Runs a Plan. Seams (printer, clock) are constructor arguments."""
+    """Runs a Plan. Seams (printer, clock, guard, run id) are constructor arguments.
+
+    ``adopt``: become the subreaper and end every descendant at shutdown; an embedder with
+    children of its own passes False (the run's processes are still found by their marker).
+    ``stray_grace``: seconds between SIGTERM and SIGKILL for a stray descendant.
+    """
 
     def __init__(
         self,
@@ -82,6 +142,10 @@ class Supervisor:
         labels: LabelCounter | None = None,
         clock: Callable[[], float] = time.monotonic,
         install_signals: bool = True,
+        guard: guards.Guard | None = None,
+        run_id: str | None = None,
+        adopt: bool = True,
+        stray_grace: float = STRAY_GRACE,
     ) -> None:
         self.plan = plan
         self.printer = printer
@@ -89,12 +153,16 @@ class Supervisor:
         self.labels = labels or LabelCounter()
         self.clock = clock
         self.install_signals = install_signals
+        self.guard = guard
+        self.run_id = run_id or guards.new_run_id()
+        self.adopt = adopt
+        self.stray_grace = stray_grace
         self.selector = selectors.DefaultSelector()
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
         self.handlers: list[AddHandler] = []
-        self.summaries: dict[str, Summary] = {}
+        self.records: dict[str, ProcessRecord] = {}
         self._timers: list[_Timer] = []
         self._seq = itertools.count()
         self._signals: list[int] = []
@@ -105,6 +173,9 @@ class Supervisor:
         self._stop_presses = 0
         self._wake_r = self._wake_w = -1
         self._subreaper = False
+        self._kill_now = False
+        self._marker_env = {guards.MARKER: self.run_id}
+        self._core: tuple[str, bool, int] | None = None
         self.event_hooks: dict[type, Callable[[Any], None]] = {}
         self.listeners: list[Callable[[str, Process], None]] = []
         self._stray_seen: dict[int, float] = {}
@@ -118,11 +189,18 @@ class Supervisor:
             for warning in self.plan.warnings:
                 self.printer.message("WARNING", "launch", warning)
             self.execute(self.plan.steps)
-            self._become_subreaper()
+            # After the first spawns, not before: ctypes costs milliseconds and the first child
+            # should not wait for it. An orphan from that window is still found by its marker.
+            if self.adopt:
+                self._set_subreaper(True)
             while not self._finished():
                 self._loop_once()
-            self._sweep_descendants()
+        except BaseException:
+            self._emergency_stop()
+            raise
         finally:
+            if self._subreaper:
+                self._set_subreaper(False)
             self._restore_signals()
             self.printer.flush()
         return self.exit_code
@@ -131,6 +209,9 @@ class Supervisor:
         timeout = self._next_timeout()
         if timeout is None or timeout > 0:
             self.printer.flush()
+            if self.printer.blocked():
+                # The terminal is behind: come back soon to hand it the rest of the backlog.
+                timeout = POLL if timeout is None else min(timeout, POLL)
         ready = self.selector.select(timeout)
         for key, _ in ready:
             key.data(key.fd)
@@ -145,7 +226,7 @@ class Supervisor:
                 return False
             # Idle: nothing runs and nothing is pending, as ROS 2's idle shutdown.
             self.begin_shutdown("idle")
-        if any(p.check_group() for p in self.lingering):
+        if self._lingering_pending():
             return False
         if self._strays_pending():
             return False
@@ -157,27 +238,39 @@ class Supervisor:
                     process.close_stream(fd)
         return True
 
-    def _strays_pending(self) -> bool:
-        """Descendants that left their group (setsid) are still ours as subreaper: end them.
+    def _lingering_pending(self) -> bool:
+        """Groups whose leader is gone but a member lives on (a grandchild in the same group)."""
+        for process in list(self.lingering):
+            if not process.check_group():
+                self.lingering.remove(process)
+                if self.guard is not None:
+                    self.guard.forget(process.pid)
+        return bool(self.lingering)
 
-        SIGTERM first, SIGKILL after STRAY_GRACE seconds; True while any is alive.
+    def _strays_pending(self) -> bool:
+        """Processes of the run outside every group we watch: end them; True while any lives.
+
+        A stray is a descendant (we are its subreaper) or a process carrying the run's marker
+        (it escaped before the subreaper was set, or was re-parented elsewhere). SIGTERM and
+        SIGCONT first, SIGKILL after ``stray_grace`` (at once after a second Ctrl-C).
         """
-        if not self._subreaper:
-            return False
-        strays = self._stray_descendants()
+        strays = self._strays()
         if not strays:
             return False
         now = self.clock()
         for proc in strays:
             first = self._stray_seen.setdefault(proc.pid, now)
-            sig = signal.SIGKILL if now - first >= STRAY_GRACE else signal.SIGTERM
+            late = self._kill_now or now - first >= self.stray_grace
+            sig = signal.SIGKILL if late else signal.SIGTERM
             if (proc.pid, sig) in self._stray_signalled:
                 continue
             self._stray_signalled.add((proc.pid, sig))
+            name = _comm(proc.pid)
             try:
-                name = proc.name()
-                proc.send_signal(sig)
-            except Exception:
+                os.kill(proc.pid, sig)
+                if sig == signal.SIGTERM:
+                    os.kill(proc.pid, signal.SIGCONT)
+            except OSError:
                 continue
             self.printer.message(
                 "WARNING",
@@ -186,32 +279,25 @@ class Supervisor:
             )
         return True
 
-    def _stray_descendants(self) -> list[Any]:
-        try:
-            import psutil
-        except ImportError:
-            return []
-        try:
-            children = psutil.Process().children(recursive=True)
-        except psutil.Error:
-            return []
-        out = []
-        for child in children:
-            try:
-                if child.status() != psutil.STATUS_ZOMBIE:
-                    out.append(child)
-            except psutil.Error:
-                continue
-        return out
+    def _strays(self) -> list[guards.ProcInfo]:
+        procs = guards.scan()
+        found = {p.pid: p for p in guards.marked(self.run_id, procs)}
+        if self._subreaper or self.adopt:
+            found.update((p.pid, p) for p in guards.descendants(os.getpid(), procs))
+        if self.guard is not None:
+            found.pop(self.guard.pid, None)
+        for pid in self.by_pid:  # our own children are the ladder's business
+            found.pop(pid, None)
+        return list(found.values())
 
     def _next_timeout(self) -> float | None:
         while self._timers and self._timers[0].cancelled:
             heapq.heappop(self._timers)
-        polling = bool(self.lingering or self._stray_seen)
+        polling = self.shutting_down and bool(self.lingering or self._stray_seen)
         if not self._timers:
-            return 0.05 if polling else None
+            return POLL if polling else None
         delay = max(0.0, self._timers[0].when - self.clock())
-        return min(delay, 0.05) if polling else delay
+        return min(delay, POLL) if polling else delay
 
     def schedule(
         self,
@@ -221,6 +307,11 @@ class Supervisor:
         keeps_alive: bool = True,
         cancel_on_shutdown: bool = True,
     ) -> _Timer:
+        """Call ``callback`` from the loop after ``delay`` seconds.
+
+        ``keeps_alive`` False: the timer alone does not keep an idle launch running (a status
+        refresh); ``cancel_on_shutdown`` False: it still fires while shutting down (the ladder).
+        """
         timer = _Timer(
             self.clock() + delay, next(self._seq), callback, keeps_alive, cancel_on_shutdown
         )
@@ -314,6 +405,7 @@ class Supervisor:
         return [p for p in self.processes if p.running and (matcher is None or matcher(p))]
 
     # --- processes ---------------------------------------------------------------------------
+    # --- processes ---------------------------------------------------------------------------
 
     def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
         if self.shutting_down:
@@ -321,23 +413,30 @@ class Supervisor:
             return None
         process = Process(spec, index=next(self._index), restarts=restarts)
         self.printer.register(spec.label, process.index)
+        record = self.records.get(spec.label)
+        if record is None:
+            record = self.records[spec.label] = ProcessRecord(spec.label, spec)
+        record.restarts, record.restart_at = restarts, None
         if spec.standin and restarts == 0:
             self.printer.message(
                 "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
             )
         try:
-            process.spawn(self.clock)
+            process.spawn(self.clock, self._marker_env)
         except OSError as e:
-            self.printer.message(
-                "ERROR", spec.label, f"failed to start {spec.argv[0]!r}: {e.strerror or e}"
-            )
+            reason = e.strerror or str(e)
+            self.printer.message("ERROR", spec.label, f"failed to start {spec.argv[0]!r}: {reason}")
             process.returncode = 127
             self.processes.append(process)
-            self._record(process)
+            record.state, record.failed, record.returncode = FAILED, True, 127
+            record.outcome = f"failed to start: {reason}"
             self._after_exit(process)
             return process
+        if self.guard is not None:
+            self.guard.watch(process.pid, spec.sigkill_timeout)
         self.processes.append(process)
         self.by_pid[process.pid] = process
+        record.state, record.pid, record.started_at = RUNNING, process.pid, process.started_at
         for fd in process.streams:
             self.selector.register(
                 fd, selectors.EVENT_READ, lambda fd, p=process: self._readable(p, fd)
@@ -408,27 +507,27 @@ class Supervisor:
                 if eof:
                     self.selector.unregister(fd)
                     process.close_stream(fd)
-                    break
-                if not data:
-                    break
 
     def _reap(self) -> None:
         while True:
             try:
-                pid, status = os.waitpid(-1, os.WNOHANG)
+                pid, status, rusage = os.wait4(-1, os.WNOHANG)
             except ChildProcessError:
                 return
             if pid == 0:
                 return
             process = self.by_pid.pop(pid, None)
             if process is None:
-                continue  # an orphaned grandchild we adopted as subreaper
-            process.reaped(status, self.clock)
+                continue  # an orphaned grandchild we adopted as subreaper, or the guard
+            process.reaped(status, self.clock, rusage)
+            # Its last words first: what is still in the pipes, then the partial last line.
             self._drain(process)
             self._flush_partial(process)
-            self._record(process)
             if process.check_group():
                 self.lingering.append(process)
+            elif self.guard is not None:
+                self.guard.forget(process.pid)
+            self._record_exit(process)
             self._after_exit(process)
 
     def _flush_partial(self, process: Process) -> None:
@@ -438,12 +537,25 @@ class Supervisor:
                 data, stream.partial = stream.partial + b"\n", b""
                 self.printer.output(process.label, stream.name, process.spec.output, data)
 
-    def _record(self, process: Process) -> None:
-        s = self.summaries.setdefault(process.label, Summary(process.label))
-        s.returncode = process.returncode
-        s.restarts = process.restarts
-        s.run_time += max(0.0, process.ended_at - process.started_at) if process.started_at else 0.0
-        s.signals.extend(process.signals_sent)
+    def _record_exit(self, process: Process) -> None:
+        record = self.records[process.label]
+        code = process.returncode if process.returncode is not None else 0
+        record.returncode = code
+        record.run_time += max(0.0, process.ended_at - process.started_at)
+        record.peak_rss = max(record.peak_rss, process.peak_rss)
+        record.cpu_time += process.cpu_time
+        record.signals.extend(process.signals_sent)
+        record.failed = False
+        if process.stopping:
+            record.outcome = _stopped_outcome(process, code)
+        elif code == 0:
+            record.outcome = "finished cleanly"
+        else:
+            record.failed = True
+            record.outcome = describe_status(code) + (
+                " (core dumped)" if process.core_dumped else ""
+            )
+        record.state = FAILED if record.failed else FINISHED
 
     def _after_exit(self, process: Process) -> None:
         spec = process.spec
@@ -460,20 +572,20 @@ class Supervisor:
             returncode=code,
         )
         self._dispatch("process_exit", process, event)
-        required = spec.required and not process.stopping
-        if required:
-            # Before on_exit runs, so the reason names the process rather than the bare
-            # Shutdown() its on_exit holds.
+        if spec.on_exit is not None:
+            self.fire(spec.on_exit, event)
+        if spec.required and not process.stopping:
+            # A required process decides the run: it ends it, and its failure is the run's.
             if code != 0:
                 self.exit_code = max(self.exit_code, EXIT_REQUIRED_FAILED)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
-        if spec.on_exit is not None:
-            self.fire(spec.on_exit, event)
-        if not required:
-            self._maybe_respawn(process, code)
+            return
+        self._maybe_respawn(process, code)
 
     def _report_exit(self, process: Process, code: int) -> None:
         label, pid = process.label, process.pid
+        if not pid:
+            return  # never started: "failed to start" said it all
         if code == 0:
             self.printer.message("INFO", label, f"process has finished cleanly [pid {pid}]")
             return
@@ -485,9 +597,32 @@ class Supervisor:
         what = describe_status(code)
         if process.core_dumped:
             what += " (core dumped)"
-        cmd = " ".join(process.argv)
+        # ROS 2's format; a newline inside an argument (python -c code) is shown escaped so that
+        # the message stays one line.
+        cmd = " ".join(process.argv).replace("\n", "\\n")
         self.printer.message(
             "ERROR", label, f"process has died [pid {pid}, exit code {code}, cmd '{cmd}']: {what}"
+        )
+        if code < 0 and not process.stopping:
+            hint = self._core_hint(process, -code)
+            if hint:
+                self.printer.message("INFO", label, hint)
+
+    def _core_hint(self, process: Process, signal_number: int) -> str | None:
+        if self._core is None:
+            pattern, uses_pid = read_core_pattern()
+            self._core = (pattern, uses_pid, core_limit())
+        pattern, uses_pid, limit = self._core
+        spec = process.spec
+        return core_dump_hint(
+            pid=process.pid,
+            signal_number=signal_number,
+            dumped=process.core_dumped,
+            executable="/bin/sh" if spec.shell else spec.argv[0],
+            cwd=spec.cwd or os.getcwd(),
+            pattern=pattern,
+            uses_pid=uses_pid,
+            limit=limit,
         )
 
     def _maybe_respawn(self, process: Process, code: int) -> None:
@@ -496,31 +631,35 @@ class Supervisor:
             return
         if policy.mode == "on-failure" and code == 0:
             return
-        if 0 <= policy.max_retries <= process.restarts:
+        record = self.records[process.label]
+        if 0 <= policy.max_retries <= record.restarts:
+            record.state = GAVE_UP
+            record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
             self.printer.message(
                 "ERROR",
                 process.label,
-                f"giving up after {process.restarts} restarts ({describe_status(code)})",
+                f"giving up after {record.restarts} restarts ({describe_status(code)})",
             )
             return
-        uptime = process.ended_at - process.started_at
-        streak = getattr(process, "streak", 0)
-        streak = 0 if uptime >= STABLE_UPTIME else streak
-        delay = min(policy.delay * (policy.backoff**streak), max(policy.max_delay, policy.delay))
-        attempt = process.restarts + 1
+        if process.ended_at - process.started_at >= STABLE_UPTIME:
+            record.streak = 0  # it ran well for a while: not a crash loop
+        delay = respawn_delay(policy, record.streak)
+        record.streak += 1
+        attempt = record.restarts + 1
         limit = "" if policy.max_retries < 0 else f"/{policy.max_retries}"
         self.printer.message(
             "WARNING",
             process.label,
-            f"{describe_status(code)}, restart {attempt}{limit} in {delay:.1f} s",
+            f"{describe_status(code)}, restart {attempt}{limit} in {_seconds(delay)} s",
         )
+        record.state, record.restart_at = RESTARTING, self.clock() + delay
+        self.schedule(delay, lambda: self._respawn(process, attempt))
 
-        def again() -> None:
-            new = self.start(process.spec, restarts=attempt)
-            if new is not None:
-                new.streak = streak + 1  # type: ignore[attr-defined]
-
-        self.schedule(delay, again)
+    def _respawn(self, old: Process, attempt: int) -> None:
+        """Start the same spec again (same argv, label, temp files); forget the old instance."""
+        if not old.streams and old not in self.lingering and old in self.processes:
+            self.processes.remove(old)  # a crash loop must not grow the list forever
+        self.start(old.spec, restarts=attempt)
 
     # --- stopping ----------------------------------------------------------------------------
 
@@ -533,7 +672,10 @@ class Supervisor:
             self.printer.message("INFO", "launch", f"shutting down: {reason}")
         for timer in self._timers:
             if timer.cancel_on_shutdown:
-                timer.cancelled = True
+                timer.cancelled = True  # pending respawns and TimerActions included
+        for record in self.records.values():
+            if record.state == RESTARTING:
+                record.state, record.restart_at = (FAILED if record.failed else FINISHED), None
         self._dispatch(
             "shutdown",
             None,
@@ -551,8 +693,10 @@ class Supervisor:
         if process.stopping:
             return
         process.stopping = True
+        if process.running:
+            self.records[process.label].state = STOPPING
         spec = process.spec
-        if not process.signal_group(signal.SIGINT):
+        if not process.signal_group(signal.SIGINT, wake=True):
             return
 
         def escalate(sig: int, waited: float, next_step: Callable[[], None] | None) -> None:
@@ -564,7 +708,7 @@ class Supervisor:
                 f"failed to terminate {waited:g} s after {signal_name(process.signals_sent[-1])},"
                 f" escalating to {signal_name(sig)} [pid {process.pid}]",
             )
-            process.signal_group(sig)
+            process.signal_group(sig, wake=True)
             if next_step is not None:
                 next_step()
 
@@ -582,41 +726,29 @@ class Supervisor:
         )
 
     def kill_everything(self) -> None:
-        """A second Ctrl-C: SIGKILL every group at once."""
+        """A second Ctrl-C: SIGKILL every group and every stray at once."""
         self.printer.message("WARNING", "launch", "stopping now: SIGKILL to every process")
+        self._kill_now = True
         for process in self.processes + self.lingering:
             if process.running or process.check_group():
                 process.stopping = True
                 process.signal_group(signal.SIGKILL)
-        self._sweep_descendants()
+        self.begin_shutdown("killed")
 
-    def _sweep_descendants(self) -> None:
-        """End anything still descended from mlaunch (an escaped grandchild) before exiting."""
-        if not self._subreaper:
-            return
+    def _emergency_stop(self) -> None:
+        """The loop itself failed: kill everything we know of before the error propagates."""
         try:
-            import psutil
-        except ImportError:
-            return
-        try:
-            strays = psutil.Process().children(recursive=True)
-        except psutil.Error:
-            return
-        strays = [
-            p for p in strays if p.pid not in self.by_pid and p.status() != psutil.STATUS_ZOMBIE
-        ]
-        for stray in strays:
-            try:
-                name = stray.name()
-                stray.kill()
-                self.printer.message(
-                    "WARNING", "launch", f"killed stray descendant {name} [pid {stray.pid}]"
-                )
-            except psutil.Error:
-                pass
-        if strays:
-            psutil.wait_procs(strays, timeout=1.0)
-        self._reap()
+            for process in self.processes + self.lingering:
+                if process.running or process.check_group():
+                    process.signal_group(signal.SIGKILL)
+            for proc in self._strays():
+                try:
+                    os.kill(proc.pid, signal.SIGKILL)
+                except OSError:
+                    pass
+            self._reap()
+        except Exception:
+            pass  # the original error is the one worth reporting
 
     # --- signals -----------------------------------------------------------------------------
 
@@ -625,13 +757,11 @@ class Supervisor:
         os.set_blocking(self._wake_r, False)
         os.set_blocking(self._wake_w, False)
         self.selector.register(self._wake_r, selectors.EVENT_READ, self._drain_wakeup)
-        if not self.install_signals:
-            signal.signal(signal.SIGCHLD, self._record_signal)
-            signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
-            return
         signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
-        for sig in (*STOP_SIGNALS, signal.SIGCHLD):
-            signal.signal(sig, self._record_signal)
+        signal.signal(signal.SIGCHLD, self._record_signal)
+        if self.install_signals:
+            for sig in STOP_SIGNALS:
+                signal.signal(sig, self._record_signal)
 
     def _record_signal(self, signum: int, frame: object) -> None:
         self._signals.append(signum)
@@ -664,10 +794,9 @@ class Supervisor:
 
     def _restore_signals(self) -> None:
         if self.install_signals:
-            for sig in (*STOP_SIGNALS, signal.SIGCHLD):
+            for sig in STOP_SIGNALS:
                 signal.signal(sig, signal.SIG_DFL)
-        else:
-            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+        signal.signal(signal.SIGCHLD, signal.SIG_DFL)
         signal.set_wakeup_fd(-1)
         self.selector.close()
         for fd in (self._wake_r, self._wake_w):
@@ -676,17 +805,38 @@ class Supervisor:
             except OSError:
                 pass
 
-    def _become_subreaper(self) -> None:
-        """Orphaned descendants are re-parented to mlaunch, not to init, so none can escape."""
+    def _set_subreaper(self, on: bool) -> None:
+        """As subreaper, orphaned descendants are re-parented to mlaunch, not to init."""
         try:
             import ctypes
 
             libc = ctypes.CDLL(None, use_errno=True)
-            PR_SET_CHILD_SUBREAPER = 36
-            self._subreaper = libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0
+            ok = libc.prctl(PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0) == 0
         except (OSError, AttributeError):
-            self._subreaper = False
+            ok = False
+        self._subreaper = ok and on
 
     def _notify(self, what: str, process: Process) -> None:
         for listener in self.listeners:
             listener(what, process)
+
+
+def _seconds(value: float) -> str:
+    """``4.0``, ``0.5``, ``0.05``: one decimal unless that would round a short delay away."""
+    return f"{value:.2f}" if 0 < value < 0.1 else f"{value:.1f}"
+
+
+def _stopped_outcome(process: Process, code: int) -> str:
+    if code < 0 and -code in process.signals_sent:
+        return f"stopped by {signal_name(-code)}"
+    if code == 0:
+        return "stopped, exited cleanly"
+    return f"stopped, {describe_status(code)}"
+
+
+def _comm(pid: int) -> str:
+    try:
+        with open(f"/proc/{pid}/comm") as f:
+            return f.read().strip()
+    except OSError:
+        return "?"

@@ -1,0 +1,315 @@
+"""The guard: ends a run's processes when mlaunch itself dies without stopping them (SIGKILL, OOM).
+
+A supervisor can only stop its children while it lives. If mlaunch is killed with SIGKILL, its
+children (each in a session of its own, so no terminal signal reaches them) would run on forever.
+So at start mlaunch forks a tiny guard that holds the read end of a pipe. mlaunch tells it, one
+short line per event, which process groups it started (``+pgid grace``) and which are gone
+(``-pgid``), and says goodbye (``x``) once it has ended everything itself. If the pipe reaches
+EOF without the goodbye, mlaunch is dead: the guard sends SIGTERM (and SIGCONT, for stopped
+processes) to every group it was told about and to every process whose environment carries the
+run's marker (``MLAUNCH_RUN_ID=<id>``, set in every child's environment and inherited by
+grandchildren, so even one that started its own session is found), waits the groups' grace,
+SIGKILLs what is left, removes mlaunch's private temp dir and says what it did on stderr.
+
+Why a forked process and not PR_SET_PDEATHSIG: that needs a preexec_fn in every spawn (slow,
+and unsafe with threads) and never reaches grandchildren. A fork costs about a millisecond and
+runs code already loaded; it never execs, imports nothing new until it has to clean up, and
+leaves with ``os._exit`` so it never flushes mlaunch's buffers a second time.
+
+The /proc scans here are shared with the supervisor's stray sweep at shutdown.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+MARKER = "MLAUNCH_RUN_ID"
+# How long the guard waits between SIGTERM and SIGKILL when it was told no grace.
+DEFAULT_GRACE = 5.0
+# An upper bound on that wait, whatever the launch file says: nobody is watching any more.
+MAX_GRACE = 30.0
+POLL = 0.02
+
+
+def new_run_id() -> str:
+    """A marker value unique to this run (pid plus random bits, so pid reuse cannot collide)."""
+    return f"{os.getpid()}-{os.urandom(4).hex()}"
+
+
+# --- /proc --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ProcInfo:
+    """The few fields of /proc/<pid>/stat a sweep needs."""
+
+    pid: int
+    ppid: int
+    pgrp: int
+    state: str
+
+    @property
+    def zombie(self) -> bool:
+        return self.state in ("Z", "X")
+
+
+def _read(path: str, limit: int = 1 << 20) -> bytes:
+    fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
+    try:
+        chunks = []
+        size = 0
+        while size < limit:
+            data = os.read(fd, 65536)
+            if not data:
+                break
+            chunks.append(data)
+            size += len(data)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
+
+
+def scan() -> list[ProcInfo]:
+    """Every process visible in /proc (those that vanish while reading are skipped)."""
+    out = []
+    for name in os.listdir("/proc"):
+        if not name.isdigit():
+            continue
+        try:
+            data = _read(f"/proc/{name}/stat")
+        except OSError:
+            continue
+        # The command name is in parentheses and may itself contain ') ': cut at the last one.
+        fields = data[data.rfind(b")") + 2 :].split(b" ", 4)
+        try:
+            out.append(ProcInfo(int(name), int(fields[1]), int(fields[2]), fields[0].decode()))
+        except (IndexError, ValueError):
+            continue
+    return out
+
+
+def descendants(root: int, procs: list[ProcInfo] | None = None) -> list[ProcInfo]:
+    """Living (non-zombie) descendants of ``root``, at any depth."""
+    procs = scan() if procs is None else procs
+    children: dict[int, list[ProcInfo]] = {}
+    for p in procs:
+        children.setdefault(p.ppid, []).append(p)
+    out: list[ProcInfo] = []
+    todo = [root]
+    while todo:
+        for child in children.get(todo.pop(), ()):
+            todo.append(child.pid)
+            if not child.zombie:
+                out.append(child)
+    return out
+
+
+def has_marker(pid: int, run_id: str) -> bool:
+    """Whether ``pid``'s environment carries ``MLAUNCH_RUN_ID=run_id``."""
+    try:
+        env = _read(f"/proc/{pid}/environ")
+    except OSError:
+        return False  # gone, or not ours to read
+    entry = f"{MARKER}={run_id}".encode()
+    return entry in env.split(b"\0")
+
+
+def marked(run_id: str, procs: list[ProcInfo] | None = None) -> list[ProcInfo]:
+    """Living processes of this run, found by the marker in their environment."""
+    procs = scan() if procs is None else procs
+    me = os.getpid()
+    return [p for p in procs if not p.zombie and p.pid != me and has_marker(p.pid, run_id)]
+
+
+# --- the mlaunch side -----------------------------------------------------------------------------
+
+
+class Guard:
+    """mlaunch's end of the pipe to the guard process. Every method is cheap and never blocks."""
+
+    def __init__(self, pid: int, fd: int) -> None:
+        self.pid = pid
+        self.fd = fd
+        self.broken = False
+
+    @classmethod
+    def start(cls, run_id: str, *, temp_dir: str | None = None) -> Guard:
+        """Fork the guard. Call before any child is spawned (so it sees every group)."""
+        r, w = os.pipe()  # both ends close-on-exec: no child inherits them
+        pid = os.fork()
+        if pid == 0:
+            code = 0
+            try:
+                os.close(w)
+                _guard_main(r, run_id, temp_dir)
+            except BaseException:
+                code = 1
+            finally:
+                os._exit(code)  # never return into mlaunch's (or pytest's) stack
+        os.close(r)
+        # A stopped or wedged guard must never stall the supervisor on a full pipe.
+        os.set_blocking(w, False)
+        return cls(pid, w)
+
+    def _send(self, line: bytes) -> None:
+        if self.broken:
+            return
+        try:
+            os.write(self.fd, line)
+        except OSError:
+            self.broken = True  # the guard died or stopped reading: run on without it
+
+    def watch(self, pgid: int, grace: float) -> None:
+        """A process group mlaunch started; ``grace`` is its time between SIGTERM and SIGKILL."""
+        self._send(b"+%d %.3f\n" % (pgid, grace))
+
+    def forget(self, pgid: int) -> None:
+        """The group is empty: its number may be reused by someone else's group."""
+        self._send(b"-%d\n" % pgid)
+
+    def close(self, *, clean: bool = True) -> None:
+        """Say goodbye (nothing is left to end) and wait briefly for the guard to leave."""
+        if self.fd < 0:
+            return
+        if clean:
+            self._send(b"x\n")
+        os.close(self.fd)
+        self.fd = -1
+        deadline = time.monotonic() + 1.0
+        while True:
+            try:
+                pid, _ = os.waitpid(self.pid, os.WNOHANG)
+            except ChildProcessError:
+                return  # already reaped (by the supervisor's SIGCHLD handling)
+            if pid or time.monotonic() > deadline or not clean:
+                return
+            time.sleep(0.002)
+
+
+# --- the guard process ---------------------------------------------------------------------------
+
+
+def _guard_main(fd: int, run_id: str, temp_dir: str | None) -> None:
+    """The forked guard: read the pipe until EOF; without the goodbye, end the run."""
+    parent = os.getppid()
+    os.setsid()  # out of the terminal's process group: Ctrl-C and SIGHUP are mlaunch's to handle
+    signal.set_wakeup_fd(-1)
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP, signal.SIGQUIT, signal.SIGTSTP,
+                signal.SIGTTIN, signal.SIGTTOU, signal.SIGPIPE):  # fmt: skip
+        signal.signal(sig, signal.SIG_IGN)
+    signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+    _keep_only_fds(fd)
+    groups: dict[int, float] = {}
+    clean = False
+    pending = b""
+    while True:
+        data = os.read(fd, 4096)
+        if not data:
+            break
+        *lines, pending = (pending + data).split(b"\n")
+        for line in lines:
+            if line == b"x":
+                clean = True
+            elif line.startswith(b"+"):
+                pgid, _, grace = line[1:].partition(b" ")
+                groups[int(pgid)] = float(grace or DEFAULT_GRACE)
+            elif line.startswith(b"-"):
+                groups.pop(int(line[1:]), None)
+    if clean:
+        return
+    ended = end_run(groups, run_id)
+    removed = _remove_temp_dir(temp_dir)
+    if ended or removed:
+        what = f"ended {ended} of its processes" if ended else "no process was left"
+        if removed:
+            what += f" and removed {temp_dir}"
+        message = (
+            f"[ERROR] [launch.guard]: mlaunch [pid {parent}] died without stopping its processes;"
+            f" {what}\n"
+        )
+        try:
+            os.write(2, message.encode("utf-8", "replace"))
+        except OSError:
+            pass
+
+
+def _keep_only_fds(fd: int) -> None:
+    """Hold nothing of mlaunch's open: no pipe of a child, no log file, not its stdout."""
+    devnull = os.open(os.devnull, os.O_RDWR)
+    os.dup2(devnull, 0)
+    os.dup2(devnull, 1)
+    os.close(devnull)
+    os.closerange(3, fd)
+    os.closerange(fd + 1, 1 << 16)
+
+
+def end_run(groups: dict[int, float], run_id: str) -> int:
+    """SIGTERM (+SIGCONT) every living process of the run, SIGKILL what outlives the grace.
+
+    Returns how many processes were signalled.
+    """
+    living = _living(groups, run_id)
+    if not living:
+        return 0
+    seen = {p.pid for p in living}
+    _signal(living, groups, signal.SIGTERM)
+    grace = min(MAX_GRACE, max(groups.values(), default=DEFAULT_GRACE))
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline:
+        time.sleep(POLL)
+        living = _living(groups, run_id)
+        if not living:
+            return len(seen)
+        new = [p for p in living if p.pid not in seen]
+        if new:  # forked during the grace: they get their SIGTERM too
+            seen.update(p.pid for p in new)
+            _signal(new, (), signal.SIGTERM)
+    # SIGKILL until nothing is left (a process may fork between a scan and the kill).
+    for _ in range(50):
+        living = _living(groups, run_id)
+        if not living:
+            break
+        seen.update(p.pid for p in living)
+        _signal(living, groups, signal.SIGKILL)
+        time.sleep(POLL)
+    return len(seen)
+
+
+def _living(groups: Iterable[int], run_id: str) -> list[ProcInfo]:
+    """Living processes in the watched groups or carrying the run's marker."""
+    procs = scan()
+    wanted = set(groups)
+    me = os.getpid()
+    living = {p.pid: p for p in procs if p.pgrp in wanted and not p.zombie and p.pid != me}
+    living.update((p.pid, p) for p in marked(run_id, procs))
+    return list(living.values())
+
+
+def _signal(procs: list[ProcInfo], groups: Iterable[int], sig: int) -> None:
+    """``sig`` once to each process: by group where the group is watched, else by pid.
+
+    SIGCONT follows SIGTERM so that a stopped process wakes up to handle it.
+    """
+    wanted = set(groups)
+    targets = {(True, p.pgrp) if p.pgrp in wanted else (False, p.pid) for p in procs}
+    for is_group, target in targets:
+        send = os.killpg if is_group else os.kill
+        try:
+            send(target, sig)
+            if sig != signal.SIGKILL:
+                send(target, signal.SIGCONT)
+        except OSError:
+            pass
+
+
+def _remove_temp_dir(temp_dir: str | None) -> bool:
+    if not temp_dir or not os.path.isdir(temp_dir):
+        return False
+    import shutil
+
+    shutil.rmtree(temp_dir, ignore_errors=True)
+    return not os.path.exists(temp_dir)

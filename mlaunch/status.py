@@ -1,0 +1,378 @@
+"""Seeing what runs: the ``--status`` live view and the exit summary.
+
+The live view (rosmon's idea, without taking over the screen) is a table pinned below the
+scrolling output: one row per process with its state, pid, uptime, restarts, CPU and memory (of
+its whole process group, sampled with psutil) and its last output line. It is redrawn about
+twice a second from a supervisor timer, never from a thread, and it owns the screen while it is
+shown: the Printer's screen output goes through it, so each burst of output is written above the
+table by erasing the table, writing the lines and drawing the table again. Scrollback keeps
+every output line and never a copy of the table. rich (to render the table) and psutil are
+imported on the first refresh, after the first processes have started. Without ``--status``
+nothing here is imported but the summary.
+
+The exit summary is a table of every process at the end of a run: its last pid, how it ended,
+restarts, total run time, peak memory and CPU time. It is printed when the run had more than one
+process or anything failed (with ``--quiet``: only when something failed), so a one-process run
+that ends cleanly stays quiet. Peak memory and CPU time come from the kernel (wait4's rusage of
+each exit), exact and free: nothing is sampled and nothing is imported for it.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Iterable
+from typing import Any
+
+from mlaunch.supervisor import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
+
+REFRESH = 0.5
+# The table takes at most this share of the terminal's height; output scrolls above it.
+MAX_SHARE = 0.5
+LAST_LINE = 300
+
+STATE_STYLE = {
+    RUNNING: "green",
+    STOPPING: "yellow",
+    RESTARTING: "yellow",
+    FAILED: "bold red",
+    GAVE_UP: "bold red",
+}
+# Which rows to keep when there are more processes than room: trouble first.
+STATE_ORDER = {FAILED: 0, GAVE_UP: 0, RESTARTING: 1, STOPPING: 2, RUNNING: 3}
+
+
+def format_duration(seconds: float) -> str:
+    """``0.42 s``, ``4.20 s``, ``42.0 s``, ``12:03``, ``1:02:03``."""
+    if seconds < 10:
+        return f"{seconds:.2f} s"
+    if seconds < 60:
+        return f"{seconds:.1f} s"
+    minutes, secs = divmod(int(seconds), 60)
+    if minutes < 60:
+        return f"{minutes}:{secs:02d}"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}"
+
+
+def format_bytes(size: float) -> str:
+    """``812 KiB``, ``35.2 MiB``, ``1.3 GiB``."""
+    if size <= 0:
+        return "-"
+    if size < 1 << 20:
+        return f"{size / 1024:.0f} KiB"
+    if size < 1 << 30:
+        return f"{size / (1 << 20):.1f} MiB"
+    return f"{size / (1 << 30):.1f} GiB"
+
+
+# --- the exit summary -----------------------------------------------------------------------------
+
+
+def summary_wanted(records: Iterable[ProcessRecord], *, quiet: bool = False) -> bool:
+    """More than one process, or any failure (only a failure with ``quiet``)."""
+    records = list(records)
+    failed = any(r.failed or r.state == GAVE_UP for r in records)
+    return failed if quiet else (len(records) > 1 or failed)
+
+
+def render_summary(records: Iterable[ProcessRecord]) -> str:
+    """The summary table as plain text (it goes to the screen and into launch.log)."""
+    head = ("process", "pid", "result", "restarts", "run time", "peak memory", "cpu time")
+    rows = [
+        (
+            r.label,
+            str(r.pid or "-"),
+            r.outcome or r.state,
+            str(r.restarts),
+            format_duration(r.run_time),
+            format_bytes(r.peak_rss),
+            f"{r.cpu_time:.2f} s",
+        )
+        for r in records
+    ]
+    widths = [max(len(row[i]) for row in [head, *rows]) for i in range(len(head))]
+    right = {1, 3, 4, 5, 6}
+
+    def line(cells: tuple[str, ...]) -> str:
+        parts = [
+            c.rjust(w) if i in right else c.ljust(w)
+            for i, (c, w) in enumerate(zip(cells, widths, strict=True))
+        ]
+        return "  " + "  ".join(parts).rstrip()
+
+    failed = sum(1 for r in records if r.failed or r.state == GAVE_UP)
+    title = f"Summary: {len(rows)} process{'es' if len(rows) != 1 else ''}"
+    if failed:
+        title += f", {failed} failed"
+    return "\n".join([title, line(head), *(line(row) for row in rows)]) + "\n"
+
+
+class ExitSummary:
+    """Attached to a supervisor; prints the summary through its printer when the run ends."""
+
+    def __init__(self, supervisor: Any, *, quiet: bool = False) -> None:
+        self.supervisor = supervisor
+        self.quiet = quiet
+
+    def close(self) -> None:
+        records = list(self.supervisor.records.values())
+        if records and summary_wanted(records, quiet=self.quiet):
+            self.supervisor.printer.block(render_summary(records))
+
+
+# --- the live view --------------------------------------------------------------------------------
+
+
+def terminal_size(fd: int = 1) -> tuple[int, int]:
+    try:
+        size = os.get_terminal_size(fd)
+        return size.columns, size.lines
+    except OSError:
+        return 100, 30
+
+
+class StatusView:
+    """The live table. Seams: ``size`` (columns, lines), ``color``, ``period``, ``sampler``.
+
+    ``sampler(pids_by_group) -> {pgid: (cpu_percent, rss)}``; the default uses psutil.
+    """
+
+    def __init__(
+        self,
+        supervisor: Any,
+        *,
+        size: Callable[[], tuple[int, int]] = terminal_size,
+        color: bool = True,
+        period: float = REFRESH,
+        sampler: Callable[[dict[int, list[int]]], dict[int, tuple[float, int]]] | None = None,
+        wall_clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.supervisor = supervisor
+        self.printer = supervisor.printer
+        self.size = size
+        self.color = color
+        self.period = period
+        self.sampler = sampler
+        self.wall_clock = wall_clock
+        self.last_line: dict[str, bytes] = {}
+        self.usage: dict[int, tuple[float, int]] = {}
+        self.frames = 0
+        self._pending: list[bytes] = []
+        self._pending_size = 0
+        self._footer = b""
+        self._drawn = 0  # lines of the table now on screen (the cursor is at its last line's end)
+        self._redraw = False
+        self._closed = False
+        self._psutil: dict[int, Any] = {}
+        self.screen = self.printer.set_screen(self)
+        self.printer.hooks.append(self._saw_output)
+        supervisor.schedule(0.0, self._tick, keeps_alive=False, cancel_on_shutdown=False)
+
+    # --- the screen, as the Printer sees it ----------------------------------------------------
+
+    def __call__(self, data: bytes) -> None:
+        self._pending.append(data)
+        self._pending_size += len(data)
+        if self._pending_size >= 256 * 1024:
+            self.flush()
+
+    @property
+    def blocked(self) -> bool:
+        return bool(getattr(self.screen, "blocked", False))
+
+    def flush(self) -> None:
+        """Output above the table, then the table again: one write, so nothing flickers."""
+        if self._pending or self._redraw:
+            frame = self._erase() + b"".join(self._pending) + self._footer
+            self._drawn = self._footer.count(b"\n") + 1 if self._footer else 0
+            self._pending.clear()
+            self._pending_size = 0
+            self._redraw = False
+            self.frames += 1
+            self.screen(frame)
+        flush = getattr(self.screen, "flush", None)
+        if flush is not None:
+            flush()
+
+    def _erase(self) -> bytes:
+        if not self._drawn:
+            return b""
+        up = b"\x1b[%dA" % (self._drawn - 1) if self._drawn > 1 else b""
+        return b"\r" + up + b"\x1b[J"
+
+    def close(self) -> None:
+        """Take the table off the screen and give the screen back to the Printer."""
+        if self._closed:
+            return
+        self._closed = True
+        self._footer = b""
+        self._redraw = True
+        self.flush()
+        self.printer.set_screen(self.screen)
+        if self._saw_output in self.printer.hooks:
+            self.printer.hooks.remove(self._saw_output)
+
+    # --- what it shows --------------------------------------------------------------------------
+
+    def _saw_output(self, label: str, stream: str, data: bytes) -> None:
+        end = len(data) - 1  # data is complete lines: it ends with a newline
+        start = data.rfind(b"\n", 0, end) + 1
+        self.last_line[label] = data[start : min(end, start + LAST_LINE)]
+
+    def _tick(self) -> None:
+        if self._closed:
+            return
+        self.usage = self._sample()
+        self._footer = self.render().encode("utf-8", "replace")
+        self._redraw = True
+        self.supervisor.schedule(
+            self.period, self._tick, keeps_alive=False, cancel_on_shutdown=False
+        )
+
+    def _groups(self) -> dict[int, list[int]]:
+        """Living members of each running process's group (one /proc scan for all)."""
+        from mlaunch.guard import scan
+
+        running = {p.pid for p in self.supervisor.processes if p.running}
+        groups: dict[int, list[int]] = {pgid: [] for pgid in running}
+        for proc in scan():
+            if proc.pgrp in groups and not proc.zombie:
+                groups[proc.pgrp].append(proc.pid)
+        return groups
+
+    def _sample(self) -> dict[int, tuple[float, int]]:
+        groups = self._groups()
+        if self.sampler is not None:
+            return self.sampler(groups)
+        return self._psutil_sample(groups)
+
+    def _psutil_sample(self, groups: dict[int, list[int]]) -> dict[int, tuple[float, int]]:
+        import psutil
+
+        usage: dict[int, tuple[float, int]] = {}
+        alive: dict[int, Any] = {}
+        for pgid, pids in groups.items():
+            cpu, rss = 0.0, 0
+            for pid in pids:
+                proc = self._psutil.get(pid)
+                try:
+                    if proc is None:
+                        proc = psutil.Process(pid)
+                        proc.cpu_percent(None)  # the first call only starts the measurement
+                    with proc.oneshot():
+                        cpu += proc.cpu_percent(None)
+                        rss += proc.memory_info().rss
+                except psutil.Error:
+                    continue
+                alive[pid] = proc
+            usage[pgid] = (cpu, rss)
+        self._psutil = alive
+        return usage
+
+    def rows(self) -> list[tuple[ProcessRecord, str, str, str, str, str, str]]:
+        """(record, state, pid, uptime, cpu, memory, last line) for each process, as text."""
+        now = self.supervisor.clock()
+        out = []
+        for record in self.supervisor.records.values():
+            running = record.state in (RUNNING, STOPPING)
+            cpu, rss = self.usage.get(record.pid, (0.0, 0)) if running else (0.0, 0)
+            if running:
+                uptime = format_duration(max(0.0, now - record.started_at))
+            elif record.state == RESTARTING and record.restart_at is not None:
+                uptime = f"restart in {max(0.0, record.restart_at - now):.1f} s"
+            else:
+                uptime = "-"
+            out.append(
+                (
+                    record,
+                    record.state,
+                    str(record.pid or "-") if running else "-",
+                    uptime,
+                    f"{cpu:.0f}%" if running else "-",
+                    format_bytes(rss) if running else "-",
+                    _printable(self.last_line.get(record.label, b"")),
+                )
+            )
+        return out
+
+    def render(self) -> str:
+        """The table as terminal text (ANSI styles when ``color``), no trailing newline."""
+        from rich import box
+        from rich.console import Console
+        from rich.table import Table
+        from rich.text import Text
+
+        columns, lines = self.size()
+        rows = self.rows()
+        room = max(1, int(lines * MAX_SHARE) - 4)
+        hidden = 0
+        if len(rows) > room:
+            keep = sorted(range(len(rows)), key=lambda i: (STATE_ORDER.get(rows[i][1], 4), i))
+            kept = set(keep[:room])
+            hidden = len(rows) - room
+            rows = [row for i, row in enumerate(rows) if i in kept]
+        counts: dict[str, int] = {}
+        for record in self.supervisor.records.values():
+            counts[record.state] = counts.get(record.state, 0) + 1
+        title = "mlaunch: " + ", ".join(f"{n} {state}" for state, n in counts.items())
+        if hidden:
+            title += f" ({hidden} not shown)"
+        table = Table(
+            title=Text(title, style="bold"),
+            title_justify="left",
+            box=box.SIMPLE_HEAD,
+            pad_edge=False,
+            show_edge=False,
+            expand=True,
+        )
+        for name, justify in (("process", "left"), ("state", "left"), ("pid", "right"),
+                              ("uptime", "right"), ("restarts", "right"), ("cpu", "right"),
+                              ("memory", "right")):  # fmt: skip
+            table.add_column(name, justify=justify, no_wrap=True)  # type: ignore[arg-type]
+        table.add_column("last output", no_wrap=True, overflow="ellipsis", ratio=1)
+        for record, state, pid, uptime, cpu, rss, last in rows:
+            style = STATE_STYLE.get(state, "dim")
+            table.add_row(
+                Text(record.label),
+                Text(state, style=style),
+                Text(pid),
+                Text(uptime),
+                Text(str(record.restarts)),
+                Text(cpu),
+                Text(rss),
+                Text(last, style="dim"),
+            )
+        import io
+
+        console = Console(
+            file=io.StringIO(),
+            width=max(40, columns - 1),
+            force_terminal=True,
+            color_system="standard" if self.color else None,
+            no_color=not self.color,
+            highlight=False,
+            legacy_windows=False,
+        )
+        console.print(table)
+        return console.file.getvalue().rstrip("\n")  # type: ignore[attr-defined]
+
+
+def _printable(raw: bytes) -> str:
+    """A child's last line without its colours and control characters (they would break rows)."""
+    text = raw.decode("utf-8", "replace")
+    if "\x1b" in text:
+        from rich.text import Text
+
+        text = Text.from_ansi(text).plain
+    return "".join(ch if ch.isprintable() else " " for ch in text).strip()
+
+
+def attach_status_view(supervisor: Any) -> StatusView | None:
+    """The view on a terminal; on anything else a warning (redrawing would fill a log file)."""
+    if not os.isatty(1):
+        supervisor.printer.message(
+            "WARNING", "launch", "--status needs a terminal on stdout; no status view"
+        )
+        return None
+    return StatusView(supervisor, color=bool(getattr(supervisor.printer, "color", True)))
