@@ -13,10 +13,11 @@ in this order of precedence:
 1. explicit paths: ``configure(search_paths=...)`` (the CLI's ``--package-path``), the
    resolver's ``ResolveOptions.package_path`` and ``MLAUNCH_PACKAGE_PATH`` (``os.pathsep``
    separated); each is a package folder or a folder searched for package folders;
-2. the source tree of each launch file in play: from the file's folder, up to the nearest folder
+2. the source tree of each launch file in play (the CLI's launch file, the one being resolved,
+   Python launch files running on the stack): from the file's folder up to the nearest folder
    holding ``.git``, ``pyproject.toml`` or ``COLCON_IGNORE`` (or, failing that, the folder above
    the launch file's own package), then searched;
-3. the same for the current working directory.
+3. for ``mlaunch PKG FILE`` only, the same for the current working directory.
 
 An installed package always wins over a source package of the same name. Source folders are
 only scanned when a name is not installed, and each scan is cached for the life of the process.
@@ -259,18 +260,21 @@ def index(
     launch_files: Iterable[str | None] = (),
     extra_paths: Sequence[str] = (),
     from_callers: bool = False,
+    from_cwd: bool = False,
 ) -> PackageIndex:
     """The index for one lookup: the configuration plus what the caller knows.
 
     ``launch_files`` are the launch files in play (the one being resolved); ``from_callers``
-    adds the launch-file code on the Python stack, for lookups that have no context
-    (``get_package_share_directory`` called while a launch file is loading).
+    adds the launch files whose code is on the Python stack, for lookups that have no context
+    (``get_package_share_directory`` called while a launch file loads); ``from_cwd`` adds the
+    source tree of the working directory (``mlaunch PKG FILE`` has no launch file yet).
     """
     starts: list[str] = []
     candidates: list[str | None] = [*launch_files, _settings.launch_file]
     if from_callers:
-        candidates.extend(_caller_files())
-    candidates.append(os.getcwd())
+        candidates.extend(_launch_files_on_stack())
+    if from_cwd:
+        candidates.append(os.getcwd())
     for item in candidates:
         if item and item not in starts:
             starts.append(item)
@@ -291,19 +295,21 @@ def for_context(context: Any, extra_paths: Sequence[str] = ()) -> PackageIndex:
     )
 
 
-def _caller_files() -> Iterator[str]:
-    """Files on the stack that are user code: not mlaunch, not the standard library or packages."""
-    mlaunch_dir = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
-    prefixes = tuple({sys.prefix, sys.base_prefix, sys.exec_prefix})
+# The module name mlaunch's Python frontend runs a launch file as.
+LAUNCH_MODULE_NAME = "python_launch_file"
+
+
+def _launch_files_on_stack() -> Iterator[str]:
+    """Python launch files whose code is running now (an include loads inside another).
+
+    Only launch files count: a lookup from any other code (a test, a tool) that happens to
+    use the launch_ros names gets no source packages from where that code lives.
+    """
     frame = sys._getframe(1)
     while frame is not None:
         filename = frame.f_code.co_filename
-        if (
-            not filename.startswith("<")
-            and not filename.startswith(mlaunch_dir)
-            and not filename.startswith(prefixes)
-            and os.path.isabs(filename)
-        ):
+        launch_module = frame.f_globals.get("__name__") == LAUNCH_MODULE_NAME
+        if (launch_module or filename.endswith(".launch.py")) and os.path.isabs(filename):
             yield filename
         frame = frame.f_back  # type: ignore[assignment]
 
@@ -419,7 +425,7 @@ def find_launch_file(package: str, file_name: str) -> str:
     As ``ros2 launch``: an os.walk of the share directory for an exact basename; none or more
     than one match is an error.
     """
-    found = index(from_callers=False).get(package)
+    found = index(from_cwd=True).get(package)
     share = found.share_directory
     matches: list[str] = []
     for root, dirs, files in os.walk(share):
