@@ -105,6 +105,7 @@ def description(tmp_path: Path) -> LaunchDescription:
             ),
             SetParameter("global_flag", True),
             SetParameter("global_rate", 2.5),
+            SetParameter("global_list", [1, 2.5]),  # -p global_list:=[1.0, 2.5]
             SetParametersFromFile(str(global_file)),
             SetRemap("/absolute", "/remapped_abs"),
             GroupAction(
@@ -165,6 +166,7 @@ def test_nodes_see_the_command_line_launch_ros_would_give(
         "use_sim_time": ("bool", True),
         "global_flag": ("bool", True),
         "global_rate": ("double", 2.5),
+        "global_list": ("double_array", [1.0, 2.5]),
         "from_global_file": ("string", "g"),
         "int_p": ("integer", 42),
         "float_p": ("double", 1.5),
