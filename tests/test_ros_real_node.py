@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import xacro
 from conftest import requires_rclpy
 from procutil import Running
 
@@ -33,11 +34,12 @@ from mlaunch.ros.actions import (
     apply_options,
 )
 from mlaunch.ros.parameter_descriptions import Parameter, ParameterValue
-from mlaunch.substitutions import LaunchConfiguration
+from mlaunch.substitutions import Command, LaunchConfiguration
 
 pytestmark = [requires_rclpy, pytest.mark.timeout(60)]
 
 INTROSPECT = Path(__file__).resolve().parent / "nodes" / "introspect.py"
+JTBOT = Path(__file__).resolve().parent.parent / "robots/jtbot_description/urdf/jtbot.urdf.xacro"
 
 
 @pytest.fixture(autouse=True)
@@ -89,6 +91,9 @@ def description(tmp_path: Path) -> LaunchDescription:
                 "strs": ["a", "b"],
                 "bools": [True, False],
                 "desc": ParameterValue(lc("f"), value_type=str),
+                "robot_description": ParameterValue(
+                    Command(["xacro ", str(JTBOT)]), value_type=str
+                ),
             },
             str(node_file),
             Parameter("p_rule", 5),
@@ -159,6 +164,8 @@ def test_nodes_see_the_command_line_launch_ros_would_give(
             finally:
                 proc.kill()
 
+    urdf = xacro.process_file(str(JTBOT)).toprettyxml(indent="  ")  # what the program prints
+    assert urdf.count("\n") > 100
     assert (probe["name"], probe["namespace"]) == ("probe", "/fleet/robot1/arm")
     assert probe["fqn"] == "/fleet/robot1/arm/probe"
     assert probe["argv"] == ["--extra"]
@@ -180,6 +187,7 @@ def test_nodes_see_the_command_line_launch_ros_would_give(
         "strs": ("string_array", ["a", "b"]),
         "bools": ("bool_array", [True, False]),
         "desc": ("string", "1.5"),
+        "robot_description": ("string", urdf),
         "from_node_file": ("integer", 7),
         "p_rule": ("integer", 5),
         "p_list": ("integer_array", [1, 2]),
