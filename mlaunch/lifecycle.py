@@ -1,0 +1,745 @@
+"""Managed (lifecycle) nodes in a running launch: bring-up, launch_ros's events, ordered sequences.
+
+What it does, attached to the supervisor when the plan has lifecycle nodes (extensions.ATTACH):
+
+- ``LifecycleNode(..., autostart=True)`` (``lifecycle_node autostart="true"`` in YAML/XML) is
+  driven to ``active`` once its process starts: its ``get_state``/``change_state`` services are
+  awaited with a deadline, then ``configure`` and ``activate`` are asked for, starting from
+  whatever state it is in. A respawned node is driven back to ``active`` the same way.
+- ``EmitEvent(event=ChangeState(lifecycle_node_matcher=..., transition_id=...))`` asks the matched
+  running lifecycle nodes for that transition; ``OnStateTransition`` handlers fire on the
+  ``<node>/transition_event`` messages, as in launch_ros.
+- ``LifecycleSequence(nodes=[...])`` brings nodes up in order, each waiting for the previous one
+  to be active (nav2's lifecycle manager, declared in the launch). In YAML/XML, declare the launch
+  argument ``mlaunch_lifecycle_sequence`` with a literal default listing the nodes (spaces or
+  commas between them), e.g. ``<arg name="mlaunch_lifecycle_sequence" default="/map /amcl"/>``
+  (``mlaunch_lifecycle_sequence:=...`` on the command line overrides it). The nodes of a sequence
+  are driven only by it (their ``autostart`` is ignored).
+- On shutdown, active nodes are deactivated in the reverse order of their activation before
+  their processes get the stop signals (bounded: DEACTIVATE_TIMEOUT per node).
+- A failed transition is printed with the node, the transition and the node's answer. It shuts
+  the launch down with exit status 1 when the launch chose so: ``required=True`` on the node, or
+  ``shutdown_on_failure=True`` (the default) on a sequence.
+
+ROS work goes through ``mlaunch.ros.bridge`` only, from worker threads; results come back to the
+supervisor's loop thread through ``LoopCall`` (a queue and a wakeup pipe in its selector).
+"""
+
+from __future__ import annotations
+
+import os
+import queue
+import re
+import selectors
+import threading
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.actions import Action
+from mlaunch.errors import LaunchFileError
+from mlaunch.plan import AddHandler, Deferred, EmitEvent, ProcessSpec, StartTimer, Step
+from mlaunch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
+
+if TYPE_CHECKING:
+    from mlaunch.process import Process
+    from mlaunch.resolve import Resolver
+    from mlaunch.ros.bridge import RosGraph, TransitionResult
+    from mlaunch.supervisor import Supervisor
+
+# How long a node's lifecycle services may take to appear, and each transition to answer.
+DEFAULT_TIMEOUT = 20.0
+# At shutdown each active node gets this long to deactivate before its stop ladder starts.
+DEACTIVATE_TIMEOUT = 3.0
+SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
+SOURCE = "lifecycle"
+# What a node needs, from each state, to become active.
+TO_ACTIVE: dict[str, tuple[str, ...]] = {
+    "unconfigured": ("configure", "activate"),
+    "inactive": ("activate",),
+    "active": (),
+}
+# ChangeState transition ids (lifecycle_msgs/msg/Transition) -> the bridge's transition labels.
+TRANSITION_LABELS: dict[int, str] = {
+    1: "configure",
+    2: "cleanup",
+    3: "activate",
+    4: "deactivate",
+    5: "shutdown",
+    6: "shutdown",
+    7: "shutdown",
+}
+_NODE_PART = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+# --- handing work back to the supervisor's loop ---------------------------------------------------
+
+
+class LoopCall:
+    """``call_soon(fn)`` from any thread: fn runs in the supervisor's loop thread, in order.
+
+    A queue plus a pipe registered with the supervisor's selector, so a result arriving from a
+    ROS thread wakes the loop at once instead of waiting for its next timer.
+    """
+
+    def __init__(self, selector: selectors.BaseSelector) -> None:
+        self._selector = selector
+        self._queue: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
+        self._read, self._write = os.pipe()
+        os.set_blocking(self._read, False)
+        os.set_blocking(self._write, False)
+        selector.register(self._read, selectors.EVENT_READ, self._run)
+        self._closed = False
+
+    def call_soon(self, fn: Callable[[], None]) -> None:
+        if self._closed:
+            return
+        self._queue.put(fn)
+        try:
+            os.write(self._write, b"x")
+        except (BlockingIOError, OSError):
+            pass  # a full pipe already wakes the loop; a closed one means the run is over
+
+    def _run(self, fd: int) -> None:
+        try:
+            while os.read(fd, 4096):
+                pass
+        except BlockingIOError:
+            pass
+        while True:
+            try:
+                fn = self._queue.get_nowait()
+            except queue.Empty:
+                return
+            fn()
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._selector.unregister(self._read)
+        except (KeyError, ValueError, RuntimeError, AttributeError):
+            pass  # the supervisor closed its selector already
+        for fd in (self._read, self._write):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
+
+
+class SharedGraph:
+    """One private RosGraph, started on first use from whichever thread needs it first."""
+
+    def __init__(self, environ: Mapping[str, str], node_name: str) -> None:
+        self.environ = dict(environ)
+        self.node_name = node_name
+        self._lock = threading.Lock()
+        self._graph: RosGraph | None = None
+        self._closed = False
+
+    def get(self) -> RosGraph:
+        from mlaunch.ros.bridge import GraphNotRunning, RosGraph
+
+        with self._lock:
+            if self._closed:
+                raise GraphNotRunning("the launch is over: the ROS graph bridge is closed")
+            if self._graph is None:
+                graph = RosGraph(node_name=self.node_name, environ=self.environ)
+                graph.start()
+                self._graph = graph
+            return self._graph
+
+    @property
+    def started(self) -> bool:
+        return self._graph is not None
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+            graph, self._graph = self._graph, None
+        if graph is not None:
+            graph.close()
+
+
+# --- the launch-file side -----------------------------------------------------------------------
+
+
+@dataclass
+class SequenceStep(Step):
+    """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order."""
+
+    nodes: tuple[str, ...] = ()
+    shutdown_on_failure: bool = True
+    timeout: float = DEFAULT_TIMEOUT
+
+
+class LifecycleSequence(Action):
+    """Configure and activate lifecycle nodes in order, each once the previous one is active.
+
+    ``nodes`` are node names: absolute (``/robot1/map_server``) or relative to the ROS namespace
+    where the action stands. ``timeout`` bounds each node's wait for its services and each of its
+    transitions. With ``shutdown_on_failure`` a failed transition ends the launch (status 1).
+    """
+
+    def __init__(
+        self,
+        *,
+        nodes: Iterable[SomeSubstitutionsType],
+        shutdown_on_failure: bool = True,
+        timeout: float | SomeSubstitutionsType = DEFAULT_TIMEOUT,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        if isinstance(nodes, str):
+            raise LaunchFileError(
+                f"LifecycleSequence nodes={nodes!r} is a string; give a list of node names",
+                where=self.origin,
+            )
+        self.nodes = [normalize(n) for n in nodes]
+        self.shutdown_on_failure = shutdown_on_failure
+        self.timeout = timeout
+
+    def execute(self, resolver: Resolver) -> None:
+        ctx = resolver.context
+        namespace = str(ctx.launch_configurations.get("ros_namespace") or "/")
+        names = [qualify(perform_substitutions(ctx, n), namespace, self.origin) for n in self.nodes]
+        check_sequence(names, self.origin)
+        timeout = resolver.float_value(self.timeout, "LifecycleSequence timeout", self.origin)
+        if timeout <= 0:
+            raise LaunchFileError(
+                f"LifecycleSequence timeout is {timeout:g}; it must be > 0 seconds",
+                where=self.origin,
+            )
+        resolver.add(
+            SequenceStep(
+                origin=self.origin,
+                nodes=tuple(names),
+                shutdown_on_failure=bool(self.shutdown_on_failure),
+                timeout=timeout,
+            )
+        )
+
+    def describe_short(self) -> str:
+        return f"LifecycleSequence({len(self.nodes)} nodes)"
+
+
+def qualify(name: str, namespace: str, where: str) -> str:
+    """The full name of a node named relative to ``namespace`` (or absolutely)."""
+    name = name.strip()
+    full = name if name.startswith("/") else f"{namespace.rstrip('/')}/{name}"
+    parts = full[1:].split("/")
+    if not name or not all(_NODE_PART.match(p) for p in parts):
+        raise LaunchFileError(
+            f"lifecycle node name {name!r} is not a ROS node name like 'map_server' or"
+            " '/robot1/map_server' (letters, digits, '_'; not starting with a digit)",
+            where=where,
+        )
+    return full
+
+
+def check_sequence(names: list[str], where: str) -> None:
+    if not names:
+        raise LaunchFileError("LifecycleSequence needs at least one node", where=where)
+    seen: set[str] = set()
+    for name in names:
+        if name in seen:
+            raise LaunchFileError(f"LifecycleSequence lists {name!r} twice", where=where)
+        seen.add(name)
+
+
+def sequence_from_arguments(
+    plan_arguments: Mapping[str, Any], given: Mapping[str, str]
+) -> SequenceStep | None:
+    """The YAML/XML form: the ``mlaunch_lifecycle_sequence`` launch argument, if declared."""
+    info = plan_arguments.get(SEQUENCE_ARGUMENT)
+    if info is None and SEQUENCE_ARGUMENT not in given:
+        return None
+    text = given.get(SEQUENCE_ARGUMENT, getattr(info, "default", None) or "")
+    where = getattr(info, "origin", "") or "the command line"
+    names = [qualify(n, "/", where) for n in re.split(r"[\s,]+", text) if n]
+    if not names:
+        return None
+    check_sequence(names, where)
+    return SequenceStep(origin=where, nodes=tuple(names))
+
+
+# --- the running side ---------------------------------------------------------------------------
+
+
+@dataclass
+class Managed:
+    """One lifecycle node of the launch, as the manager knows it."""
+
+    fqn: str
+    spec: ProcessSpec
+    drive: str = ""  # "autostart", "sequence" or "" (only events move it)
+    process: Process | None = None
+    generation: int = 0  # bumped on every exit, so a late result of a dead process is ignored
+    state: str = "unknown"
+    brought_up: bool = False
+    subscribed: bool = False
+
+    @property
+    def required(self) -> bool:
+        return self.spec.required
+
+
+@dataclass
+class Outcome:
+    """A transition result, with why it was asked for (for reports and listeners)."""
+
+    result: TransitionResult
+    reason: str  # autostart, sequence, respawn, event, shutdown
+    shutdown_on_failure: bool = False
+
+
+class LifecycleManager:
+    """Drives the launch's managed nodes; lives in the supervisor's loop thread."""
+
+    def __init__(
+        self,
+        supervisor: Supervisor,
+        *,
+        sequences: Iterable[SequenceStep] = (),
+        timeout: float = DEFAULT_TIMEOUT,
+        deactivate_timeout: float = DEACTIVATE_TIMEOUT,
+    ) -> None:
+        self.supervisor = supervisor
+        self.timeout = timeout
+        self.deactivate_timeout = deactivate_timeout
+        self.sequences = list(sequences)
+        self.nodes: dict[str, Managed] = {}
+        self.outcomes: list[Outcome] = []
+        # Called in the loop thread with each Outcome (the smoke test listens here).
+        self.listeners: list[Callable[[Outcome], None]] = []
+        self.activation_order: list[str] = []
+        self.loop = LoopCall(supervisor.selector)
+        self.graph = SharedGraph(_graph_environ(supervisor), f"_mlaunch_lifecycle_{os.getpid()}")
+        self._threads: list[threading.Thread] = []
+        self._released = True
+        self._held: list[Process] = []
+        self._in_sequence = {name for seq in self.sequences for name in seq.nodes}
+        for spec in supervisor.plan.processes():
+            self._track(spec)
+        supervisor.listeners.append(self._on_process)
+        self._hook_events()
+        self._check_sequences()
+        if self.sequences:
+            # First thing in the loop, after the plan's processes are started.
+            supervisor.schedule(0.0, self._start_sequences, keeps_alive=False)
+
+    def _check_sequences(self) -> None:
+        """Warn about sequence names no LifecycleNode of the plan has (a typo, a namespace)."""
+        known = sorted(self.nodes)
+        for seq in self.sequences:
+            for name in seq.nodes:
+                if name not in self.nodes:
+                    self.supervisor.printer.message(
+                        "WARNING",
+                        SOURCE,
+                        f"lifecycle sequence ({seq.origin}) names {name}, which no LifecycleNode"
+                        f" of this launch has (they are: {', '.join(known) or 'none'});"
+                        " waiting for it anyway",
+                    )
+
+    @classmethod
+    def of(cls, supervisor: Supervisor) -> LifecycleManager | None:
+        """The manager attached to this supervisor, if any (it hooks ChangeState events)."""
+        for hook in supervisor.event_hooks.values():
+            owner = getattr(hook, "__self__", None)
+            if isinstance(owner, cls):
+                return owner
+        return None
+
+    def _hook_events(self) -> None:
+        from mlaunch.ros.events import ChangeState
+
+        self.supervisor.event_hooks[ChangeState] = self._on_change_state
+        # Runs inside begin_shutdown, before it sends the first stop signal.
+        self.supervisor.handlers.append(
+            AddHandler(
+                origin="mlaunch.lifecycle",
+                kind="shutdown",
+                body=Deferred([], _empty_context(), "mlaunch.lifecycle", self._on_shutdown),
+                handler=self,
+            )
+        )
+
+    def _track(self, spec: ProcessSpec) -> Managed | None:
+        info = spec.node
+        if info is None or not info.lifecycle or not info.fully_qualified_name:
+            return None
+        fqn = info.fully_qualified_name
+        managed = self.nodes.get(fqn)
+        if managed is None or managed.spec is not spec:
+            drive = (
+                "sequence" if fqn in self._in_sequence else ("autostart" if info.autostart else "")
+            )
+            managed = Managed(fqn, spec, drive)
+            self.nodes[fqn] = managed
+        return managed
+
+    # --- process events (loop thread) ----------------------------------------------------------
+
+    def _on_process(self, what: str, process: Process) -> None:
+        managed = self._track(process.spec)
+        if managed is None:
+            return
+        if what == "exited":
+            managed.process = None
+            managed.generation += 1
+            managed.state = "gone"
+            if managed.fqn in self.activation_order:
+                self.activation_order.remove(managed.fqn)
+            return
+        managed.process = process
+        reason = ""
+        if managed.drive == "autostart" or (managed.drive == "sequence" and managed.brought_up):
+            reason = "respawn" if process.restarts else "autostart"
+        self._spawn(self._started, managed, managed.generation, reason)
+
+    def _start_sequences(self) -> None:
+        for seq in self.sequences:
+            self._spawn(self._run_sequence, seq)
+
+    def _spawn(self, target: Callable[..., None], *args: Any) -> None:
+        if self.supervisor.shutting_down and target != self._deactivate_all:
+            return
+        thread = threading.Thread(target=target, args=args, daemon=True, name="mlaunch-lifecycle")
+        self._threads = [t for t in self._threads if t.is_alive()]
+        self._threads.append(thread)
+        thread.start()
+
+    # --- worker threads -------------------------------------------------------------------------
+
+    def _started(self, managed: Managed, generation: int, reason: str) -> None:
+        """A lifecycle node's process started: watch its transitions, bring it up if asked."""
+        graph = self._graph_or_report(managed.fqn)
+        if graph is None:
+            return
+        if not managed.subscribed:
+            # Subscribed before the first transition is asked for, so handlers see all of them.
+            managed.subscribed = True
+            fqn = managed.fqn
+            try:
+                graph.on_transition(
+                    fqn, lambda ev: self.loop.call_soon(lambda: self._transition(ev))
+                )
+            except Exception as exc:
+                self._post_note("ERROR", f"cannot watch {fqn}/transition_event: {exc}")
+        if not reason:
+            return
+        outcome = self._bring_up(managed.fqn, reason, self.timeout, managed.required)
+        if outcome is not None and outcome.result.ok:
+            self.loop.call_soon(lambda: self._up(managed.fqn, generation))
+
+    def _run_sequence(self, seq: SequenceStep) -> None:
+        for fqn in seq.nodes:
+            outcome = self._bring_up(fqn, "sequence", seq.timeout, seq.shutdown_on_failure)
+            if outcome is None or not outcome.result.ok:
+                return
+            managed = self.nodes.get(fqn)
+            generation = managed.generation if managed is not None else 0
+            self.loop.call_soon(lambda fqn=fqn, g=generation: self._up(fqn, g))  # type: ignore[misc]
+        names = ", ".join(seq.nodes)
+        self._post_note("INFO", f"lifecycle sequence complete: {names} active")
+
+    def _bring_up(
+        self, fqn: str, reason: str, timeout: float, shutdown_on_failure: bool
+    ) -> Outcome | None:
+        """Query the state, then ask for what is missing up to 'active'; None if cancelled."""
+        from mlaunch.ros.bridge import GraphNotRunning, RosBridgeError, TransitionResult
+
+        graph = self._graph_or_report(fqn)
+        if graph is None:
+            return None
+        try:
+            state = graph.lifecycle_state(fqn, timeout)
+        except GraphNotRunning:
+            return None
+        except RosBridgeError as exc:
+            result = TransitionResult(False, fqn, "configure", f"{fqn}: {exc}")
+            return self._post(Outcome(result, reason, shutdown_on_failure))
+        steps = TO_ACTIVE.get(state)
+        if steps is None:
+            detail = f"{fqn} is {state!r}; only an unconfigured or inactive node can be brought up"
+            result = TransitionResult(False, fqn, "configure", detail, state)
+            return self._post(Outcome(result, reason, shutdown_on_failure))
+        outcome = Outcome(TransitionResult(True, fqn, "activate", f"{fqn} is already active"), "")
+        for label in steps:
+            if self.supervisor.shutting_down:
+                return None
+            try:
+                result = graph.change_state(fqn, label, timeout)
+            except GraphNotRunning:
+                return None
+            outcome = self._post(Outcome(result, reason, shutdown_on_failure))
+            if not result.ok:
+                break
+        return outcome
+
+    def _graph_or_report(self, fqn: str) -> RosGraph | None:
+        from mlaunch.ros.bridge import GraphNotRunning, RosBridgeError
+
+        try:
+            return self.graph.get()
+        except GraphNotRunning:
+            return None
+        except RosBridgeError as exc:
+            self._post_note("ERROR", f"cannot drive lifecycle node {fqn}: {exc}")
+            return None
+
+    def _post(self, outcome: Outcome) -> Outcome:
+        self.loop.call_soon(lambda: self._record(outcome))
+        return outcome
+
+    def _post_note(self, level: str, text: str) -> None:
+        self.loop.call_soon(lambda: self.supervisor.printer.message(level, SOURCE, text))
+
+    # --- results (loop thread) ------------------------------------------------------------------
+
+    def _record(self, outcome: Outcome) -> None:
+        self.outcomes.append(outcome)
+        result = outcome.result
+        managed = self.nodes.get(result.node)
+        if managed is not None and result.state:
+            managed.state = result.state
+        printer = self.supervisor.printer
+        if result.ok:
+            printer.message("INFO", SOURCE, result.detail)
+        elif self.supervisor.shutting_down and outcome.reason != "shutdown":
+            printer.message("INFO", SOURCE, f"{result.detail} (the launch is shutting down)")
+        else:
+            why = f" [{outcome.reason}]" if outcome.reason else ""
+            printer.message("ERROR", SOURCE, f"transition failed{why}: {result.detail}")
+            if outcome.shutdown_on_failure and outcome.reason != "shutdown":
+                self.supervisor.exit_code = max(self.supervisor.exit_code, 1)
+                self.supervisor.begin_shutdown(
+                    f"lifecycle node {result.node}: {result.transition} failed"
+                )
+        for listener in self.listeners:
+            listener(outcome)
+
+    def _up(self, fqn: str, generation: int) -> None:
+        managed = self.nodes.get(fqn)
+        if managed is None or managed.generation != generation:
+            return
+        managed.brought_up = True
+        managed.state = "active"
+        if fqn in self.activation_order:
+            self.activation_order.remove(fqn)
+        self.activation_order.append(fqn)
+
+    def _transition(self, event: Any) -> None:
+        """A ``transition_event`` message: track the state, fire OnStateTransition handlers."""
+        from mlaunch.ros.events import StateTransition
+
+        managed = self.nodes.get(event.node)
+        if managed is None:
+            return
+        managed.state = event.goal_state
+        if event.goal_state == "active" and event.node not in self.activation_order:
+            self.activation_order.append(event.node)
+        elif event.goal_state != "active" and event.node in self.activation_order:
+            self.activation_order.remove(event.node)
+        transition = StateTransition(
+            action=managed.spec.action,
+            transition=event.transition,
+            start_state=event.start_state,
+            goal_state=event.goal_state,
+        )
+        self._dispatch(managed.spec, transition)
+
+    def _dispatch(self, spec: ProcessSpec, event: Any) -> None:
+        for handler in list(self.supervisor.handlers):
+            if handler.kind != "state_transition":
+                continue
+            matches = getattr(handler.handler, "matches", None)
+            if matches is not None:
+                if not matches(event):
+                    continue
+            elif handler.matcher is not None and not handler.matcher(spec):
+                continue
+            if handler.once and handler in self.supervisor.handlers:
+                self.supervisor.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, event)
+
+    def _on_change_state(self, event: Any) -> None:
+        """``EmitEvent(event=ChangeState(...))``: the transition, for each matched running node."""
+        label = TRANSITION_LABELS.get(event.transition_id)
+        printer = self.supervisor.printer
+        if label is None:
+            printer.message(
+                "WARNING",
+                SOURCE,
+                f"{event!r}: transition {event.transition_id} cannot be requested from a node;"
+                f" valid ids: {', '.join(f'{k} ({v})' for k, v in TRANSITION_LABELS.items())}",
+            )
+            return
+        matched = [m for m in self.nodes.values() if m.process is not None and _matches(event, m)]
+        if not matched:
+            printer.message("WARNING", SOURCE, f"{event!r} matched no running lifecycle node")
+            return
+        for managed in matched:
+            self._spawn(self._change, managed, label)
+
+    def _change(self, managed: Managed, label: str) -> None:
+        from mlaunch.ros.bridge import GraphNotRunning
+
+        graph = self._graph_or_report(managed.fqn)
+        if graph is None:
+            return
+        try:
+            result = graph.change_state(managed.fqn, label, self.timeout)
+        except GraphNotRunning:
+            return
+        self._post(Outcome(result, "event", managed.required))
+
+    # --- shutdown ----------------------------------------------------------------------------
+
+    def _on_shutdown(self, event: Any, context: Any) -> list[Any]:
+        """Hold the active nodes' processes back from the stop ladder while they deactivate."""
+        targets = [
+            self.nodes[fqn]
+            for fqn in reversed(self.activation_order)
+            if fqn in self.nodes and self.nodes[fqn].process is not None
+        ]
+        held = [m.process for m in targets if m.process is not None and m.process.running]
+        if not held or not self.graph.started:
+            return []
+        # Supervisor.stop() passes over a process already marked stopping, so these keep
+        # running until _release() hands them to the ladder.
+        for process in held:
+            process.stopping = True
+        self._held = held
+        self._released = False
+        bound = self.deactivate_timeout * len(held) + 1.0
+        self.supervisor.schedule(bound, self._release, cancel_on_shutdown=False)
+        self._spawn(self._deactivate_all, [m.fqn for m in targets])
+        return []
+
+    def _deactivate_all(self, names: list[str]) -> None:
+        from mlaunch.ros.bridge import GraphNotRunning
+
+        try:
+            graph = self.graph.get()
+            for fqn in names:
+                result = graph.change_state(fqn, "deactivate", self.deactivate_timeout)
+                self._post(Outcome(result, "shutdown"))
+        except GraphNotRunning:
+            return
+        finally:
+            self.loop.call_soon(self._release)
+
+    def _release(self) -> None:
+        if self._released:
+            return
+        self._released = True
+        for process in self._held:
+            if process.running:
+                process.stopping = False
+                self.supervisor.stop(process)
+        self._held = []
+
+    def close(self) -> None:
+        self.loop.close()
+        self.graph.close()
+        for thread in self._threads:
+            thread.join(timeout=1.0)
+
+
+def _matches(event: Any, managed: Managed) -> bool:
+    """launch_ros matchers take the LifecycleNode action; mlaunch's also take the ProcessSpec."""
+    matcher = event.lifecycle_node_matcher
+    for target in (managed.spec, managed.spec.action):
+        try:
+            if matcher(target):
+                return True
+        except Exception:
+            continue
+    return False
+
+
+def _empty_context() -> Any:
+    from mlaunch.context import LaunchContext
+
+    return LaunchContext(environment={})
+
+
+def _graph_environ(supervisor: Supervisor) -> dict[str, str]:
+    """The environment the managed nodes get (their ROS_DOMAIN_ID), else mlaunch's own."""
+    for spec in supervisor.plan.processes():
+        if spec.node is not None and spec.node.lifecycle:
+            return dict(spec.env)
+    return dict(os.environ)
+
+
+# --- deciding whether to attach -------------------------------------------------------------------
+
+
+def plan_needs_lifecycle(plan: Any) -> bool:
+    """Whether anything in the plan (deferred parts included) is about lifecycle nodes."""
+    for step in plan.steps:
+        if isinstance(step, SequenceStep):
+            return True
+        if isinstance(step, EmitEvent) and type(step.event).__name__ == "ChangeState":
+            return True
+        if isinstance(step, AddHandler) and step.kind == "state_transition":
+            return True
+        spec = getattr(step, "spec", None)
+        if spec is not None and spec.node is not None and spec.node.lifecycle:
+            return True
+        body = step.body if isinstance(step, (StartTimer, AddHandler)) else None
+        if body is not None and _mentions_lifecycle(body.entities, 0):
+            return True
+        on_exit = spec.on_exit if spec is not None else None
+        if on_exit is not None and _mentions_lifecycle(on_exit.entities, 0):
+            return True
+    return False
+
+
+def _mentions_lifecycle(entities: Iterable[Any], depth: int) -> bool:
+    if depth > 20:
+        return False
+    for entity in entities:
+        if getattr(entity, "is_lifecycle", False) or isinstance(entity, LifecycleSequence):
+            return True
+        if type(getattr(entity, "event", None)).__name__ == "ChangeState":
+            return True
+        if getattr(getattr(entity, "event_handler", None), "kind", "") == "state_transition":
+            return True
+        children: list[Any] = []
+        get = getattr(entity, "get_sub_entities", None)
+        if get is not None:
+            children += list(get())
+        children += list(getattr(entity, "entities", []) or [])
+        handler = getattr(entity, "event_handler", None)
+        if handler is not None:
+            children += list(getattr(handler, "entities", []) or [])
+        if children and _mentions_lifecycle(children, depth + 1):
+            return True
+    return False
+
+
+def attach(options: Any, supervisor: Supervisor) -> LifecycleManager | None:
+    """extensions.ATTACH entry: a LifecycleManager when the plan has lifecycle work, else None."""
+    plan = supervisor.plan
+    sequences = [s for s in plan.steps if isinstance(s, SequenceStep)]
+    from_argument = sequence_from_arguments(plan.arguments, getattr(options, "arguments", {}))
+    if from_argument is not None:
+        sequences.append(from_argument)
+    if not sequences and not plan_needs_lifecycle(plan):
+        return None
+    return LifecycleManager(supervisor, sequences=sequences)
+
+
+__all__ = [
+    "DEFAULT_TIMEOUT",
+    "LifecycleManager",
+    "LifecycleSequence",
+    "LoopCall",
+    "SequenceStep",
+    "attach",
+]
