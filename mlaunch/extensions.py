@@ -10,4 +10,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-ATTACH: list[Callable[[Any, Any], Any]] = []
+
+def _lifecycle(options: Any, supervisor: Any) -> Any:
+    """Lifecycle (managed) node driving; None unless the plan has lifecycle work."""
+    from mlaunch.lifecycle import attach
+
+    return attach(options, supervisor)
+
+
+ATTACH: list[Callable[[Any, Any], Any]] = [_lifecycle]
