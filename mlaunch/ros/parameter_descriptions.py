@@ -22,8 +22,6 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import yaml
-
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.substitutions import (
     Substitution,
@@ -203,6 +201,8 @@ def _is_scalar(value: Any, scalar: type) -> bool:
 
 
 def _yaml(text: str, what: str) -> Any:
+    import yaml
+
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as e:
@@ -342,6 +342,8 @@ def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -
         line = text.count("\n", 0, e.index) + 1
         raise SubstitutionFailure(f"{path}:{line}: {e.message}")
     performed = perform_substitutions(context, normalize(parts))
+    import yaml
+
     try:
         yaml.safe_load(performed)
     except yaml.YAMLError as e:

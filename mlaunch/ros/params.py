@@ -22,6 +22,7 @@ writes Python tuples (``!!python/tuple``, which only rcl's lenient parser accept
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 import tempfile
@@ -29,8 +30,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-import yaml
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.ros.parameter_descriptions import (
@@ -214,6 +213,8 @@ def _typed_text(text: str, name: str) -> Any:
 
 
 def _yaml(text: str, name: str) -> Any:
+    import yaml
+
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as e:
@@ -279,7 +280,9 @@ def parameter_rule(name: str, value: Any) -> str:
 
     Text rcl would retype is quoted (see ``params_file_text``).
     """
-    return f"{name}:={yaml.dump(_plain(value), Dumper=_ParamsDumper)}"
+    import yaml
+
+    return f"{name}:={yaml.dump(_plain(value), Dumper=_dumper())}"
 
 
 def global_parameter_rule(name: str, value: Any) -> str:
@@ -289,6 +292,8 @@ def global_parameter_rule(name: str, value: Any) -> str:
     writes the tuple's str() ``(1, 2)``, which the node reads as a string.
     """
     if isinstance(value, (list, tuple)):
+        import yaml
+
         text = yaml.safe_dump(_plain(value), default_flow_style=True, width=2**31).strip()
         return f"{name}:={text}"
     return f"{name}:={value}"
@@ -307,7 +312,9 @@ def params_file_text(node_key: str, params: Mapping[str, Any]) -> str:
     launch file said text. Every other value is written byte for byte as launch_ros writes it.
     """
     document = {node_key: {"ros__parameters": _plain(dict(params))}}
-    return yaml.dump(document, Dumper=_ParamsDumper, default_flow_style=False)
+    import yaml
+
+    return yaml.dump(document, Dumper=_dumper(), default_flow_style=False)
 
 
 def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | None) -> str:
@@ -357,16 +364,23 @@ def rcl_reads_as_text(text: str) -> bool:
     return text not in _RCL_BOOLS and _RCL_NUMBER.fullmatch(text) is None
 
 
-class _ParamsDumper(yaml.Dumper):
-    """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype."""
+@functools.cache
+def _dumper() -> Any:
+    """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype.
 
+    Built on first use: PyYAML is imported only by launches that write parameters.
+    """
+    import yaml
 
-def _represent_text(dumper: yaml.Dumper, data: _TextValue) -> yaml.ScalarNode:
-    style = None if rcl_reads_as_text(data) else "'"
-    return dumper.represent_scalar("tag:yaml.org,2002:str", str(data), style=style)
+    def represent_text(dumper: yaml.Dumper, data: _TextValue) -> yaml.ScalarNode:
+        style = None if rcl_reads_as_text(data) else "'"
+        return dumper.represent_scalar("tag:yaml.org,2002:str", str(data), style=style)
 
+    class ParamsDumper(yaml.Dumper):
+        pass
 
-_ParamsDumper.add_representer(_TextValue, _represent_text)
+    ParamsDumper.add_representer(_TextValue, represent_text)
+    return ParamsDumper
 
 
 __all__ = [
