@@ -447,6 +447,7 @@ def test_global_parameter_values_use_python_str_and_yaml_lists(prefix: Path, tem
         SetParameter("text", "true"),
         SetParameter("subst", LaunchConfiguration("v")),
         SetParameter("numbers", [1, 2.5]),
+        SetParameter("names", ["a b", "y"]),
         SetParameter(["na", "me"], "x"),
         Node(package="demo", executable="talker"),
     ]
@@ -461,6 +462,8 @@ def test_global_parameter_values_use_python_str_and_yaml_lists(prefix: Path, tem
         "subst:=3",
         "-p",
         "numbers:=[1.0, 2.5]",
+        "-p",
+        "names:=[a b, 'y']",
         "-p",
         "name:=x",
     ]

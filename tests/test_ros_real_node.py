@@ -111,6 +111,7 @@ def description(tmp_path: Path) -> LaunchDescription:
             SetParameter("global_flag", True),
             SetParameter("global_rate", 2.5),
             SetParameter("global_list", [1, 2.5]),  # -p global_list:=[1.0, 2.5]
+            SetParameter("global_names", ["a b", "y"]),  # -p global_names:=[a b, 'y']
             SetParametersFromFile(str(global_file)),
             SetRemap("/absolute", "/remapped_abs"),
             GroupAction(
@@ -174,6 +175,7 @@ def test_nodes_see_the_command_line_launch_ros_would_give(
         "global_flag": ("bool", True),
         "global_rate": ("double", 2.5),
         "global_list": ("double_array", [1.0, 2.5]),
+        "global_names": ("string_array", ["a b", "y"]),
         "from_global_file": ("string", "g"),
         "int_p": ("integer", 42),
         "float_p": ("double", 1.5),

@@ -294,7 +294,8 @@ def global_parameter_rule(name: str, value: Any) -> str:
     if isinstance(value, (list, tuple)):
         import yaml
 
-        text = yaml.safe_dump(_plain(value), default_flow_style=True, width=2**31).strip()
+        flow = yaml.dump(_plain(value), Dumper=_dumper(), default_flow_style=True, width=2**31)
+        text = flow.strip()
         return f"{name}:={text}"
     return f"{name}:={value}"
 
