@@ -18,4 +18,21 @@ def _lifecycle(options: Any, supervisor: Any) -> Any:
     return attach(options, supervisor)
 
 
-ATTACH: list[Callable[[Any, Any], Any]] = [_lifecycle]
+def _status_view(options: Any, supervisor: Any) -> Any:
+    """``--status``: the live table pinned below the output (rich and psutil, only then)."""
+    if not getattr(options, "status", False):
+        return None
+    from mlaunch.status import attach_status_view
+
+    return attach_status_view(supervisor)
+
+
+def _exit_summary(options: Any, supervisor: Any) -> Any:
+    """The table of every process at the end (more than one process, or any failure)."""
+    from mlaunch.status import ExitSummary
+
+    return ExitSummary(supervisor, quiet=bool(getattr(options, "quiet", False)))
+
+
+# Closed in this order at the end: the status view leaves the screen before the summary prints.
+ATTACH: list[Callable[[Any, Any], Any]] = [_lifecycle, _status_view, _exit_summary]

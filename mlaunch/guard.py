@@ -248,35 +248,31 @@ def _keep_only_fds(fd: int) -> None:
 
 
 def end_run(groups: dict[int, float], run_id: str) -> int:
-    """SIGTERM (+SIGCONT) every living process of the run, SIGKILL what outlives the grace.
+    """SIGTERM (+SIGCONT) every living process of the run, SIGKILL what outlives its grace.
 
-    Returns how many processes were signalled.
+    A process in a watched group gets that group's grace (its sigkill_timeout); one found only
+    by the marker gets the longest. Returns how many processes were signalled.
     """
-    living = _living(groups, run_id)
-    if not living:
-        return 0
-    seen = {p.pid for p in living}
-    _signal(living, groups, signal.SIGTERM)
-    grace = min(MAX_GRACE, max(groups.values(), default=DEFAULT_GRACE))
-    deadline = time.monotonic() + grace
-    while time.monotonic() < deadline:
-        time.sleep(POLL)
-        living = _living(groups, run_id)
-        if not living:
-            return len(seen)
-        new = [p for p in living if p.pid not in seen]
-        if new:  # forked during the grace: they get their SIGTERM too
-            seen.update(p.pid for p in new)
-            _signal(new, (), signal.SIGTERM)
-    # SIGKILL until nothing is left (a process may fork between a scan and the kill).
-    for _ in range(50):
+    start = time.monotonic()
+    longest = min(MAX_GRACE, max(groups.values(), default=DEFAULT_GRACE))
+    first_seen: dict[int, float] = {}
+    killed: set[int] = set()
+    while time.monotonic() - start < longest + 5.0:
         living = _living(groups, run_id)
         if not living:
             break
-        seen.update(p.pid for p in living)
-        _signal(living, groups, signal.SIGKILL)
+        now = time.monotonic()
+        for proc in living:
+            if proc.pid not in first_seen:
+                first_seen[proc.pid] = now
+                _send(proc.pid, signal.SIGTERM)
+                _send(proc.pid, signal.SIGCONT)  # a stopped process must wake up to die
+            grace = min(MAX_GRACE, groups.get(proc.pgrp, longest))
+            if now - first_seen[proc.pid] >= grace and proc.pid not in killed:
+                killed.add(proc.pid)
+                _send(proc.pid, signal.SIGKILL)
         time.sleep(POLL)
-    return len(seen)
+    return len(first_seen)
 
 
 def _living(groups: Iterable[int], run_id: str) -> list[ProcInfo]:
@@ -289,21 +285,11 @@ def _living(groups: Iterable[int], run_id: str) -> list[ProcInfo]:
     return list(living.values())
 
 
-def _signal(procs: list[ProcInfo], groups: Iterable[int], sig: int) -> None:
-    """``sig`` once to each process: by group where the group is watched, else by pid.
-
-    SIGCONT follows SIGTERM so that a stopped process wakes up to handle it.
-    """
-    wanted = set(groups)
-    targets = {(True, p.pgrp) if p.pgrp in wanted else (False, p.pid) for p in procs}
-    for is_group, target in targets:
-        send = os.killpg if is_group else os.kill
-        try:
-            send(target, sig)
-            if sig != signal.SIGKILL:
-                send(target, signal.SIGCONT)
-        except OSError:
-            pass
+def _send(pid: int, sig: int) -> None:
+    try:
+        os.kill(pid, sig)
+    except OSError:
+        pass
 
 
 def _remove_temp_dir(temp_dir: str | None) -> bool:

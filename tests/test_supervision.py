@@ -618,26 +618,43 @@ def test_logfile_keeps_lines_whole_across_rotation(tmp_path: Path) -> None:
 # --- crashes and core dumps ---------------------------------------------------------------------
 
 
+def hint_for(
+    pattern: str,
+    *,
+    dumped: bool = True,
+    uses_pid: bool = False,
+    limit: int = -1,
+    signal_number: int = signal.SIGSEGV,
+) -> str | None:
+    return core_dump_hint(
+        pid=42,
+        signal_number=signal_number,
+        dumped=dumped,
+        executable="/opt/bin/talker",
+        cwd="/w",
+        pattern=pattern,
+        uses_pid=uses_pid,
+        limit=limit,
+    )
+
+
 def test_core_dump_hints() -> None:
-    common = {"pid": 42, "signal_number": signal.SIGSEGV, "executable": "/opt/bin/talker"}
-    assert core_dump_hint(**common, dumped=False, cwd="/w", pattern="core", limit=0) == (
+    assert hint_for("core", dumped=False, limit=0) == (
         "core dumps are off (ulimit -c is 0; 'ulimit -c unlimited' turns them on)"
     )
-    hint = core_dump_hint(
-        **common, dumped=True, cwd="/w", pattern="|/lib/systemd/systemd-coredump %P %u %g %s"
+    assert hint_for("core", dumped=False, limit=-1) == "no core dump was written"
+    assert hint_for("|/lib/systemd/systemd-coredump %P %u %g %s") == (
+        "core dump kept by systemd-coredump: coredumpctl gdb 42"
     )
-    assert hint == "core dump kept by systemd-coredump: coredumpctl gdb 42"
-    hint = core_dump_hint(**common, dumped=True, cwd="/w", pattern="|/usr/share/apport/apport %p")
-    assert hint == "core dump handed to /usr/share/apport/apport"
-    hint = core_dump_hint(**common, dumped=True, cwd="/w", pattern="/var/crash/core.%e.%p.%t")
-    assert (
-        hint
-        == "core dump expected at /var/crash/core.talker.42.* (gdb /opt/bin/talker /var/crash/core.talker.42.*)"
+    assert hint_for("|/usr/share/apport/apport %p") == (
+        "core dump handed to /usr/share/apport/apport"
     )
-    hint = core_dump_hint(**common, dumped=True, cwd="/w", pattern="core", uses_pid=True)
-    assert hint is not None and hint.startswith("core dump expected at /w/core.42 ")
-    not_core = {**common, "signal_number": signal.SIGTERM}
-    assert core_dump_hint(**not_core, dumped=False, cwd="/", pattern="core") is None
+    assert hint_for("/var/crash/core.%e.%p.%t") == (
+        "core dump expected at /var/crash/core.talker.42.*"
+        " (gdb /opt/bin/talker /var/crash/core.talker.42.*)"
+    )
+    assert (hint_for("core", uses_pid=True) or "").startswith("core dump expected at /w/core.42 ")
+    assert hint_for("core", dumped=False, signal_number=signal.SIGTERM) is None
     assert expand_core_pattern("%%-%e-%h", pid=1, executable="x") == f"%-x-{os.uname().nodename}"
 
 
