@@ -829,7 +829,8 @@ class _Reader:
             rel = _rel(desc.origin)
             if desc.kind == "robot_description":
                 node.parameters.insert(0, (text("robot_description"), desc.value))
-                node.notes.append(f"robot_description: the global parameter of {rel}")
+                where = os.path.basename(desc.origin)
+                node.notes.append(f"robot_description: the global parameter of {where}")
             else:
                 node.gui = desc.value
             if not conds <= node_conds:
@@ -1719,6 +1720,8 @@ def _gui_switch(node: NodeItem, gui: Value) -> Group:
     plain = copy.copy(node)
     plain.gui, plain.warnings, plain.condition = None, [], Cond(gui, unless=True)
     with_gui = copy.copy(plain)
+    plain.notes = [*node.notes, "without the GUI (use_gui false)"]
+    with_gui.notes = [*node.notes, "use_gui true: the GUI is its own package in ROS 2"]
     with_gui.package = with_gui.executable = text("joint_state_publisher_gui")
     with_gui.condition = Cond(gui)
     items: list[Item] = [plain, with_gui]
