@@ -630,10 +630,11 @@ class ExecuteProcess(Action):
         argv = self.command(resolver)
         if not argv or not argv[0]:
             raise SubstitutionFailure("the command is empty", where=self.origin)
+        named = argv
         argv, standin = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
-        prefix = self._prefix(ctx, argv)
-        label_argv = prefix + argv if prefix else argv
-        base = self.label_base(resolver, label_argv)
+        prefix = self._prefix(ctx, named)
+        # The label comes from the program the launch file named, not from its stand-in.
+        base = self.label_base(resolver, prefix + named if prefix else named)
         env = self._environment(ctx)
         on_exit, required = self._exit_policy(resolver)
         spec = ProcessSpec(

@@ -467,3 +467,14 @@ __all__ = [
     "scan",
     "source_root",
 ]
+
+
+def _apply_pending_settings() -> None:
+    """Settings the CLI recorded before this module was needed (see mlaunch.ros)."""
+    import mlaunch.ros
+
+    if mlaunch.ros.package_settings is not None:
+        configure(**mlaunch.ros.package_settings)
+
+
+_apply_pending_settings()
