@@ -31,12 +31,12 @@ def generate_launch_description() -> LaunchDescription:
             # smartcar_display.launch:9
             SetParameter(name="use_sim_time", value=False),
             # smartcar_display.launch:18: ROS 1 node arbotix (arbotix_driver)
-            # WARNING: arbotix_python arbotix_driver (the ArbotiX diff-drive controller) has
-            # no ROS 2 package: it is replaced by a Gazebo simulator (gzserver; mlaunch's
-            # stand-in where Gazebo is not installed) that drives the robot from /cmd_vel
-            # through the diff-drive plugin of its URDF, and spawn_entity.py spawns
-            # robot_description as 'smartcar'; its parameters (port, baud, rate, sync_write,
-            # sync_read, read_rate, write_rate, controllers, sim) are not used
+            # WARNING: arbotix_python arbotix_driver (the ArbotiX diff-drive controller) has no ROS
+            # 2 package: it is replaced by a Gazebo simulator (gzserver; mlaunch's stand-in where
+            # Gazebo is not installed) that drives the robot from /cmd_vel through the diff-drive
+            # plugin of its URDF, and spawn_entity.py spawns robot_description as 'smartcar'; its
+            # parameters (port, baud, rate, sync_write, sync_read, read_rate, write_rate,
+            # controllers, sim) are not used
             ExecuteProcess(
                 cmd=["gzserver", "-s", "libgazebo_ros_init.so", "-s", "libgazebo_ros_factory.so"],
                 output="screen",
@@ -49,8 +49,8 @@ def generate_launch_description() -> LaunchDescription:
                 output="screen",
             ),
             # smartcar_display.launch:23
-            # WARNING: use_gui: ROS 2's joint_state_publisher has no GUI;
-            # joint_state_publisher_gui (its own package) runs when use_gui is true
+            # WARNING: use_gui: ROS 2's joint_state_publisher has no GUI; joint_state_publisher_gui
+            # (its own package) runs when use_gui is true
             GroupAction(
                 [
                     # smartcar_display.launch:23: without the GUI (use_gui false)
@@ -152,8 +152,8 @@ def generate_launch_description() -> LaunchDescription:
             # )
             # smartcar_display.launch:34: ROS 1 rviz/rviz is rviz2/rviz2 in ROS 2
             # WARNING: the RViz config $(find smartcar_description)/urdf.rviz is a ROS 1 RViz
-            # config (Class: rviz/...): rviz2 cannot load ROS 1 configs (display classes
-            # rviz/... are rviz_default_plugins/... in rviz2); save a new one from rviz2
+            # config (Class: rviz/...): rviz2 cannot load ROS 1 configs (display classes rviz/...
+            # are rviz_default_plugins/... in rviz2); save a new one from rviz2
             Node(
                 package="rviz2",
                 executable="rviz2",

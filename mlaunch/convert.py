@@ -303,7 +303,8 @@ class Py:
 
     kind: str  # "call", "list", "dict", "tuple", "code"
     name: str = ""
-    items: list[Any] = field(default_factory=list)  # Py, (key, Py), or ("#", comment lines)
+    # Py, (key, Py), ("#", comments to wrap) or ("#!", code lines to comment out as they are)
+    items: list[Any] = field(default_factory=list)
     keywords: list[tuple[str, Py]] = field(default_factory=list)
 
 
@@ -340,8 +341,11 @@ def render(expr: Py, indent: int, used: int = 0) -> str:
     else:
         head, tail = {"list": ("[", "]"), "dict": ("{", "}"), "tuple": ("(", ")")}[expr.kind]
         for item in expr.items:
-            if isinstance(item, tuple) and item[0] == "#":
-                lines += [f"{pad}# {line}".rstrip() for line in item[1]]
+            if isinstance(item, tuple) and item[0] == "#!":  # code, commented out as it is
+                lines += [f"{pad}# {line}" for line in item[1]]
+            elif isinstance(item, tuple) and item[0] == "#":
+                for comment in item[1]:
+                    lines += [f"{pad}# {line}" for line in wrap(comment, WIDTH - len(pad) - 2)]
             elif isinstance(item, tuple):
                 key = render(item[0], indent + 4)
                 lines.append(f"{pad}{key}: {render(item[1], indent + 4, len(key) + 2)},")
@@ -355,7 +359,7 @@ def _flat(expr: Py) -> str | None:
         return expr.name
     parts: list[str] = []
     for item in expr.items:
-        if isinstance(item, tuple) and item[0] == "#":
+        if isinstance(item, tuple) and item[0] in ("#", "#!"):
             return None
         if isinstance(item, tuple):
             key, value = _flat(item[0]), _flat(item[1])
@@ -438,10 +442,11 @@ class PythonWriter:
     def items(self, items: list[Item]) -> Py:
         out: list[Any] = []
         for item in items:
-            out.append(("#", [x for c in comments(item, self.source) for x in wrap(c, 80)]))
+            out.append(("#", comments(item, self.source)))
             if isinstance(item, Dropped):
                 dropped = render(self.node(item.node), 0).splitlines()
-                out.append(("#", ["Where it can run:", *dropped]))
+                out.append(("#", ["Where it can run:"]))
+                out.append(("#!", dropped))
                 continue
             action = self.action(item)
             if action is not None:
@@ -572,7 +577,7 @@ class PythonWriter:
 
     def param(self, value: PValue) -> Py:
         if value.dynamic is None:
-            return code(repr(value.literal))
+            return code(pyliteral(value.literal))
         inner = self.value(value.dynamic)
         if value.vtype is None:
             return inner
@@ -612,6 +617,15 @@ class PythonWriter:
         if isinstance(part, FileRef):
             return self.use("FileContent", self.value(part.path))
         raise TypeError(f"unknown substitution {part!r}")
+
+
+def pyliteral(value: Any) -> str:
+    """A parameter literal as Python source, strings in double quotes as ruff writes them."""
+    if isinstance(value, str):
+        return _flat(pystr(value)) or ""
+    if isinstance(value, list):
+        return "[" + ", ".join(pyliteral(v) for v in value) + "]"
+    return repr(value)
 
 
 def _header(source: Source, opening: str, closing: str, prefix: str = "") -> str:
@@ -906,7 +920,7 @@ class YamlWriter:
         v = self.t.value
         out: list[str] = []
         if isinstance(item, Group):
-            out.append(f"{pad}children:")
+            out.append(f"{pad}children:" + ("" if item.items or item.namespace else " []"))
             if item.namespace is not None:
                 out += [
                     f"{pad}- push_ros_namespace:",
@@ -940,8 +954,10 @@ class YamlWriter:
             lines.append(f"{pad}  value: {_yaml_literal(value.literal)}")
         else:
             lines.append(f"{pad}  value: {yaml_str(self.t.value(value.dynamic))}")
-            if value.vtype is not None:
-                lines.append(f"{pad}  type: {_TYPE_NAMES[value.vtype]}")
+        # the same type rule as XML: the YAML frontend guesses the type of text values too
+        typed = dict(self.xml.param_attributes(value)).get("type")
+        if typed is not None:
+            lines.append(f"{pad}  type: {typed}")
         return lines
 
 

@@ -485,6 +485,20 @@ TAG_ATTRIBUTES: dict[str, tuple[str, ...]] = {
     "group": ("ns", "clear_params"),
     "remap": ("from", "to"),
     "env": ("name", "value"),
+    "master": ("auto",),
+    "test": (
+        "test-name",
+        "pkg",
+        "type",
+        "name",
+        "args",
+        "ns",
+        "clear_params",
+        "cwd",
+        "launch-prefix",
+        "retry",
+        "time-limit",
+    ),
 }
 
 
@@ -1097,7 +1111,10 @@ class _Reader:
         group = Group(origin=self.origin(el), condition=cond, items=inner.items(), namespace=ns)
         if "clear_params" in el.attrs:
             group.warnings.append(_CLEAR_PARAMS)
-        out.body.append(group)
+        if group.items:
+            out.body.append(group)
+        elif group.warnings:  # nothing left in it (its parameters moved out): only the warning
+            out.body.append(Warn(origin=group.origin, condition=cond, message=_CLEAR_PARAMS))
         self.pass_up(inner, out, cond)
 
     def tag_include(self, el: Element, scope: _Scope, out: _Out) -> None:
