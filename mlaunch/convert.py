@@ -330,7 +330,7 @@ def render(expr: Py, indent: int, used: int = 0) -> str:
     ``used``: what precedes it on its line after the indentation (``name=``, ``key: ``).
     """
     flat = _flat(expr)
-    if flat is not None and indent + used + len(flat) + 1 <= WIDTH:
+    if flat is not None and (expr.kind == "code" or indent + used + len(flat) + 1 <= WIDTH):
         return flat
     pad = " " * (indent + 4)
     lines: list[str] = []

@@ -94,11 +94,19 @@ def summarize(plan: Plan) -> list[dict[str, Any]]:
             "output": spec.output,
             "respawn": spec.respawn,
             "required": spec.required,
-            "node": spec.node,
+            "node": _node(spec),
             "standin": spec.standin,
         }
         for spec in plan.processes()
     ]
+
+
+def _node(spec: ProcessSpec) -> tuple[Any, ...] | None:
+    node = spec.node
+    if node is None:
+        return None
+    name = None if node.name is None else _ANON.sub("_<anon>", node.name)
+    return (name, node.namespace, node.package, node.executable, node.lifecycle)
 
 
 def _argv(spec: ProcessSpec, temp_dir: str) -> list[Any]:
