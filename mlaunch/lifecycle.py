@@ -32,6 +32,7 @@ import queue
 import re
 import selectors
 import threading
+import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -49,6 +50,8 @@ if TYPE_CHECKING:
 
 # How long a node's lifecycle services may take to appear, and each transition to answer.
 DEFAULT_TIMEOUT = 20.0
+# get_state is asked again this often while waiting for a node (a lost request is not fatal).
+STATE_ATTEMPT = 2.0
 # At shutdown each active node gets this long to deactivate before its stop ladder starts.
 DEACTIVATE_TIMEOUT = 3.0
 SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
@@ -455,7 +458,7 @@ class LifecycleManager:
         if graph is None:
             return None
         try:
-            state = graph.lifecycle_state(fqn, timeout)
+            state = self._wait_state(graph, fqn, time.monotonic() + timeout)
         except GraphNotRunning:
             return None
         except RosBridgeError as exc:
@@ -478,6 +481,23 @@ class LifecycleManager:
             if not result.ok:
                 break
         return outcome
+
+    def _wait_state(self, graph: RosGraph, fqn: str, deadline: float) -> str:
+        """The node's state, asking again every STATE_ATTEMPT seconds until the deadline.
+
+        A respawned node's old get_state server can still look available (its death not yet
+        noticed by DDS) while the new one has not matched our client yet: a request sent then
+        is lost. Asking again is harmless, as get_state changes nothing.
+        """
+        from mlaunch.ros.bridge import RosTimeout
+
+        while True:
+            left = deadline - time.monotonic()
+            try:
+                return graph.lifecycle_state(fqn, max(0.1, min(STATE_ATTEMPT, left)))
+            except RosTimeout:
+                if time.monotonic() >= deadline or self.supervisor.shutting_down:
+                    raise
 
     def _graph_or_report(self, fqn: str) -> RosGraph | None:
         from mlaunch.ros.bridge import GraphNotRunning, RosBridgeError

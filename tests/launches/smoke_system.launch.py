@@ -69,7 +69,18 @@ def build(context):
         )
     )
     if variant == "ghost":
-        entities.append(Node(executable="sleep", arguments=["60"], name="ghost", namespace="robot"))
+        idle = (
+            "import signal, time; signal.signal(signal.SIGINT, lambda *_: exit(0)); time.sleep(60)"
+        )
+        entities.append(
+            Node(
+                executable=sys.executable,
+                arguments=["-c", idle],
+                name="ghost",
+                namespace="robot",
+                exec_name="ghost",
+            )
+        )
     return entities
 
 
