@@ -25,7 +25,6 @@ import os
 import signal
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass
 
 MARKER = "MLAUNCH_RUN_ID"
 # How long the guard waits between SIGTERM and SIGKILL when it was told no grace.
@@ -43,18 +42,23 @@ def new_run_id() -> str:
 # --- /proc --------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
 class ProcInfo:
-    """The few fields of /proc/<pid>/stat a sweep needs."""
+    """The few fields of /proc/<pid>/stat a sweep needs (a plain class: cheap to import)."""
 
-    pid: int
-    ppid: int
-    pgrp: int
-    state: str
+    __slots__ = ("pgrp", "pid", "ppid", "state")
+
+    def __init__(self, pid: int, ppid: int, pgrp: int, state: str) -> None:
+        self.pid = pid
+        self.ppid = ppid
+        self.pgrp = pgrp
+        self.state = state
 
     @property
     def zombie(self) -> bool:
         return self.state in ("Z", "X")
+
+    def __repr__(self) -> str:
+        return f"ProcInfo(pid={self.pid}, ppid={self.ppid}, pgrp={self.pgrp}, state={self.state!r})"
 
 
 def _read(path: str, limit: int = 1 << 20) -> bytes:

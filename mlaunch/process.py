@@ -139,14 +139,16 @@ def utf8_safe_cut(buf: bytes) -> int:
     return n
 
 
-@dataclass
 class Stream:
     """One pipe from a child: its fd and the partial line not yet complete."""
 
-    name: str
-    fd: int
-    file: object = None
-    partial: bytes = b""
+    __slots__ = ("fd", "file", "name", "partial")
+
+    def __init__(self, name: str, fd: int, file: object = None) -> None:
+        self.name = name
+        self.fd = fd
+        self.file = file
+        self.partial = b""
 
 
 @dataclass

@@ -81,14 +81,28 @@ FAILED = "failed"
 GAVE_UP = "gave up"
 
 
-@dataclass(order=True)
 class _Timer:
-    when: float
-    seq: int
-    callback: Callable[[], None] = field(compare=False)
-    keeps_alive: bool = field(default=True, compare=False)
-    cancel_on_shutdown: bool = field(default=True, compare=False)
-    cancelled: bool = field(default=False, compare=False)
+    """A pending callback in the loop's heap (a plain class: dataclass creation costs start-up)."""
+
+    __slots__ = ("callback", "cancel_on_shutdown", "cancelled", "keeps_alive", "seq", "when")
+
+    def __init__(
+        self,
+        when: float,
+        seq: int,
+        callback: Callable[[], None],
+        keeps_alive: bool = True,
+        cancel_on_shutdown: bool = True,
+    ) -> None:
+        self.when = when
+        self.seq = seq
+        self.callback = callback
+        self.keeps_alive = keeps_alive
+        self.cancel_on_shutdown = cancel_on_shutdown
+        self.cancelled = False
+
+    def __lt__(self, other: _Timer) -> bool:
+        return (self.when, self.seq) < (other.when, other.seq)
 
 
 @dataclass
@@ -172,6 +186,8 @@ class Supervisor:
         self.exit_code = EXIT_OK
         self._stop_presses = 0
         self._wake_r = self._wake_w = -1
+        self._old_wakeup = -1
+        self._old_handlers: dict[int, Any] = {}
         self._subreaper = False
         self._kill_now = False
         self._marker_env = {guards.MARKER: self.run_id}
@@ -562,6 +578,12 @@ class Supervisor:
         code = process.returncode if process.returncode is not None else 0
         self._report_exit(process, code)
         self._notify("exited", process)
+        if spec.required and not process.stopping:
+            # A required process decides the run: it ends it, and its failure is the run's.
+            # First, so the shutdown names it (its on_exit=Shutdown() then has nothing to do).
+            if code != 0:
+                self.exit_code = max(self.exit_code, EXIT_REQUIRED_FAILED)
+            self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
         event = ev.ProcessExited(
             action=spec.action,
             name=spec.label,
@@ -574,12 +596,6 @@ class Supervisor:
         self._dispatch("process_exit", process, event)
         if spec.on_exit is not None:
             self.fire(spec.on_exit, event)
-        if spec.required and not process.stopping:
-            # A required process decides the run: it ends it, and its failure is the run's.
-            if code != 0:
-                self.exit_code = max(self.exit_code, EXIT_REQUIRED_FAILED)
-            self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
-            return
         self._maybe_respawn(process, code)
 
     def _report_exit(self, process: Process, code: int) -> None:
@@ -757,11 +773,10 @@ class Supervisor:
         os.set_blocking(self._wake_r, False)
         os.set_blocking(self._wake_w, False)
         self.selector.register(self._wake_r, selectors.EVENT_READ, self._drain_wakeup)
-        signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
-        signal.signal(signal.SIGCHLD, self._record_signal)
-        if self.install_signals:
-            for sig in STOP_SIGNALS:
-                signal.signal(sig, self._record_signal)
+        # What was there before is put back at the end (an embedder may have its own).
+        self._old_wakeup = signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
+        ours = (*STOP_SIGNALS, signal.SIGCHLD) if self.install_signals else (signal.SIGCHLD,)
+        self._old_handlers = {sig: signal.signal(sig, self._record_signal) for sig in ours}
 
     def _record_signal(self, signum: int, frame: object) -> None:
         self._signals.append(signum)
@@ -793,11 +808,9 @@ class Supervisor:
         self._reap()
 
     def _restore_signals(self) -> None:
-        if self.install_signals:
-            for sig in STOP_SIGNALS:
-                signal.signal(sig, signal.SIG_DFL)
-        signal.signal(signal.SIGCHLD, signal.SIG_DFL)
-        signal.set_wakeup_fd(-1)
+        for sig, handler in self._old_handlers.items():
+            signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+        signal.set_wakeup_fd(self._old_wakeup)
         self.selector.close()
         for fd in (self._wake_r, self._wake_w):
             try:
