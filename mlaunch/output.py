@@ -90,10 +90,11 @@ class Screen:
     def __call__(self, data: bytes) -> None:
         self.write(data)
 
-    def write(self, data: bytes) -> None:
+    def write(self, data: bytes, *, urgent: bool = False) -> None:
+        """Queue ``data``; beyond the limit it is dropped (counted) unless ``urgent``."""
         if self.gone:
             return
-        if self._size + len(data) > self.limit:
+        if self._size + len(data) > self.limit and not urgent:
             self.dropped_lines += data.count(b"\n")
             self.dropped_bytes += len(data)
             return
@@ -101,6 +102,10 @@ class Screen:
         self._size += len(data)
         if self._size >= SCREEN_CHUNK:
             self.flush()
+
+    def urgent(self, data: bytes) -> None:
+        """mlaunch's own messages (an exit, an escalation) are few and small: never dropped."""
+        self.write(data, urgent=True)
 
     @property
     def blocked(self) -> bool:
@@ -364,10 +369,11 @@ class Printer:
         """``[LEVEL] [source]: text`` on screen and in launch.log."""
         line = f"[{level}] [{source}]: {text}\n".encode("utf-8", "replace")
         if not self.quiet or level in ("WARNING", "ERROR"):
+            write = getattr(self._write, "urgent", self._write)
             if self.color and LEVEL_COLORS.get(level):
-                self._write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
+                write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
             else:
-                self._write(line)
+                write(line)
         if self._launch_log is not None:
             self._launch_log.write(b"%.7f " % self.clock() + line)
             self._dirty.add(self._launch_log)

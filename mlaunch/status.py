@@ -163,6 +163,7 @@ class StatusView:
         self._footer = b""
         self._drawn = 0  # lines of the table now on screen (the cursor is at its last line's end)
         self._redraw = False
+        self._urgent = False
         self._closed = False
         self._psutil: dict[int, Any] = {}
         self.screen = self.printer.set_screen(self)
@@ -177,6 +178,11 @@ class StatusView:
         if self._pending_size >= 256 * 1024:
             self.flush()
 
+    def urgent(self, data: bytes) -> None:
+        """mlaunch's own messages: the frame that carries them must not be dropped."""
+        self._urgent = True
+        self(data)
+
     @property
     def blocked(self) -> bool:
         return bool(getattr(self.screen, "blocked", False))
@@ -190,7 +196,9 @@ class StatusView:
             self._pending_size = 0
             self._redraw = False
             self.frames += 1
-            self.screen(frame)
+            write = getattr(self.screen, "urgent", self.screen) if self._urgent else self.screen
+            self._urgent = False
+            write(frame)
         flush = getattr(self.screen, "flush", None)
         if flush is not None:
             flush()

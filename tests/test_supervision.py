@@ -561,6 +561,8 @@ def test_a_stuck_terminal_never_blocks_the_children(tmp_path: Path) -> None:
             return not screen.blocked and b"the terminal fell behind" in got
 
         assert wait_until(drained, 10)
+        # mlaunch's own messages are never dropped, only the children's lines.
+        assert b"[INFO] [chatty]: process has finished cleanly" in got
         # The log file has every line.
         logged = (tmp_path / "chatty.log").read_bytes().count(b"\n")
         assert logged == n
