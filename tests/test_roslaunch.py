@@ -380,8 +380,8 @@ def test_rosparam_dump_delete_and_unusable_values_are_warnings(tmp_path: Path) -
     plan = plan_of(path)
     text = warnings_text(plan)
     assert "w.launch:2: <rosparam command='dump'> is skipped" in text
-    assert "w.launch:4: parameter empty: an empty list has no ROS 2 parameter type" in text
-    assert "w.launch:5: <param binfile> (binary data" in text
+    assert "w.launch:3: <rosparam> at line 4: parameter empty: an empty list has no ROS 2" in text
+    assert "w.launch:3: <param> at line 5: <param binfile> (binary data" in text
 
 
 def test_global_params_reach_every_node_of_their_scope_whatever_the_order(tmp_path: Path) -> None:
@@ -546,10 +546,19 @@ def test_include_passes_args_in_a_namespace_and_dirname_points_at_the_included_f
           <include file="$(dirname)/parts/part.launch" unless="true">
             <arg name="who" value="never"/>
           </include>
+          <include file="$(dirname)/parts/part.launch" ns="twice">
+            <arg name="who" value="again"/>
+            <arg name="speed" value="2" if="false"/>
+          </include>
         </launch>
         """,
     )
-    (part,) = plan_of(path, {"robot": "r3"}).processes()
+    plan = plan_of(path, {"robot": "r3"})
+    part, again = plan.processes()
+    assert again.argv[1:3] == ("again", "2")  # a launch argument cannot be conditional in ROS 2
+    assert "main.launch:10: <arg> at line 12: if/unless on an <include>'s <arg>" in "\n".join(
+        plan.warnings
+    )
     assert part.argv[1:4] == ("r3", "1", str(tmp_path / "parts"))
     assert part.node is not None and part.node.fully_qualified_name == "/r3/part"
     assert part.env_changes["INC_ENV"] == "yes"

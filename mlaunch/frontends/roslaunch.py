@@ -1124,9 +1124,15 @@ class _Reader:
         ns = self.attr(el, "ns", scope)
         arguments: list[tuple[str, Value]] = []
         envs: list[Item] = []
+        notes: list[str] = []
         for child in el.children:
             if child.tag == "arg":
                 self.check_attributes(child, out)
+                if self.condition(child, scope) is not None:
+                    notes.append(
+                        f"<arg> at line {child.line}: if/unless on an <include>'s <arg> is not"
+                        " supported by ROS 2 launch arguments: it is always passed"
+                    )
                 name = self.literal(child, "name", scope, required=True)
                 value = self.attr(child, "value", scope) or self.attr(child, "default", scope)
                 if value is None:
@@ -1139,7 +1145,7 @@ class _Reader:
                 envs += _collect.body
             else:
                 raise self.error(child, f"<{child.tag}> is not valid inside <include>")
-        include = Include(origin=self.origin(el), path=path, arguments=arguments)
+        include = Include(origin=self.origin(el), path=path, arguments=arguments, warnings=notes)
         if "clear_params" in el.attrs:
             include.warnings.append(_CLEAR_PARAMS)
         if ns is None and not envs:
@@ -1240,13 +1246,13 @@ class _Reader:
             self.check_attributes(child, out)
             if self.condition(child, scope) is not None:
                 node.warnings.append(
-                    f"{_rel(self.origin(child))}: if/unless on <{child.tag}> inside a node is not"
+                    f"<{child.tag}> at line {child.line}: if/unless inside a node is not"
                     " supported by ROS 2 node parameters: it always applies"
                 )
             try:
                 self.node_child(node, child, scope, out)
             except _Skip as skip:
-                node.warnings.append(f"{_rel(self.origin(child))}: {skip.message}")
+                node.warnings.append(f"<{child.tag}> at line {child.line}: {skip.message}")
 
     def node_child(self, node: NodeItem, child: Element, scope: _Scope, out: _Out) -> None:
         if child.tag == "remap":
