@@ -91,7 +91,10 @@ class Source:
 
     def include_path(self, item: Include) -> tuple[Value, str | None]:
         """An included ROS 1 file: its converted twin when one exists beside it."""
-        path = r1.resolve_static(item.path, self.path)
+        try:
+            path = r1.resolve_static(item.path, self.path)
+        except MlaunchError as e:  # a package not here: ROS 2 will look it up when launching
+            return item.path, f"cannot check for a converted twin of the included file: {e}"
         last = item.path[-1] if item.path else ""
         if path is None or not path.endswith(".launch") or not isinstance(last, str):
             return item.path, None

@@ -140,6 +140,19 @@ def test_included_files_are_their_converted_twins_when_they_exist(
         twin.unlink()
 
 
+def test_an_include_from_a_package_not_found_here_still_converts(tmp_path: Path) -> None:
+    path = write(
+        tmp_path,
+        "i.launch",
+        '<launch>\n  <include file="$(find not_here_pkg)/launch/x.launch"/>\n</launch>\n',
+    )
+    text = convert.convert(path, "py")
+    assert 'AnyLaunchDescriptionSource([FindPackageShare("not_here_pkg"), "/launch/x.launch"])' in (
+        text
+    )
+    assert "cannot check for a converted twin" in text and "not_here_pkg" in text
+
+
 def test_output_elsewhere_keeps_dirname_pointing_at_the_source(
     system: Path, tmp_path: Path
 ) -> None:
