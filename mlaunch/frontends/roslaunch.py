@@ -628,16 +628,12 @@ class _Reader:
         value = self.attr(el, name, scope, required)
         if value is None:
             return None
-        found = self.static(value)
+        found = static_text(value)
         if found is None:
             raise self.error(
                 el, f"attribute {name!r} must be known when the file is read: {el.attrs[name]!r}"
             )
         return found
-
-    def static(self, value: Value) -> str | None:
-        """A value without launch-time parts ($(arg), $(env), $(eval) ...), as text."""
-        return static_text(value)
 
     def flag(self, el: Element, name: str, scope: _Scope) -> bool | Value | None:
         value = self.attr(el, name, scope)
@@ -1206,7 +1202,7 @@ class _Reader:
         for attr_name, why in (("cwd", _CWD), ("clear_params", _CLEAR_PARAMS)):
             if attr_name in el.attrs:
                 node.warnings.append(why.format(value=el.attrs[attr_name]))
-        out.body.extend(self.map_node(node, el, scope, out))
+        out.body.extend(self.map_node(node, el, out))
 
     def output(self, el: Element, scope: _Scope) -> Value | None:
         value = self.attr(el, "output", scope)
@@ -1280,7 +1276,7 @@ class _Reader:
                     name = text(_dotted(plain.lstrip("~")))
                 node.parameters.append((name, value))
 
-    def map_node(self, node: NodeItem, el: Element, scope: _Scope, out: _Out) -> list[Item]:
+    def map_node(self, node: NodeItem, el: Element, out: _Out) -> list[Item]:
         """Known ROS 1 packages and programs as their ROS 2 counterparts."""
         key = (static_text(node.package), static_text(node.executable))
         if key[0] == "robot_state_publisher" and key[1] in ("state_publisher", key[0]):
