@@ -11,7 +11,10 @@ Ready means, by default:
   - every lifecycle node is ``active``;
   - with use_sim_time (``--use-sim-time``, ``use_sim_time:=true``, a SetParameter or a node's
     own parameter), ``/clock`` is advancing;
-and at the end, every process stopped within its stop ladder (none needed SIGKILL).
+and at the end, every process stopped within its stop ladder (none needed SIGKILL). A process
+that exits before the end fails the test even if it would be respawned; ``--allow-exit LABEL``
+lets a one-shot process (label or base name) finish with status 0. Processes started later by
+timers or event handlers are watched from when they start.
 
 More expectations, from the command line (each has the overall ``--timeout`` as deadline unless
 ``--within S`` follows it):
@@ -21,8 +24,9 @@ More expectations, from the command line (each has the overall ``--timeout`` as 
   --expect-lifecycle /robot1/amcl[:STATE]   (default active; replaces the default check)
   --expect-output 'LABEL:REGEX' | 'REGEX'   a line of output (LABEL: a process label like
                                      talker-1 or its base name talker) matches REGEX
+  --expect-clock /clock              simulated time advances (also without use_sim_time)
   --expect 'KIND TARGET [within S]'  the same in one string (KIND: topic, service, node,
-                                     lifecycle, output)
+                                     lifecycle, output, clock)
 or from the launch file:
   - any launch configuration whose name starts with ``mlaunch_expect`` holds one expectation
     as 'KIND TARGET [within S]', e.g. in YAML
@@ -75,7 +79,15 @@ TICK = 0.1
 # Waiting for a lifecycle node's get_state answer while checking (it is asked again later).
 STATE_QUERY_TIMEOUT = 1.0
 CONFIG_PREFIX = "mlaunch_expect"
-KINDS = ("topic", "service", "node", "lifecycle", "output")
+KINDS = ("topic", "service", "node", "lifecycle", "output", "clock")
+HELP = {
+    "topic": "/scan[:RATE_HZ]: messages arrive (at >= 90%% of RATE_HZ)",
+    "service": "/name: the service is offered",
+    "node": "/ns/name: the node is in the ROS graph",
+    "lifecycle": "/ns/name[:STATE]: the managed node is in STATE (active)",
+    "output": "'LABEL:REGEX' or 'REGEX': a line of output matches",
+    "clock": "/clock: simulated time advances (implied by use_sim_time)",
+}
 GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock"})
 LIFECYCLE_STATES = ("unconfigured", "inactive", "active", "finalized")
 STATUS_MARKS = {"met": "ok", "failed": "FAIL", "skipped": "--", "pending": "--"}
@@ -167,6 +179,8 @@ def parse_target(kind: str, target: str, origin: str) -> Expectation:
         return Expectation("lifecycle", _absolute(name, "node", origin), origin, state=state)
     if kind == "output":
         return Expectation("output", target, origin)
+    if kind == "clock":
+        return Expectation("clock", _absolute(target, "topic", origin), origin)
     raise UsageError(f"unknown expectation kind {kind!r}; valid: {', '.join(KINDS)}")
 
 
@@ -326,11 +340,24 @@ def build_parser() -> argparse.ArgumentParser:
     group = parser.add_argument_group("expectations")
     for kind in KINDS:
         group.add_argument(
-            f"--expect-{kind}", metavar=kind.upper(), action=_ExpectAction, const=kind
+            f"--expect-{kind}",
+            metavar=kind.upper(),
+            action=_ExpectAction,
+            const=kind,
+            help=HELP[kind],
         )
-    group.add_argument("--expect", metavar="'KIND TARGET [within S]'", action=_ExpectAction)
     group.add_argument(
-        "--within", metavar="S", type=float, action=_WithinAction, help="deadline of the previous"
+        "--expect",
+        metavar="'KIND TARGET [within S]'",
+        action=_ExpectAction,
+        help="any of the above in one string",
+    )
+    group.add_argument(
+        "--within",
+        metavar="S",
+        type=float,
+        action=_WithinAction,
+        help="the deadline (seconds from the start) of the expectation just before",
     )
     parser.add_argument(
         "--timeout",
@@ -418,6 +445,10 @@ def main(args: Sequence[str]) -> int:
     try:
         mine, rest = split_arguments(args)
         settings = parse_settings(mine)
+        if not rest:
+            raise UsageError(
+                "mlaunch test needs a launch file: mlaunch test FILE [name:=value ...]"
+            )
         opts = cli.parse_options(rest)
         if opts.show_args or opts.print_plan:
             return cli.run_cli(rest)
@@ -724,6 +755,13 @@ class SmokeRun:
         self._mark(e, "failed", seen)
         self._finish(f"mlaunch test failed: {e.describe()}: {seen}")
 
+    def _fail_all(self, expectations: list[Expectation], seen: str) -> None:
+        if self.phase == "done" or not expectations:
+            return
+        for e in expectations:
+            self._mark(e, "failed", seen)
+        self._finish(f"mlaunch test failed: {seen}")
+
     def _maybe_ready(self) -> None:
         if self.phase != "waiting":
             return
@@ -760,9 +798,10 @@ class SmokeRun:
         except GraphNotRunning:
             return
         except RosBridgeError as exc:
+            # No graph (rclpy missing, a bad ROS_DOMAIN_ID): nothing will change by waiting.
             message = f"cannot look at the ROS graph: {exc}"
-            findings = [(e, False, message) for e in self._graph_expectations()]
-            self.loop.call_soon(lambda: self._apply(findings))
+            failing = self._graph_expectations()
+            self.loop.call_soon(lambda: self._fail_all(failing, message))
             return
         probe = GraphProbe(graph)
         while not self._stop.is_set():

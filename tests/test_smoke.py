@@ -3,6 +3,7 @@ tests/launches/smoke_system system (two lifecycle nodes and a talker) passing an
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -267,6 +268,11 @@ def test_bad_options_are_one_line_errors(tmp_path: Path) -> None:
         "mlaunch: error: topic expectation '/a:x' (--expect 'topic /a:x'): rate 'x' is not a"
         " positive number of Hz (write /scan:10)"
     ]
+    bare = run_mlaunch("test", env=clean_env())
+    assert bare.returncode == 2
+    assert bare.stderr.strip() == (
+        "mlaunch: error: a launch file is needed: mlaunch test FILE [name:=value ...]"
+    )
 
 
 # --- the ROS system ------------------------------------------------------------------------------
@@ -359,8 +365,6 @@ def test_system_passes_with_lifecycle_nodes_brought_up_in_order(
 def test_system_fails_precisely(
     ros_env: dict[str, str], args: list[str], failed: str, seen: str
 ) -> None:
-    import re
-
     done = _smoke(ros_env, SYSTEM, *args)
     out = done.stdout
     assert done.returncode == 1, out + done.stderr
@@ -394,3 +398,22 @@ def test_yaml_system_declares_its_expectations_and_sequence(ros_env: dict[str, s
     line = _row(slow.stdout, "topic /robot/chatter")
     assert line.startswith("FAIL")
     assert "too slow: 3.0 Hz over the last 2 s" in line and "wanted >= 9.0 Hz" in line
+
+
+@requires_rclpy
+def test_use_sim_time_waits_for_clock_to_advance(ros_env: dict[str, str]) -> None:
+    clock_launch = str(LAUNCHES / "sim_clock.launch.py")
+    done = _smoke(ros_env, clock_launch, "use_sim_time:=true")
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert re.search(r"advanced from 100\.\d\d s to 100\.\d\d s", _row(done.stdout, "/clock"))
+    frozen = _smoke(
+        ros_env,
+        clock_launch,
+        "use_sim_time:=true",
+        "frozen:=true",
+        "--expect",
+        "clock /clock within 5",
+    )
+    assert frozen.returncode == 1
+    row = _row(frozen.stdout, "/clock advances")
+    assert row.startswith("FAIL") and re.search(r"stuck at 100\.00 s \(\d+ messages\)", row), row
