@@ -446,9 +446,7 @@ def main(args: Sequence[str]) -> int:
         mine, rest = split_arguments(args)
         settings = parse_settings(mine)
         if not rest:
-            raise UsageError(
-                "mlaunch test needs a launch file: mlaunch test FILE [name:=value ...]"
-            )
+            raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
         opts = cli.parse_options(rest)
         if opts.show_args or opts.print_plan:
             return cli.run_cli(rest)
