@@ -421,7 +421,6 @@ class Supervisor:
         return [p for p in self.processes if p.running and (matcher is None or matcher(p))]
 
     # --- processes ---------------------------------------------------------------------------
-    # --- processes ---------------------------------------------------------------------------
 
     def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
         if self.shutting_down:
@@ -479,12 +478,16 @@ class Supervisor:
             return
         data, eof = process.read(fd)
         if data:
-            self.printer.output(process.label, stream.name, process.spec.output, data)
-            if self.handlers:
-                self._io_event(process, stream.name, data)
+            self._deliver(process, stream.name, data)
         if eof:
             self.selector.unregister(fd)
             process.close_stream(fd)
+
+    def _deliver(self, process: Process, stream: str, data: bytes) -> None:
+        """Complete lines of a child: to the printer, then to OnProcessIO handlers."""
+        self.printer.output(process.label, stream, process.spec.output, data)
+        if self.handlers:
+            self._io_event(process, stream, data)
 
     def _io_event(self, process: Process, stream: str, data: bytes) -> None:
         event_type = ev.ProcessStdout if stream == "stdout" else ev.ProcessStderr
@@ -517,9 +520,7 @@ class Supervisor:
                     break
                 data, eof = process.read(fd)
                 if data:
-                    self.printer.output(
-                        process.label, process.streams[fd].name, process.spec.output, data
-                    )
+                    self._deliver(process, process.streams[fd].name, data)
                 if eof:
                     self.selector.unregister(fd)
                     process.close_stream(fd)
@@ -551,7 +552,7 @@ class Supervisor:
         for stream in process.streams.values():
             if stream.partial:
                 data, stream.partial = stream.partial + b"\n", b""
-                self.printer.output(process.label, stream.name, process.spec.output, data)
+                self._deliver(process, stream.name, data)
 
     def _record_exit(self, process: Process) -> None:
         record = self.records[process.label]

@@ -684,3 +684,27 @@ def test_a_crash_by_signal_says_so_and_where_the_core_went(tmp_path: Path) -> No
     assert expected and expected[0].startswith(f"core dump expected at {tmp_path / pattern}")
     core = Path(expected[0].split(" at ", 1)[1].split(" (gdb ", 1)[0])
     assert wait_until(core.exists, 5)
+
+
+def test_process_io_handlers_see_the_last_words_too(tmp_path: Path) -> None:
+    path = write_launch(
+        tmp_path,
+        """
+        from launch.actions import LogInfo, RegisterEventHandler
+        from launch.event_handlers import OnProcessIO
+
+        def generate_launch_description():
+            talker = ExecuteProcess(
+                cmd=[PY, '-c', 'import sys; print("one", flush=True); sys.stdout.write("last")'],
+                name='talker')
+            seen = lambda event: [LogInfo(msg='saw ' + event.text.decode().strip())]
+            return LaunchDescription([
+                RegisterEventHandler(OnProcessIO(target_action=talker, on_stdout=seen)),
+                talker,
+            ])
+        """,
+    )
+    h = Harness(plan_from(path, tmp_path))
+    assert h.run() == 0
+    assert "saw one" in h.text
+    assert "saw last" in h.text  # the unterminated line flushed at exit reaches handlers
