@@ -15,6 +15,7 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import IO
 
 import pytest
 
@@ -80,7 +81,9 @@ def proc(code: str, name: str, **extra: object) -> str:
 class Mlaunch:
     """``python -m mlaunch FILE`` as a subprocess, its stdout read line by line by a thread."""
 
-    def __init__(self, tmp_path: Path, launch: Path, *args: str, stdout: object = None) -> None:
+    def __init__(
+        self, tmp_path: Path, launch: Path, *args: str, stdout: int | IO[bytes] | None = None
+    ) -> None:
         self.tmp = tmp_path / "tmp"
         self.tmp.mkdir(exist_ok=True)
         self.log_dir = tmp_path / "log"
