@@ -206,13 +206,9 @@ def report_error(error: BaseException, debug: bool) -> int:
 
 def configure_packages(opts: Options, path: str) -> None:
     """Tell the ROS layer where source packages are, before anything is resolved."""
-    try:
-        from mlaunch.ros import packages
-    except ImportError:
-        return
-    configure = getattr(packages, "configure", None)
-    if configure is not None:
-        configure(search_paths=opts.package_path, launch_file=path, environ=os.environ)
+    from mlaunch import ros
+
+    ros.configure_packages(search_paths=opts.package_path, launch_file=path, environ=os.environ)
 
 
 def run_cli(argv: Sequence[str]) -> int:
