@@ -548,7 +548,9 @@ class ExecuteProcess(Action):
 
     mlaunch extensions: ``respawn`` also takes ``'always'``/``'on-failure'``; ``required=True``
     is short for ``on_exit=Shutdown()``; ``respawn_backoff``/``respawn_max_delay`` slow a crash
-    loop down.
+    loop down. The first restart waits ``respawn_delay`` as in ROS 2; each further exit within
+    10 s of starting multiplies the wait by ``respawn_backoff`` (default 2, so a crash loop cannot
+    burn a core), up to ``respawn_max_delay`` (30 s). ``respawn_backoff=1`` restarts like ROS 2.
     """
 
     def __init__(
@@ -572,7 +574,7 @@ class ExecuteProcess(Action):
         respawn: Any = False,
         respawn_delay: Any = None,
         respawn_max_retries: Any = -1,
-        respawn_backoff: Any = 1.0,
+        respawn_backoff: Any = 2.0,
         respawn_max_delay: Any = 30.0,
         required: Any = False,
         **kwargs: Any,
