@@ -665,7 +665,10 @@ class SmokeRun:
 
     def _on_output(self, label: str, stream: str, data: bytes) -> None:
         lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
-        self.rings.setdefault(label, deque(maxlen=RING_LINES)).extend(lines)
+        ring = self.rings.get(label)
+        if ring is None:
+            ring = self.rings[label] = deque(maxlen=RING_LINES)
+        ring.extend(lines)
         if self.phase == "done":
             return
         for e in self.expectations:
