@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import shlex
-import shutil
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
@@ -797,7 +796,9 @@ ExecuteLocal = ExecuteProcess
 
 
 def which(name: str, env: dict[str, str]) -> str | None:
-    return shutil.which(name, path=env.get("PATH", os.defpath))
+    from mlaunch.substitutions import which as which_on_path
+
+    return which_on_path(name, env.get("PATH", os.defpath))
 
 
 __all__ = [

@@ -9,9 +9,8 @@ mlaunch, and inside mlaunch every description is built from classes mlaunch can 
 from __future__ import annotations
 
 import importlib
-import importlib.abc
-import importlib.machinery
 import sys
+from importlib.machinery import ModuleSpec
 from types import ModuleType
 
 ALIASES: dict[str, str] = {
@@ -52,18 +51,20 @@ ALIASES: dict[str, str] = {
 }
 
 
-class _AliasLoader(importlib.abc.Loader):
+# Plain classes, not importlib.abc's: importing importlib.abc pulls in importlib.resources and
+# pathlib (~7 ms), and the import system only needs these methods.
+class _AliasLoader:
     def __init__(self, target: str) -> None:
         self.target = target
 
-    def create_module(self, spec: importlib.machinery.ModuleSpec) -> ModuleType:
+    def create_module(self, spec: ModuleSpec) -> ModuleType:
         return importlib.import_module(self.target)
 
     def exec_module(self, module: ModuleType) -> None:
         return None
 
 
-class AliasFinder(importlib.abc.MetaPathFinder):
+class AliasFinder:
     """Answers the ROS 2 module names with mlaunch modules."""
 
     def find_spec(self, fullname, path=None, target=None):  # type: ignore[no-untyped-def]
@@ -71,9 +72,7 @@ class AliasFinder(importlib.abc.MetaPathFinder):
         if target_name is None:
             return None
         is_package = any(alias.startswith(fullname + ".") for alias in ALIASES)
-        return importlib.machinery.ModuleSpec(
-            fullname, _AliasLoader(target_name), is_package=is_package
-        )
+        return ModuleSpec(fullname, _AliasLoader(target_name), is_package=is_package)
 
 
 _FINDER = AliasFinder()

@@ -13,9 +13,40 @@ from typing import Any
 
 def _lifecycle(options: Any, supervisor: Any) -> Any:
     """Lifecycle (managed) node driving; None unless the plan has lifecycle work."""
+    if not _may_have_lifecycle_work(options, supervisor.plan):
+        return None
     from mlaunch.lifecycle import attach
 
     return attach(options, supervisor)
+
+
+def _may_have_lifecycle_work(options: Any, plan: Any) -> bool:
+    """A cheap look that can rule lifecycle out without importing mlaunch.lifecycle (~5 ms).
+
+    False only when nothing in the plan can involve a managed node; lifecycle.attach then
+    makes the exact decision.
+    """
+    import sys
+
+    if "mlaunch.lifecycle" in sys.modules:  # a LifecycleSequence or Expect was built
+        return True
+    sequence = "mlaunch_lifecycle_sequence"
+    if sequence in plan.arguments or sequence in getattr(options, "arguments", {}):
+        return True
+    deferred = False
+    for step in plan.steps:
+        spec = getattr(step, "spec", None)
+        if spec is not None and spec.node is not None and spec.node.lifecycle:
+            return True
+        if getattr(step, "kind", "") == "state_transition":
+            return True
+        if type(getattr(step, "event", None)).__name__ == "ChangeState":
+            return True
+        deferred = deferred or getattr(step, "body", None) is not None
+        deferred = deferred or (spec is not None and spec.on_exit is not None)
+    # Deferred parts resolve later; a lifecycle node can only be among them if the ROS
+    # actions were loaded.
+    return deferred and "mlaunch.ros.actions" in sys.modules
 
 
 def _status_view(options: Any, supervisor: Any) -> Any:

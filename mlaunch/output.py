@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import os
 import select
-import socket
 import stat
 import sys
 import time
@@ -291,7 +290,7 @@ def make_run_log_dir(environ: Mapping[str, str]) -> str:
     base = log_base_dir(environ)
     stamp = time.strftime("%Y-%m-%d-%H-%M-%S", time.localtime())
     micro = f"{time.time() % 1:.6f}"[2:]
-    path = os.path.join(base, f"{stamp}-{micro}-{socket.gethostname()}-{os.getpid()}")
+    path = os.path.join(base, f"{stamp}-{micro}-{os.uname().nodename}-{os.getpid()}")
     os.makedirs(path, exist_ok=True)
     latest = os.path.join(base, "latest")
     if not os.path.exists(latest) or os.path.islink(latest):

@@ -9,15 +9,14 @@ from __future__ import annotations
 import math
 import os
 import shlex
-import shutil
-import socket
 import subprocess
 from collections.abc import Callable, Iterable, Sequence
-from pathlib import Path
-from random import randint
 from typing import TYPE_CHECKING, Any, Union
 
 from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
+
+# pathlib is not imported: it costs milliseconds at start-up, and os.PathLike covers Path.
+Path = os.PathLike
 
 if TYPE_CHECKING:
     from mlaunch.context import LaunchContext
@@ -51,8 +50,8 @@ def normalize(value: Any) -> Subs:
         return (value,)
     if isinstance(value, str):
         return (TextSubstitution(text=value),)
-    if isinstance(value, Path):
-        return (TextSubstitution(text=str(value)),)
+    if isinstance(value, os.PathLike):
+        return (TextSubstitution(text=os.fspath(value)),)
     if isinstance(value, (int, float, bool)):
         return (TextSubstitution(text=str(value)),)
     if isinstance(value, Iterable):
@@ -171,7 +170,8 @@ class AnonName(Substitution):
         cached = context.launch_configurations.get(key)
         if isinstance(cached, str):
             return cached
-        raw = f"{name}_{socket.gethostname()}_{os.getpid()}_{randint(0, 2**63)}"
+        unique = int.from_bytes(os.urandom(8), "big") >> 1
+        raw = f"{name}_{os.uname().nodename}_{os.getpid()}_{unique}"
         value = raw.replace(".", "_").replace("-", "_").replace(":", "_")
         context.launch_configurations[key] = value
         return value
@@ -260,6 +260,17 @@ class FileContent(Substitution):
 # --- paths and programs ----------------------------------------------------------------------
 
 
+def which(name: str, path: str) -> str | None:
+    """The first executable file ``name`` on ``path`` (shutil.which, without importing shutil)."""
+    if os.sep in name:
+        return name if os.access(name, os.X_OK) and not os.path.isdir(name) else None
+    for folder in path.split(os.pathsep):
+        candidate = os.path.join(folder or os.curdir, name)
+        if os.access(candidate, os.X_OK) and not os.path.isdir(candidate):
+            return candidate
+    return None
+
+
 class PathJoinSubstitution(Substitution):
     """``os.path.join`` of the performed parts; ``/`` extends it."""
 
@@ -287,7 +298,7 @@ class FindExecutable(Substitution):
 
     def perform(self, context: LaunchContext) -> str:
         name = perform_substitutions(context, self.name)
-        found = shutil.which(name, path=context.environment.get("PATH", os.defpath))
+        found = which(name, context.environment.get("PATH", os.defpath))
         if found is None:
             raise SubstitutionFailure(f"executable {name!r} not found on the PATH")
         return found
