@@ -12,6 +12,7 @@ import importlib
 import sys
 from importlib.machinery import ModuleSpec
 from types import ModuleType
+from typing import Any
 
 ALIASES: dict[str, str] = {
     "launch": "mlaunch.launch_api",
@@ -72,7 +73,8 @@ class AliasFinder:
         if target_name is None:
             return None
         is_package = any(alias.startswith(fullname + ".") for alias in ALIASES)
-        return ModuleSpec(fullname, _AliasLoader(target_name), is_package=is_package)
+        loader: Any = _AliasLoader(target_name)
+        return ModuleSpec(fullname, loader, is_package=is_package)
 
 
 _FINDER = AliasFinder()
