@@ -308,7 +308,12 @@ class ReadyProbe:
 
 
 def stop_and_time(proc: Launched, probe: ReadyProbe, sig: int, timeout: float) -> float:
-    """Send ``sig`` to the launcher; seconds until it and every child are gone."""
+    """Send ``sig`` to the launcher; seconds until it and every descendant are gone.
+
+    The benchmark children are seen on the FIFO, the launcher through its pidfd, and any other
+    descendant (mlaunch's guard process, an orphan) after the launcher's exit: the harness is
+    their subreaper, so they are then its own children.
+    """
     deadline = time.perf_counter() + timeout
     probe.release()
     sent = time.perf_counter()
@@ -316,7 +321,28 @@ def stop_and_time(proc: Launched, probe: ReadyProbe, sig: int, timeout: float) -
     gone = probe.wait_gone(deadline)
     proc.reap(deadline)
     assert proc.exited_at is not None
-    return max(gone, proc.exited_at) - sent
+    return max(gone, proc.exited_at, wait_no_children(deadline)) - sent
+
+
+def wait_no_children(deadline: float, poll: float = 0.0005) -> float:
+    """When the harness had no child left (reaping as they exit); polls /proc/self only."""
+    me = os.getpid()
+    path = f"/proc/{me}/task/{me}/children"
+    while True:
+        try:
+            while os.waitpid(-1, os.WNOHANG)[0]:
+                pass
+        except ChildProcessError:
+            return time.perf_counter()
+        try:
+            with open(path) as f:
+                if not f.read().split():
+                    return time.perf_counter()
+        except FileNotFoundError:  # no CONFIG_PROC_CHILDREN: waitpid above is the only judge
+            pass
+        if time.perf_counter() > deadline:
+            raise BenchError("a descendant of the launcher outlived it past the deadline")
+        time.sleep(poll)  # only after the launcher has exited: nothing left to disturb
 
 
 def read_pipe_until_exit(
