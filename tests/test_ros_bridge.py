@@ -330,6 +330,27 @@ def test_lifecycle_failures_are_reported(ros_env: dict[str, str], tmp_path: Path
 
 
 @requires_rclpy
+def test_sigint_just_before_spin_exits_0(ros_env: dict[str, str], tmp_path: Path) -> None:
+    """The JSON line is printed right before spinning starts: the window that once lost a signal."""
+    children = Children(ros_env, tmp_path)
+    try:
+        started = [children.start(f"i{n}", "introspect.py") for n in range(3)]
+        pending = list(started)
+        deadline = time.monotonic() + STARTUP
+        while pending and time.monotonic() < deadline:
+            for child in [c for c in pending if c.out().endswith("\n")]:
+                child.proc.send_signal(signal.SIGINT)
+                pending.remove(child)
+            time.sleep(0.005)
+        assert not pending, "introspect printed no JSON line"
+        for child in started:
+            assert child.proc.wait(timeout=5) == 0, child.err()
+            assert "Traceback" not in child.err(), child.err()
+    finally:
+        children.stop_all()
+
+
+@requires_rclpy
 def test_absent_node_times_out_at_the_deadline(ros_env: dict[str, str]) -> None:
     with RosGraph(environ=ros_env) as graph:
         started = time.monotonic()
