@@ -283,7 +283,9 @@ class RosGraph:
         self._stopping.set()
         self._release_waiters()
         if self._executor is not None:
-            self._executor.wake()
+            # A task, not wake(): wake() only makes spin_once rebuild its wait set and wait on
+            # (up to its 0.5 s timeout); a ready task makes it return at once.
+            self._executor.create_task(lambda: None)
         if self._thread is not None:
             self._thread.join(timeout=ENTITY_TIMEOUT)
         self._destroy()
