@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mlaunch.standins.rsp import ParameterError, ParamSpec, declare
+from mlaunch.standins.common import EXIT_FAILURE, spin_until_shutdown
+from mlaunch.standins.rsp import INPUT_ERRORS, ParameterError, ParamSpec, declare
 from mlaunch.standins.urdf import Joint, Robot, UrdfError, parse_urdf
 
 if TYPE_CHECKING:
@@ -25,8 +26,6 @@ if TYPE_CHECKING:
     from std_msgs.msg import String
 
 NODE_NAME = "joint_state_publisher"
-EXIT_OK = 0
-EXIT_FAILURE = 1
 
 PARAMS = (
     ParamSpec("robot_description", "", str),
@@ -165,7 +164,6 @@ def start(node: Node, urdf_file: str | None) -> JointPublisher:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the node until shutdown; 1 with a one-line error when its input is unusable."""
     import rclpy
-    from rclpy.executors import ExternalShutdownException
     from rclpy.node import Node
     from rclpy.utilities import remove_ros_args
 
@@ -178,21 +176,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_FAILURE
     # zeros.<joint> are free-form names, so take whatever the overrides declare.
     node = Node(NODE_NAME, automatically_declare_parameters_from_overrides=True)
-    try:
-        start(node, options.urdf_file)
-        rclpy.spin(node)
-    except UrdfError as exc:
-        node.get_logger().error(f"robot_description is not a valid URDF: {exc}")
-        return EXIT_FAILURE
-    except ParameterError as exc:
-        node.get_logger().error(f"{exc}")
-        return EXIT_FAILURE
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return EXIT_OK
+    return spin_until_shutdown(node, lambda: start(node, options.urdf_file), INPUT_ERRORS)
 
 
 if __name__ == "__main__":

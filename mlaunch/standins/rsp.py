@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.standins.common import EXIT_FAILURE, spin_until_shutdown
 from mlaunch.standins.urdf import Robot, UrdfError, parse_urdf
 
 if TYPE_CHECKING:
@@ -23,12 +24,17 @@ if TYPE_CHECKING:
     from sensor_msgs.msg import JointState
 
 NODE_NAME = "robot_state_publisher"
-EXIT_OK = 0
-EXIT_FAILURE = 1
 
 
 class ParameterError(ValueError):
     """A parameter has a value the node cannot use; the message names it and the bad value."""
+
+
+# Bad input the node refuses with one line (and exit status 1), as the real one does.
+INPUT_ERRORS: dict[type[Exception], str] = {
+    UrdfError: "robot_description is not a valid URDF: ",
+    ParameterError: "",
+}
 
 
 @dataclass(frozen=True)
@@ -170,7 +176,6 @@ def start(node: Node) -> StatePublisher:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the node until shutdown; 1 with a one-line error when its input is unusable."""
     import rclpy
-    from rclpy.executors import ExternalShutdownException
     from rclpy.node import Node
 
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
@@ -180,21 +185,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"[ERROR] [{NODE_NAME}]: invalid ROS arguments: {exc}", file=sys.stderr)
         return EXIT_FAILURE
     node = Node(NODE_NAME)
-    try:
-        start(node)
-        rclpy.spin(node)
-    except UrdfError as exc:
-        node.get_logger().error(f"robot_description is not a valid URDF: {exc}")
-        return EXIT_FAILURE
-    except ParameterError as exc:
-        node.get_logger().error(f"{exc}")
-        return EXIT_FAILURE
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-    return EXIT_OK
+    return spin_until_shutdown(node, lambda: start(node), INPUT_ERRORS)
 
 
 if __name__ == "__main__":

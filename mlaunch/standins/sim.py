@@ -21,15 +21,14 @@ import array
 import json
 import math
 import os
-import signal
 import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
+from mlaunch.standins.common import StopFlag, install_stop_flag
 from mlaunch.standins.diffdrive import (
     DiffDrive,
     ImuParams,
@@ -461,21 +460,9 @@ def free_name(name: str, taken: Mapping[str, object]) -> str:
 # ---------------------------------------------------------------- ROS side
 
 
-class _Stop:
-    """Set by SIGINT/SIGTERM; the main loop checks it (handlers only record)."""
-
-    def __init__(self) -> None:
-        self.requested = False
-
-    def __call__(self, signum: int, frame: FrameType | None) -> None:
-        self.requested = True
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point: parse the Gazebo command line, load the world, serve until signalled."""
-    stop = _Stop()
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    stop = install_stop_flag()
     argv = list(sys.argv if argv is None else argv)
     try:
         return _run(argv, stop)
@@ -483,7 +470,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
 
 
-def _run(argv: list[str], stop: _Stop) -> int:
+def _run(argv: list[str], stop: StopFlag) -> int:
     from rclpy.utilities import remove_ros_args
 
     try:
@@ -505,7 +492,7 @@ def _run(argv: list[str], stop: _Stop) -> int:
     return _serve(argv, options, world, stop)
 
 
-def _serve(argv: list[str], options: SimOptions, world: World, stop: _Stop) -> int:
+def _serve(argv: list[str], options: SimOptions, world: World, stop: StopFlag) -> int:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
@@ -601,7 +588,7 @@ def _real_time_factor(node: Any) -> float:
     return rtf
 
 
-def _loop(sim: Simulation, bridge: RosBridge, executor: Any, rtf: float, stop: _Stop) -> None:
+def _loop(sim: Simulation, bridge: RosBridge, executor: Any, rtf: float, stop: StopFlag) -> None:
     """Step sim time in lockstep with wall time / rtf; serve callbacks in between."""
     wall_step = sim.step_ns / 1e9 / rtf
     next_wall = time.monotonic()

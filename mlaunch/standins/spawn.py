@@ -15,16 +15,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import signal
 import sys
 import time
 import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import FrameType
 from typing import Any
 
+from mlaunch.standins.common import StopFlag, install_stop_flag
 from mlaunch.standins.sim import SPAWN_TOPIC, SPAWNED_TOPIC
 
 DEFAULT_TIMEOUT = 30.0  # spawn_entity.py's -timeout default
@@ -271,21 +270,9 @@ def spawn_request(options: SpawnOptions, xml: str, request_id: str, node_namespa
 # ---------------------------------------------------------------- ROS side
 
 
-class _Stop:
-    """Set by SIGINT/SIGTERM; the wait loops check it (handlers only record)."""
-
-    def __init__(self) -> None:
-        self.requested = False
-
-    def __call__(self, signum: int, frame: FrameType | None) -> None:
-        self.requested = True
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit status."""
-    stop = _Stop()
-    signal.signal(signal.SIGINT, stop)
-    signal.signal(signal.SIGTERM, stop)
+    stop = install_stop_flag()
     argv = list(sys.argv if argv is None else argv)
     try:
         return _run(argv, stop)
@@ -296,7 +283,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
 
 
-def _run(argv: list[str], stop: _Stop) -> int:
+def _run(argv: list[str], stop: StopFlag) -> int:
     from rclpy.utilities import remove_ros_args
 
     options = parse_spawn_args(remove_ros_args(argv)[1:])
@@ -312,7 +299,7 @@ def _run(argv: list[str], stop: _Stop) -> int:
     return _spawn(argv, options, xml, stop)
 
 
-def _spawn(argv: list[str], options: SpawnOptions, xml: str | None, stop: _Stop) -> int:
+def _spawn(argv: list[str], options: SpawnOptions, xml: str | None, stop: StopFlag) -> int:
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
@@ -344,7 +331,7 @@ class _Waiter:
     """Spins the executor until a condition holds, the deadline passes or a signal arrives."""
 
     executor: Any
-    stop: _Stop
+    stop: StopFlag
     program: str
 
     def until(self, done: Callable[[], bool], timeout: float) -> bool:
