@@ -97,3 +97,37 @@ def test_seed_launch_file_runs_unmodified(ros_env: dict[str, str], tmp_path: Pat
     finally:
         run.kill()
     assert "Traceback" not in run.text, run.text[-3000:]
+
+
+def test_jtbot_sim_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: Path) -> None:
+    """The CI smoke launch: `mlaunch test` on jtbot_sim, with its sensors as expectations."""
+    env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    junit = tmp_path / "jtbot.xml"
+    done = subprocess.run(
+        mlaunch(
+            "test",
+            str(REPO / "launches" / "jtbot_sim.launch.py"),
+            "--allow-exit",
+            "spawn_entity.py",
+            "--expect-topic",
+            "/scan:4",
+            "--expect-topic",
+            "/odom",
+            "--expect-topic",
+            "/imu",
+            "--expect-output",
+            "spawn_entity.py:spawned entity 'jtbot'",
+            "--hold",
+            "1",
+            "--junit",
+            str(junit),
+        ),
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+    report = junit.read_text()
+    assert 'failures="0"' in report and "/scan" in report and "/clock" in report
