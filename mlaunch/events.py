@@ -1,11 +1,19 @@
-"""Events, with the names of ROS 2 launch, and the matchers handlers use to pick processes."""
+"""Events, with the names of ROS 2 launch, and the matchers handlers use to pick processes.
+
+Plain classes (not dataclasses, whose import and creation cost start-up time) that compare and
+show themselves as dataclasses do, through ``plan.Record``.
+"""
 
 from __future__ import annotations
 
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+
+from mlaunch.plan import Record
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
 
 
 class Event:
@@ -14,38 +22,74 @@ class Event:
     name = "launch.events.Event"
 
 
-@dataclass
-class Shutdown(Event):
-    reason: str = "reason not given"
-    due_to_sigint: bool = False
+class Shutdown(Record, Event):
+    _fields = ("reason", "due_to_sigint")
+
+    def __init__(self, reason: str = "reason not given", due_to_sigint: bool = False) -> None:
+        self.reason = reason
+        self.due_to_sigint = due_to_sigint
 
 
-@dataclass
-class ProcessEvent(Event):
+class ProcessEvent(Record, Event):
     """Fields of ROS 2's process events: the action, the label, argv, cwd, env and pid."""
 
-    action: Any = None
-    name: str = ""
-    cmd: list[str] = field(default_factory=list)
-    cwd: str | None = None
-    env: dict[str, str] | None = None
-    pid: int = 0
+    _fields: tuple[str, ...] = ("action", "name", "cmd", "cwd", "env", "pid")
+
+    def __init__(
+        self,
+        action: Any = None,
+        name: str = "",
+        cmd: list[str] | None = None,
+        cwd: str | None = None,
+        env: dict[str, str] | None = None,
+        pid: int = 0,
+    ) -> None:
+        self.action = action
+        self.name = name
+        self.cmd: list[str] = [] if cmd is None else cmd
+        self.cwd = cwd
+        self.env = env
+        self.pid = pid
 
 
-@dataclass
 class ProcessStarted(ProcessEvent):
     pass
 
 
-@dataclass
 class ProcessExited(ProcessEvent):
-    returncode: int = 0
+    _fields = (*ProcessEvent._fields, "returncode")
+
+    def __init__(
+        self,
+        action: Any = None,
+        name: str = "",
+        cmd: list[str] | None = None,
+        cwd: str | None = None,
+        env: dict[str, str] | None = None,
+        pid: int = 0,
+        returncode: int = 0,
+    ) -> None:
+        super().__init__(action, name, cmd, cwd, env, pid)
+        self.returncode = returncode
 
 
-@dataclass
 class ProcessIO(ProcessEvent):
-    text: bytes = b""
-    fd: int = 1
+    _fields = (*ProcessEvent._fields, "text", "fd")
+
+    def __init__(
+        self,
+        action: Any = None,
+        name: str = "",
+        cmd: list[str] | None = None,
+        cwd: str | None = None,
+        env: dict[str, str] | None = None,
+        pid: int = 0,
+        text: bytes = b"",
+        fd: int = 1,
+    ) -> None:
+        super().__init__(action, name, cmd, cwd, env, pid)
+        self.text = text
+        self.fd = fd
 
 
 class ProcessStdout(ProcessIO):
@@ -56,20 +100,29 @@ class ProcessStderr(ProcessIO):
     pass
 
 
-ProcessMatcher = Callable[[Any], bool]
+if TYPE_CHECKING:
+    ProcessMatcher = Callable[[Any], bool]
+else:  # the same at run time, without typing.Any
+    ProcessMatcher = Callable[[object], bool]
 
 
-@dataclass
-class ShutdownProcess(Event):
+class ShutdownProcess(Record, Event):
     """Run the stop ladder on the processes the matcher selects."""
 
-    process_matcher: ProcessMatcher | None = None
+    _fields = ("process_matcher",)
+
+    def __init__(self, process_matcher: ProcessMatcher | None = None) -> None:
+        self.process_matcher = process_matcher
 
 
-@dataclass
-class SignalProcess(Event):
-    signal_number: int = 2
-    process_matcher: ProcessMatcher | None = None
+class SignalProcess(Record, Event):
+    _fields = ("signal_number", "process_matcher")
+
+    def __init__(
+        self, signal_number: int = 2, process_matcher: ProcessMatcher | None = None
+    ) -> None:
+        self.signal_number = signal_number
+        self.process_matcher = process_matcher
 
 
 def matches_action(target_action: Any) -> ProcessMatcher:

@@ -172,6 +172,7 @@ class SharedGraph:
 class SequenceStep(Step):
     """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order."""
 
+    origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     nodes: tuple[str, ...] = ()
     shutdown_on_failure: bool = True
     timeout: float = DEFAULT_TIMEOUT

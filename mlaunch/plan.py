@@ -4,34 +4,90 @@ A Plan is an ordered list of steps (start this process, print this line, arm thi
 for this event, shut down). Anything that depends on run time is a step carrying a ``Deferred``:
 entities plus the context captured where they were written, resolved by the same resolver when
 the trigger fires.
+
+The classes are plain classes with ``__slots__``, not dataclasses: importing dataclasses costs
+~8 ms (it imports inspect, ast, dis and tokenize) and creating each dataclass ~0.4 ms, all before
+the first child starts. ``Record`` gives them the equality and repr a dataclass would have.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
-
+# typing is imported by type checkers only (~4 ms at start-up); mypy treats this name as
+# typing.TYPE_CHECKING.
+TYPE_CHECKING = False
 if TYPE_CHECKING:
+    from typing import Any
+
     from mlaunch.context import LaunchContext
 
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")
 
 
-@dataclass(frozen=True)
-class RespawnPolicy:
-    """When and how a process is started again after it exits.
+class Record:
+    """Equality and repr over the names in ``_fields``, as a dataclass compares and shows itself.
+
+    Equal when of the same class with equal fields; unhashable (defining ``__eq__`` removes the
+    inherited ``__hash__``), as a mutable dataclass is.
+    """
+
+    __slots__ = ()
+    _fields: tuple[str, ...] = ()
+
+    def _values(self) -> tuple[Any, ...]:
+        return tuple(getattr(self, name) for name in self._fields)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Record) or other.__class__ is not self.__class__:
+            return NotImplemented
+        return self._values() == other._values()
+
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._fields)
+        return f"{type(self).__qualname__}({fields})"
+
+
+class RespawnPolicy(Record):
+    """When and how a process is started again after it exits (immutable and hashable).
 
     ``mode`` is ``never``, ``always`` (ROS 2's respawn=True: any exit) or ``on-failure``
     (non-zero status or a signal). The delay doubles after each quick failure up to
     ``max_delay`` (crash-loop backoff); ``max_retries`` -1 means no limit.
     """
 
-    mode: str = "never"
-    delay: float = 0.0
-    max_retries: int = -1
-    backoff: float = 1.0
-    max_delay: float = 30.0
+    _fields = ("mode", "delay", "max_retries", "backoff", "max_delay")
+    __slots__ = _fields
+    # What the slots hold, for type checkers: __init__ sets them without ``self.x = ...``.
+    mode: str
+    delay: float
+    max_retries: int
+    backoff: float
+    max_delay: float
+
+    def __init__(
+        self,
+        mode: str = "never",
+        delay: float = 0.0,
+        max_retries: int = -1,
+        backoff: float = 1.0,
+        max_delay: float = 30.0,
+    ) -> None:
+        # Frozen: the supervisor and every respawn share one policy object.
+        init = object.__setattr__
+        init(self, "mode", mode)
+        init(self, "delay", delay)
+        init(self, "max_retries", max_retries)
+        init(self, "backoff", backoff)
+        init(self, "max_delay", max_delay)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"cannot assign to field {name!r} of a RespawnPolicy (it is frozen)")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"cannot delete field {name!r} of a RespawnPolicy (it is frozen)")
+
+    def __hash__(self) -> int:
+        return hash(self._values())
 
     def describe(self) -> str:
         if self.mode == "never":
@@ -43,16 +99,27 @@ class RespawnPolicy:
         return text
 
 
-@dataclass
-class NodeInfo:
+class NodeInfo(Record):
     """What the ROS layer knows about a process that is a ROS node."""
 
-    name: str | None
-    namespace: str
-    package: str | None
-    executable: str
-    lifecycle: bool = False
-    autostart: bool = False
+    _fields = ("name", "namespace", "package", "executable", "lifecycle", "autostart")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        name: str | None,
+        namespace: str,
+        package: str | None,
+        executable: str,
+        lifecycle: bool = False,
+        autostart: bool = False,
+    ) -> None:
+        self.name = name
+        self.namespace = namespace
+        self.package = package
+        self.executable = executable
+        self.lifecycle = lifecycle
+        self.autostart = autostart
 
     @property
     def fully_qualified_name(self) -> str | None:
@@ -62,41 +129,90 @@ class NodeInfo:
         return f"{ns}/{self.name}"
 
 
-@dataclass
-class ProcessSpec:
+class ProcessSpec(Record):
     """Everything needed to start, watch and stop one process. Respawns reuse it unchanged."""
 
-    label: str
-    argv: tuple[str, ...]
-    env: dict[str, str]
-    env_changes: dict[str, str | None]
-    cwd: str | None = None
-    shell: bool = False
-    output: str = "log"
-    respawn: RespawnPolicy = field(default_factory=RespawnPolicy)
-    sigterm_timeout: float = 5.0
-    sigkill_timeout: float = 5.0
-    required: bool = False
-    on_exit: Deferred | None = None
-    origin: str = ""
-    action: Any = None
-    node: NodeInfo | None = None
-    standin: str | None = None
-    temp_files: tuple[str, ...] = ()
+    _fields = (
+        "label",
+        "argv",
+        "env",
+        "env_changes",
+        "cwd",
+        "shell",
+        "output",
+        "respawn",
+        "sigterm_timeout",
+        "sigkill_timeout",
+        "required",
+        "on_exit",
+        "origin",
+        "action",
+        "node",
+        "standin",
+        "temp_files",
+    )
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        label: str,
+        argv: tuple[str, ...],
+        env: dict[str, str],
+        env_changes: dict[str, str | None],
+        cwd: str | None = None,
+        shell: bool = False,
+        output: str = "log",
+        respawn: RespawnPolicy | None = None,
+        sigterm_timeout: float = 5.0,
+        sigkill_timeout: float = 5.0,
+        required: bool = False,
+        on_exit: Deferred | None = None,
+        origin: str = "",
+        action: Any = None,
+        node: NodeInfo | None = None,
+        standin: str | None = None,
+        temp_files: tuple[str, ...] = (),
+    ) -> None:
+        self.label = label
+        self.argv = argv
+        self.env = env
+        self.env_changes = env_changes
+        self.cwd = cwd
+        self.shell = shell
+        self.output = output
+        self.respawn: RespawnPolicy = RespawnPolicy() if respawn is None else respawn
+        self.sigterm_timeout = sigterm_timeout
+        self.sigkill_timeout = sigkill_timeout
+        self.required = required
+        self.on_exit = on_exit
+        self.origin = origin
+        self.action = action
+        self.node = node
+        self.standin = standin
+        self.temp_files = temp_files
 
     @property
     def base_name(self) -> str:
         return self.label.rsplit("-", 1)[0]
 
 
-@dataclass
-class Deferred:
+class Deferred(Record):
     """Entities to resolve later, with the context they were written in."""
 
-    entities: list[Any]
-    context: LaunchContext
-    origin: str = ""
-    callback: Any = None  # callable(event, context) -> entities, as ROS 2 handlers accept
+    _fields = ("entities", "context", "origin", "callback")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        entities: list[Any],
+        context: LaunchContext,
+        origin: str = "",
+        callback: Any = None,  # callable(event, context) -> entities, as ROS 2 handlers accept
+    ) -> None:
+        self.entities = entities
+        self.context = context
+        self.origin = origin
+        self.callback = callback
 
     def describe(self) -> str:
         if self.callback is not None:
@@ -110,79 +226,151 @@ def _entity_name(entity: Any) -> str:
     return describe() if describe else type(entity).__name__
 
 
-@dataclass
-class Step:
+class Step(Record):
     """One thing the supervisor does, in plan order."""
 
-    origin: str = ""
+    _fields: tuple[str, ...] = ("origin",)
+    __slots__ = _fields
+
+    def __init__(self, origin: str = "") -> None:
+        self.origin = origin
 
 
-@dataclass
 class Spawn(Step):
-    spec: ProcessSpec | None = None
+    __slots__ = ("spec",)
+    _fields = (*Step._fields, "spec")
+
+    def __init__(self, origin: str = "", spec: ProcessSpec | None = None) -> None:
+        self.origin = origin
+        self.spec = spec
 
 
-@dataclass
 class Log(Step):
-    level: str = "INFO"
-    source: str = "launch.user"
-    message: str = ""
+    __slots__ = ("level", "message", "source")
+    _fields = (*Step._fields, "level", "source", "message")
+
+    def __init__(
+        self,
+        origin: str = "",
+        level: str = "INFO",
+        source: str = "launch.user",
+        message: str = "",
+    ) -> None:
+        self.origin = origin
+        self.level = level
+        self.source = source
+        self.message = message
 
 
-@dataclass
 class StartTimer(Step):
-    period: float = 0.0
-    body: Deferred | None = None
-    cancel_on_shutdown: bool = True
+    __slots__ = ("body", "cancel_on_shutdown", "period")
+    _fields = (*Step._fields, "period", "body", "cancel_on_shutdown")
+
+    def __init__(
+        self,
+        origin: str = "",
+        period: float = 0.0,
+        body: Deferred | None = None,
+        cancel_on_shutdown: bool = True,
+    ) -> None:
+        self.origin = origin
+        self.period = period
+        self.body = body
+        self.cancel_on_shutdown = cancel_on_shutdown
 
 
-@dataclass
 class AddHandler(Step):
     """Listen for an event: ``kind`` is process_start, process_exit, process_io, shutdown, ..."""
 
-    kind: str = ""
-    matcher: Any = None  # callable(ProcessSpec) -> bool, or None for every process
-    body: Deferred | None = None
-    io_callbacks: dict[str, Any] = field(default_factory=dict)
-    once: bool = False
-    handler: Any = None  # the user's handler object (for UnregisterEventHandler)
+    __slots__ = ("body", "handler", "io_callbacks", "kind", "matcher", "once")
+    _fields = (*Step._fields, "kind", "matcher", "body", "io_callbacks", "once", "handler")
+
+    def __init__(
+        self,
+        origin: str = "",
+        kind: str = "",
+        matcher: Any = None,  # callable(ProcessSpec) -> bool, or None for every process
+        body: Deferred | None = None,
+        io_callbacks: dict[str, Any] | None = None,
+        once: bool = False,
+        handler: Any = None,  # the user's handler object (for UnregisterEventHandler)
+    ) -> None:
+        self.origin = origin
+        self.kind = kind
+        self.matcher = matcher
+        self.body = body
+        self.io_callbacks: dict[str, Any] = {} if io_callbacks is None else io_callbacks
+        self.once = once
+        self.handler = handler
 
 
-@dataclass
 class RemoveHandler(Step):
-    handler: Any = None
+    __slots__ = ("handler",)
+    _fields = (*Step._fields, "handler")
+
+    def __init__(self, origin: str = "", handler: Any = None) -> None:
+        self.origin = origin
+        self.handler = handler
 
 
-@dataclass
 class RequestShutdown(Step):
-    reason: str = "reason not given"
+    __slots__ = ("reason",)
+    _fields = (*Step._fields, "reason")
+
+    def __init__(self, origin: str = "", reason: str = "reason not given") -> None:
+        self.origin = origin
+        self.reason = reason
 
 
-@dataclass
 class EmitEvent(Step):
     """An event other than Shutdown (ShutdownProcess, SignalProcess, lifecycle ChangeState...)."""
 
-    event: Any = None
+    __slots__ = ("event",)
+    _fields = (*Step._fields, "event")
+
+    def __init__(self, origin: str = "", event: Any = None) -> None:
+        self.origin = origin
+        self.event = event
 
 
-@dataclass
-class ArgumentInfo:
+class ArgumentInfo(Record):
     """A declared launch argument, for --show-args and CLI checks."""
 
-    name: str
-    default: str | None
-    description: str
-    choices: tuple[str, ...] | None
-    origin: str
-    conditional: bool = False
+    _fields = ("name", "default", "description", "choices", "origin", "conditional")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        name: str,
+        default: str | None,
+        description: str,
+        choices: tuple[str, ...] | None,
+        origin: str,
+        conditional: bool = False,
+    ) -> None:
+        self.name = name
+        self.default = default
+        self.description = description
+        self.choices = choices
+        self.origin = origin
+        self.conditional = conditional
 
 
-@dataclass
-class Plan:
-    steps: list[Step] = field(default_factory=list)
-    arguments: dict[str, ArgumentInfo] = field(default_factory=dict)
-    warnings: list[str] = field(default_factory=list)
-    temp_dir: str | None = None
+class Plan(Record):
+    _fields = ("steps", "arguments", "warnings", "temp_dir")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        steps: list[Step] | None = None,
+        arguments: dict[str, ArgumentInfo] | None = None,
+        warnings: list[str] | None = None,
+        temp_dir: str | None = None,
+    ) -> None:
+        self.steps: list[Step] = [] if steps is None else steps
+        self.arguments: dict[str, ArgumentInfo] = {} if arguments is None else arguments
+        self.warnings: list[str] = [] if warnings is None else warnings
+        self.temp_dir = temp_dir
 
     def processes(self) -> list[ProcessSpec]:
         return [s.spec for s in self.steps if isinstance(s, Spawn) and s.spec is not None]

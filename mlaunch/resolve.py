@@ -9,15 +9,17 @@ from __future__ import annotations
 
 import itertools
 import os
-from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any
 
 from mlaunch.context import LaunchContext
 from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
 from mlaunch.origin import user_location
-from mlaunch.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step
+from mlaunch.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Record, Spawn, Step
 from mlaunch.substitutions import Substitution, normalize, perform, perform_substitutions
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable, Mapping
+    from typing import Any
 
 
 class LabelCounter:
@@ -30,15 +32,25 @@ class LabelCounter:
         return f"{base}-{next(self._next)}"
 
 
-@dataclass
-class ResolveOptions:
+class ResolveOptions(Record):
     """What the CLI decides about resolution."""
 
-    standins: bool = True
-    use_sim_time: bool | None = None
-    package_path: tuple[str, ...] = ()
-    temp_dir: str | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
+    _fields = ("standins", "use_sim_time", "package_path", "temp_dir", "extra")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        standins: bool = True,
+        use_sim_time: bool | None = None,
+        package_path: tuple[str, ...] = (),
+        temp_dir: str | None = None,
+        extra: dict[str, Any] | None = None,
+    ) -> None:
+        self.standins = standins
+        self.use_sim_time = use_sim_time
+        self.package_path = package_path
+        self.temp_dir = temp_dir
+        self.extra: dict[str, Any] = {} if extra is None else extra
 
 
 class Resolver:

@@ -211,6 +211,7 @@ def _rate(text: str, target: str, origin: str) -> float:
 class ExpectStep(Step):
     """Plan step of an Expect action (the supervisor passes over steps it does not know)."""
 
+    origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     expectation: Expectation | None = None
 
 
