@@ -4,8 +4,12 @@ Child output is data, never markup: bytes in, invalid UTF-8 replaced, each line 
 process label, written with one call per chunk. A chunk is prefixed with a single
 ``bytes.replace`` instead of a per-line Python loop, which is what lets mlaunch pass hundreds of
 thousands of lines a second while the children keep running. The terminal never blocks the
-supervisor (Screen: a bounded, non-blocking queue); the log files get every line. rich is used
-only by the status view, and imported only when it is shown.
+supervisor (Screen: a bounded, non-blocking queue that the supervisor flushes whenever fd 1 is
+writable); when the reader is slower than the children, the supervisor stops reading their pipes
+until the queue drains, so they slow down to the reader's pace and no line is lost. Only a reader
+that takes nothing at all for a while (a paused terminal) costs screen lines, counted and
+reported; the log files get every line. rich is used only by the status view, and imported only
+when it is shown.
 """
 
 from __future__ import annotations
@@ -17,8 +21,10 @@ import sys
 import time
 from collections import deque
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
-from typing import IO
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import IO
 
 # Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
 # which mlaunch always writes so every process has its log).
@@ -41,8 +47,15 @@ DEFAULT_ROTATE_KEEP = 3
 # Per log file: a hundred processes must not pin a hundred large buffers.
 LOG_BUFFER = 64 * 1024
 # Screen output queued for a terminal that is behind, at most; beyond it lines are dropped
-# from the screen (never from the logs).
+# from the screen (never from the logs). Only reached when the reader has stalled (below).
 SCREEN_BACKLOG = 4 * 1024 * 1024
+# Above HIGH_WATER queued bytes the supervisor stops reading the children's pipes, until the
+# queue is below LOW_WATER again: the children wait for the reader instead of losing lines.
+HIGH_WATER = 1024 * 1024
+LOW_WATER = 256 * 1024
+# A reader that takes nothing for this long (Ctrl-S, a pipe nobody reads) holds the children
+# no longer: they run on, and what does not fit the backlog is dropped from the screen.
+STALL = 1.0
 # Queued screen output is written once this much has gathered, else when the loop goes idle.
 SCREEN_CHUNK = 256 * 1024
 
@@ -67,20 +80,47 @@ class Screen:
     """The terminal (fd 1) for a supervisor that must never block on it.
 
     Output is queued and handed to the fd without blocking: O_NONBLOCK is set only around the
-    write, so the shell sharing the terminal never inherits it. If the reader falls behind (a
-    slow ssh link, a terminal paused with Ctrl-S, a pipe nobody reads) the queue grows up to
-    ``limit`` bytes; beyond that, output is dropped from the screen only, counted, and reported
-    once the terminal catches up. The children keep running and the log files keep every line.
+    write, so the shell sharing the terminal never inherits it. The supervisor flushes whenever
+    the fd is writable (``waiting``/``fd``) and stops reading its children while ``holding()``:
+    from ``high_water`` queued bytes until the queue is below ``low_water``. So a slow reader
+    (a slow ssh link, ``| less``) slows the children down and loses nothing.
+
+    A reader that makes no progress at all for ``stall`` seconds (a terminal paused with
+    Ctrl-S, a pipe nobody reads) holds nobody any longer: the queue grows to ``limit`` bytes and
+    beyond that output is dropped from the screen only, counted, and reported where the gap is
+    (or once the terminal catches up). The children keep running and the log files keep every
+    line. mlaunch's own messages (``urgent``) are never dropped.
     """
 
-    def __init__(self, fd: int = 1, *, limit: int = SCREEN_BACKLOG) -> None:
+    def __init__(
+        self,
+        fd: int = 1,
+        *,
+        limit: int = SCREEN_BACKLOG,
+        stall: float = STALL,
+        high_water: int = HIGH_WATER,
+        low_water: int = LOW_WATER,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         self.fd = fd
         self.limit = limit
+        self.stall = stall
+        # A small limit (a test's) scales the marks down, so that holding starts before dropping.
+        self.high_water = min(high_water, max(1, limit // 2))
+        self.low_water = min(low_water, self.high_water // 4)
+        self.clock = clock
+        # Totals over the run; the notices say what was dropped since the previous notice.
         self.dropped_lines = 0
         self.dropped_bytes = 0
+        self._noted_lines = 0
+        self._noted_bytes = 0
+        self.peak = 0  # the most bytes ever queued (memory stays bounded: tests look)
         self.gone = False  # the reader went away (EPIPE, EIO): the screen is dropped for good
         self._queue: deque[bytes] = deque()
+        self._offset = 0  # bytes of the queue's head already written
         self._size = 0
+        self._held = False
+        self._progress_at = 0.0  # the last write the reader took, or when output began waiting
         try:
             self._regular = stat.S_ISREG(os.fstat(fd).st_mode)
         except OSError:
@@ -88,6 +128,11 @@ class Screen:
 
     def __call__(self, data: bytes) -> None:
         self.write(data)
+
+    @property
+    def backlog(self) -> int:
+        """Bytes queued for the terminal."""
+        return self._size
 
     def write(self, data: bytes, *, urgent: bool = False) -> None:
         """Queue ``data``; beyond the limit it is dropped (counted) unless ``urgent``."""
@@ -97,10 +142,20 @@ class Screen:
             self.dropped_lines += data.count(b"\n")
             self.dropped_bytes += len(data)
             return
-        self._queue.append(data)
-        self._size += len(data)
+        if not self._queue:
+            self._progress_at = self.clock()  # the stall clock starts when output waits
+        if self.dropped_bytes != self._noted_bytes and not urgent:
+            # Room again after a gap: say so right where the lines are missing.
+            self._append(self._drop_notice())
+        self._append(data)
         if self._size >= SCREEN_CHUNK:
             self.flush()
+
+    def _append(self, data: bytes) -> None:
+        self._queue.append(data)
+        self._size += len(data)
+        if self._size > self.peak:
+            self.peak = self._size
 
     def urgent(self, data: bytes) -> None:
         """mlaunch's own messages (an exit, an escalation) are few and small: never dropped."""
@@ -111,6 +166,27 @@ class Screen:
         """Output is waiting for the terminal."""
         return bool(self._queue) and not self.gone
 
+    waiting = blocked
+
+    def stalled(self) -> bool:
+        """Output waits and the reader has taken nothing for ``stall`` seconds."""
+        return self.blocked and self.clock() - self._progress_at >= self.stall
+
+    def holding(self) -> bool:
+        """Whether the producers should wait for the reader (the supervisor asks before reads).
+
+        From ``high_water`` queued bytes until below ``low_water``, unless the reader stalled.
+        """
+        if self._held:
+            if self._size < self.low_water or self.gone:
+                self._held = False
+                return False
+        elif self._size < self.high_water or self.gone:
+            return False
+        else:
+            self._held = True
+        return not self.stalled()
+
     def flush(self) -> None:
         """Write what the terminal takes now; keep the rest queued."""
         if not self._queue or self.gone:
@@ -120,9 +196,8 @@ class Screen:
             os.set_blocking(self.fd, False)
         try:
             self._write_queue()
-            if not self._queue and self.dropped_lines + self.dropped_bytes:
-                self._queue.append(self._drop_notice())
-                self._size += len(self._queue[-1])
+            if not self._queue and self.dropped_bytes != self._noted_bytes:
+                self._append(self._drop_notice())
                 self._write_queue()
         finally:
             if nonblocking:
@@ -134,32 +209,40 @@ class Screen:
     def _write_queue(self) -> None:
         queue = self._queue
         while queue:
-            if len(queue) > 1 and len(queue[0]) < SCREEN_CHUNK:
+            if len(queue) > 1 and len(queue[0]) - self._offset < SCREEN_CHUNK:
                 # Many small pieces (one per line burst) go out in one write.
                 parts, size = [], 0
                 while queue and size < SCREEN_CHUNK:
-                    size += len(queue[0])
-                    parts.append(queue.popleft())
+                    part = queue.popleft()
+                    if self._offset:
+                        part, self._offset = part[self._offset :], 0
+                    size += len(part)
+                    parts.append(part)
                 queue.appendleft(b"".join(parts))
             head = queue[0]
             try:
-                n = os.write(self.fd, head)
+                # A partial write keeps an offset into the head: the rest is never copied.
+                n = os.write(self.fd, memoryview(head)[self._offset :] if self._offset else head)
             except BlockingIOError:
                 return
             except OSError:
                 self.gone = True
                 queue.clear()
-                self._size = 0
+                self._size = self._offset = 0
                 return
+            if n > 0:
+                self._progress_at = self.clock()
             self._size -= n
-            if n < len(head):
-                queue[0] = head[n:]
+            self._offset += n
+            if self._offset < len(head):
                 return
             queue.popleft()
+            self._offset = 0
 
     def _drop_notice(self) -> bytes:
-        lines, size = self.dropped_lines, self.dropped_bytes
-        self.dropped_lines = self.dropped_bytes = 0
+        lines = self.dropped_lines - self._noted_lines
+        size = self.dropped_bytes - self._noted_bytes
+        self._noted_lines, self._noted_bytes = self.dropped_lines, self.dropped_bytes
         return (
             f"[WARNING] [launch]: the terminal fell behind: {lines} lines ({size / 1e6:.1f} MB)"
             " were not shown; the log files have them\n"
@@ -303,24 +386,39 @@ def make_run_log_dir(environ: Mapping[str, str]) -> str:
     return path
 
 
-@dataclass
 class Printer:
     """Owns the terminal and the log files of a run.
 
     ``out`` receives every byte meant for the screen; None means the real terminal through a
-    Screen (non-blocking, bounded). Tests pass a callable that collects bytes.
+    Screen (non-blocking, bounded), whose flow control the supervisor drives (``waiting_fd``,
+    ``holding``, ``flush_screen``). Tests pass a callable that collects bytes, or a Screen.
     """
 
-    out: Callable[[bytes], object] | None = None
-    color: bool = False
-    log_dir: str | None = None
-    rotate_bytes: int = DEFAULT_ROTATE_BYTES
-    rotate_keep: int = DEFAULT_ROTATE_KEEP
-    quiet: bool = False
-    clock: Callable[[], float] = time.time
-
-    def __post_init__(self) -> None:
-        self._write: Callable[[bytes], object] = Screen() if self.out is None else self.out
+    def __init__(
+        self,
+        out: Callable[[bytes], object] | None = None,
+        color: bool = False,
+        log_dir: str | None = None,
+        rotate_bytes: int = DEFAULT_ROTATE_BYTES,
+        rotate_keep: int = DEFAULT_ROTATE_KEEP,
+        quiet: bool = False,
+        clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.out = out
+        self.color = color
+        self.log_dir = log_dir
+        self.rotate_bytes = rotate_bytes
+        self.rotate_keep = rotate_keep
+        self.quiet = quiet
+        self.clock = clock
+        # The Screen under whatever the screen output goes through (a status view wraps it).
+        self._screen: Screen | None
+        self._write: Callable[[bytes], object]
+        if out is None:
+            self._screen = self._write = Screen()
+        else:
+            self._screen = out if isinstance(out, Screen) else None
+            self._write = out
         self._launch_log: LogFile | None = None
         self._own: dict[str, LogFile] = {}
         self._prefix: dict[str, bytes] = {}
@@ -329,6 +427,9 @@ class Printer:
         self.hooks: list[Callable[[str, str, bytes], None]] = []
         if self.log_dir:
             self._launch_log = self._open("launch.log", lazy=False)
+
+    def __repr__(self) -> str:
+        return f"Printer(log_dir={self.log_dir!r}, color={self.color}, quiet={self.quiet})"
 
     def _open(self, name: str, *, lazy: bool = True) -> LogFile:
         assert self.log_dir is not None
@@ -361,6 +462,25 @@ class Printer:
     def blocked(self) -> bool:
         """The screen has output waiting for the terminal (the supervisor then polls)."""
         return bool(getattr(self._write, "blocked", False))
+
+    # --- flow control, driven by the supervisor's loop ------------------------------------------
+
+    def waiting_fd(self) -> int | None:
+        """The terminal's fd while output waits for it (to select for writability), else None."""
+        screen = self._screen
+        if screen is None or not screen.waiting:
+            return None
+        return screen.fd
+
+    def holding(self) -> bool:
+        """The terminal is far behind: stop reading the children until it catches up."""
+        screen = self._screen
+        return screen is not None and screen.holding()
+
+    def flush_screen(self) -> None:
+        """Hand the terminal what it takes now (its fd was reported writable)."""
+        if self._screen is not None:
+            self._screen.flush()
 
     # --- launch's own messages ----------------------------------------------------------------
 

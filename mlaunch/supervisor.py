@@ -14,6 +14,17 @@ Nothing is left behind:
 - a guard process (mlaunch.guard, a constructor seam) ends the run if mlaunch itself is killed;
 - if the loop itself fails, every group is killed before the error propagates.
 
+At shutdown the stray sweep walks mlaunch's process tree (/proc/<pid>/task/*/children, a few
+reads); the full /proc scan for the marker (every process's environment) is only made when the
+walk cannot be trusted to see everything: without the subreaper, or when a child had already
+exited before the subreaper was set (its orphans went to init).
+
+Output flow: while the terminal has a backlog, its fd is in the selector for writability, so the
+backlog is written as fast as the reader takes it; while the backlog is above its high-water
+mark (``Printer.holding()``), a child's pipe that becomes readable is taken out of the selector
+until the terminal catches up, so the children block on their own pipes instead of losing lines.
+A reader that has stalled (nothing taken for ~1 s) holds nobody: the Screen drops, and says so.
+
 The per-label ProcessRecord (state, restarts, run time, peak memory) is what the status view and
 the exit summary read; peak memory and CPU time come from wait4's rusage, so nothing is sampled.
 """
@@ -27,8 +38,6 @@ import selectors
 import signal
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
 
 from mlaunch import events as ev
 from mlaunch import guard as guards
@@ -57,6 +66,10 @@ from mlaunch.process import (
     signal_name,
 )
 from mlaunch.resolve import LabelCounter, ResolveOptions, resolve_deferred
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
 
 EXIT_OK = 0
 EXIT_REQUIRED_FAILED = 1
@@ -105,26 +118,70 @@ class _Timer:
         return (self.when, self.seq) < (other.when, other.seq)
 
 
-@dataclass
 class ProcessRecord:
-    """One process label over the whole run (all its respawns): for the status view and summary."""
+    """One process label over the whole run (all its respawns): for the status view and summary.
 
-    label: str
-    spec: ProcessSpec
-    state: str = RUNNING
-    pid: int = 0
-    started_at: float = 0.0
-    restarts: int = 0
-    # Quick exits in a row: the exponent of the crash-loop backoff.
-    streak: int = 0
-    returncode: int | None = None
-    outcome: str = ""
-    failed: bool = False
-    run_time: float = 0.0
-    peak_rss: int = 0
-    cpu_time: float = 0.0
-    restart_at: float | None = None
-    signals: list[int] = field(default_factory=list)
+    A plain class (dataclass creation is start-up cost); every field is a keyword argument.
+    """
+
+    __slots__ = (
+        "cpu_time",
+        "failed",
+        "label",
+        "outcome",
+        "peak_rss",
+        "pid",
+        "restart_at",
+        "restarts",
+        "returncode",
+        "run_time",
+        "signals",
+        "spec",
+        "started_at",
+        "state",
+        "streak",
+    )
+
+    def __init__(
+        self,
+        label: str,
+        spec: ProcessSpec,
+        state: str = RUNNING,
+        pid: int = 0,
+        started_at: float = 0.0,
+        restarts: int = 0,
+        streak: int = 0,
+        returncode: int | None = None,
+        outcome: str = "",
+        failed: bool = False,
+        run_time: float = 0.0,
+        peak_rss: int = 0,
+        cpu_time: float = 0.0,
+        restart_at: float | None = None,
+        signals: list[int] | None = None,
+    ) -> None:
+        self.label = label
+        self.spec = spec
+        self.state = state
+        self.pid = pid
+        self.started_at = started_at
+        self.restarts = restarts
+        # Quick exits in a row: the exponent of the crash-loop backoff.
+        self.streak = streak
+        self.returncode = returncode
+        self.outcome = outcome
+        self.failed = failed
+        self.run_time = run_time
+        self.peak_rss = peak_rss
+        self.cpu_time = cpu_time
+        self.restart_at = restart_at
+        self.signals: list[int] = [] if signals is None else signals
+
+    def __repr__(self) -> str:
+        return (
+            f"ProcessRecord(label={self.label!r}, state={self.state!r}, pid={self.pid},"
+            f" restarts={self.restarts}, outcome={self.outcome!r})"
+        )
 
 
 def respawn_delay(policy: RespawnPolicy, streak: int) -> float:
@@ -196,6 +253,14 @@ class Supervisor:
         self.listeners: list[Callable[[str, Process], None]] = []
         self._stray_seen: dict[int, float] = {}
         self._stray_signalled: set[tuple[int, int]] = set()
+        # A child had exited before the subreaper was set: its orphans may have gone to init,
+        # where only the marker scan finds them.
+        self._escaped = False
+        # Output flow: the terminal fd selected for writability, and the pipes not read while
+        # the terminal is behind (fd -> process).
+        self._out_fd: int | None = None
+        self._out_unselectable: set[int] = set()
+        self._paused: dict[int, Process] = {}
 
     # --- the loop ------------------------------------------------------------------------------
 
@@ -205,12 +270,18 @@ class Supervisor:
             for warning in self.plan.warnings:
                 self.printer.message("WARNING", "launch", warning)
             self.execute(self.plan.steps)
+            if self.guard is not None:
+                self.guard.flush()  # the first spawns' groups, in one write
             # After the first spawns, not before: ctypes costs milliseconds and the first child
             # should not wait for it. An orphan from that window is still found by its marker.
             if self.adopt:
                 self._set_subreaper(True)
+                self._escaped = self._a_child_has_exited()
             while not self._finished():
                 self._loop_once()
+            if self.guard is not None:
+                # Everything of the run has ended: the guard may leave while we tidy up.
+                self.guard.dismiss()
         except BaseException:
             self._emergency_stop()
             raise
@@ -225,14 +296,66 @@ class Supervisor:
         timeout = self._next_timeout()
         if timeout is None or timeout > 0:
             self.printer.flush()
-            if self.printer.blocked():
-                # The terminal is behind: come back soon to hand it the rest of the backlog.
-                timeout = POLL if timeout is None else min(timeout, POLL)
+        if self.guard is not None and self.guard.pending:
+            self.guard.flush()  # this turn's +pgid/-pgid lines, in one write
+        if self._watch_output() or self._paused:
+            # The terminal cannot be selected on, or children wait for it: look again soon
+            # (a stalled reader must not hold them longer than the Screen's stall time).
+            timeout = POLL if timeout is None else min(timeout, POLL)
         ready = self.selector.select(timeout)
         for key, _ in ready:
             key.data(key.fd)
         self._handle_signals()
         self._run_due_timers()
+
+    # --- output flow ----------------------------------------------------------------------------
+
+    def _watch_output(self) -> bool:
+        """Select the terminal for writability while output waits; resume held pipes.
+
+        True when output waits on a terminal that cannot be selected on (then the loop polls).
+        """
+        fd = self.printer.waiting_fd()
+        if fd != self._out_fd:
+            if self._out_fd is not None:
+                self.selector.unregister(self._out_fd)
+                self._out_fd = None
+            if fd is not None and fd not in self._out_unselectable:
+                try:
+                    self.selector.register(fd, selectors.EVENT_WRITE, self._writable)
+                    self._out_fd = fd
+                except (OSError, ValueError, KeyError):
+                    # A regular file or /dev/null (never blocks), a closed fd, or one already
+                    # in the selector: flushed each turn instead.
+                    self._out_unselectable.add(fd)
+        if self._paused and not self.printer.holding():
+            self._resume_reading()
+        if fd is None:
+            return self.printer.blocked()  # a screen of another kind (a test's) with a backlog
+        return fd != self._out_fd
+
+    def _writable(self, fd: int) -> None:
+        self.printer.flush_screen()
+        if self._paused and not self.printer.holding():
+            self._resume_reading()
+
+    def _resume_reading(self) -> None:
+        """The terminal caught up (or stalled): read the held pipes again."""
+        paused, self._paused = self._paused, {}
+        for fd, process in paused.items():
+            if fd in process.streams:
+                self._select(process, fd)
+
+    def _select(self, process: Process, fd: int) -> None:
+        self.selector.register(
+            fd, selectors.EVENT_READ, lambda fd, p=process: self._readable(p, fd)
+        )
+
+    def _close_stream(self, process: Process, fd: int) -> None:
+        """Stop watching a pipe (in the selector, or held) and close it."""
+        if self._paused.pop(fd, None) is None:
+            self.selector.unregister(fd)
+        process.close_stream(fd)
 
     def _finished(self) -> bool:
         if any(p.running for p in self.processes):
@@ -248,10 +371,9 @@ class Supervisor:
             return False
         for process in self.processes:
             for fd in list(process.streams):
-                self._readable(process, fd)
+                self._read(process, fd)
                 if fd in process.streams:
-                    self.selector.unregister(fd)
-                    process.close_stream(fd)
+                    self._close_stream(process, fd)
         return True
 
     def _lingering_pending(self) -> bool:
@@ -295,11 +417,18 @@ class Supervisor:
             )
         return True
 
-    def _strays(self) -> list[guards.ProcInfo]:
-        procs = guards.scan()
-        found = {p.pid: p for p in guards.marked(self.run_id, procs)}
+    def _strays(self, *, thorough: bool = False) -> list[guards.ProcInfo]:
+        """Processes of the run outside our own children: descendants, and marked ones.
+
+        The walk down our process tree is cheap and, as subreaper, sees every descendant that
+        was orphaned after the subreaper was set. The marker scan reads every process's
+        environment (~ms), so it is made only when something may have escaped the walk.
+        """
+        found: dict[int, guards.ProcInfo] = {}
         if self._subreaper or self.adopt:
-            found.update((p.pid, p) for p in guards.descendants(os.getpid(), procs))
+            found.update((p.pid, p) for p in guards.tree(os.getpid()))
+        if thorough or not self._subreaper or self._escaped:
+            found.update((p.pid, p) for p in guards.marked(self.run_id))
         if self.guard is not None:
             found.pop(self.guard.pid, None)
         for pid in self.by_pid:  # our own children are the ladder's business
@@ -453,9 +582,7 @@ class Supervisor:
         self.by_pid[process.pid] = process
         record.state, record.pid, record.started_at = RUNNING, process.pid, process.started_at
         for fd in process.streams:
-            self.selector.register(
-                fd, selectors.EVENT_READ, lambda fd, p=process: self._readable(p, fd)
-            )
+            self._select(process, fd)
         self.printer.message("INFO", spec.label, f"process started with pid [{process.pid}]")
         self._notify("started", process)
         self._dispatch(
@@ -473,6 +600,17 @@ class Supervisor:
         return process
 
     def _readable(self, process: Process, fd: int) -> None:
+        """A child's pipe has data: read it, unless the terminal is too far behind."""
+        if self.printer.holding():
+            # Leave it in the pipe: the child blocks on a full pipe until the terminal catches
+            # up. Out of the selector meanwhile, or every turn would find it ready again.
+            if fd in process.streams:
+                self.selector.unregister(fd)
+                self._paused[fd] = process
+            return
+        self._read(process, fd)
+
+    def _read(self, process: Process, fd: int) -> None:
         stream = process.streams.get(fd)
         if stream is None:
             return
@@ -480,8 +618,7 @@ class Supervisor:
         if data:
             self._deliver(process, stream.name, data)
         if eof:
-            self.selector.unregister(fd)
-            process.close_stream(fd)
+            self._close_stream(process, fd)
 
     def _deliver(self, process: Process, stream: str, data: bytes) -> None:
         """Complete lines of a child: to the printer, then to OnProcessIO handlers."""
@@ -522,8 +659,7 @@ class Supervisor:
                 if data:
                     self._deliver(process, process.streams[fd].name, data)
                 if eof:
-                    self.selector.unregister(fd)
-                    process.close_stream(fd)
+                    self._close_stream(process, fd)
 
     def _reap(self) -> None:
         while True:
@@ -758,7 +894,7 @@ class Supervisor:
             for process in self.processes + self.lingering:
                 if process.running or process.check_group():
                     process.signal_group(signal.SIGKILL)
-            for proc in self._strays():
+            for proc in self._strays(thorough=True):
                 try:
                     os.kill(proc.pid, signal.SIGKILL)
                 except OSError:
@@ -813,11 +949,20 @@ class Supervisor:
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
         signal.set_wakeup_fd(self._old_wakeup)
         self.selector.close()
+        self._out_fd = None
         for fd in (self._wake_r, self._wake_w):
             try:
                 os.close(fd)
             except OSError:
                 pass
+
+    def _a_child_has_exited(self) -> bool:
+        """Whether a child is already a zombie (exited before we became subreaper)."""
+        try:
+            info = os.waitid(os.P_ALL, 0, os.WEXITED | os.WNOHANG | os.WNOWAIT)
+        except (ChildProcessError, OSError):
+            return False
+        return info is not None
 
     def _set_subreaper(self, on: bool) -> None:
         """As subreaper, orphaned descendants are re-parented to mlaunch, not to init."""
