@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import re
 import selectors
+import shutil
 import signal
 import subprocess
 import sys
@@ -20,6 +21,7 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
 from test_supervision import Harness, gone, make_spec, wait_until
 
 from mlaunch import guard as guards
@@ -317,6 +319,7 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
     assert during_run == [0]
 
 
+@pytest.mark.skipif(shutil.which("setsid") is None, reason="needs setsid(1) from util-linux")
 def test_an_orphan_from_before_the_subreaper_is_found_by_its_marker(monkeypatch: object) -> None:
     calls = counting_marker_scans(monkeypatch)
 
