@@ -1,7 +1,5 @@
 """``python -m mlaunch``: the same as the ``mlaunch`` command."""
 
-import sys
+from mlaunch.cli import program
 
-from mlaunch.cli import main
-
-sys.exit(main())
+program()

@@ -324,6 +324,28 @@ def private_temp_dir() -> str:
     raise OSError(f"cannot create a private directory in {base}")
 
 
+def remove_private_dir(path: str) -> None:
+    """Remove the params-file folder: flat, so no shutil (2 ms to import at exit)."""
+    try:
+        entries = list(os.scandir(path))
+    except FileNotFoundError:
+        return
+    if any(e.is_dir(follow_symlinks=False) for e in entries):
+        import shutil
+
+        shutil.rmtree(path, ignore_errors=True)
+        return
+    for entry in entries:
+        try:
+            os.unlink(entry.path)
+        except FileNotFoundError:
+            pass
+    try:
+        os.rmdir(path)
+    except OSError:
+        pass
+
+
 def launch(opts: Options, path: str, description: object) -> int:
     from mlaunch.resolve import ResolveOptions, resolve
 
@@ -360,9 +382,7 @@ def launch(opts: Options, path: str, description: object) -> int:
             return 0
         return supervise(opts, plan, options, labels, log_dir)
     finally:
-        import shutil
-
-        shutil.rmtree(temp_dir, ignore_errors=True)
+        remove_private_dir(temp_dir)
 
 
 def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
@@ -456,5 +476,24 @@ def _terminal_width() -> int:
         return 100
 
 
+def program() -> None:
+    """The ``mlaunch`` program: main(), then exit without interpreter teardown.
+
+    By the time main() returns, the printer is closed, the guard reaped and the temp dir gone;
+    only stdio buffers remain, so flushing them and calling os._exit skips ~8 ms of teardown
+    between the last child's death and mlaunch's. Tests call main() instead.
+    """
+    try:
+        code = main()
+    except SystemExit as e:  # argparse's usage errors and --help
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe (mlaunch ... | head)
+            pass
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    program()

@@ -289,6 +289,47 @@ def test_plain_launch_never_imports_rclpy(tmp_path: Path, env: dict[str, str]) -
     assert "IMPORTED []" in done.stdout
 
 
+def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
+    """The start-up budget (first child within 60 ms): what must not load before the first child.
+
+    The child's own start is the moment checked: the launch's only process is started, then the
+    heavy modules are looked for in mlaunch's sys.modules as its first output line arrives.
+    --show-args must not load the runtime at all.
+    """
+    heavy = ("rclpy", "rich", "asyncio", "yaml", "dataclasses", "typing", "inspect", "psutil")
+    path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'print(1)'], output='screen'),")
+    code = (
+        "import sys\n"
+        "import mlaunch.supervisor as sup\n"
+        "seen = []\n"
+        "original = sup.Supervisor.start\n"
+        "def start(self, *a, **k):\n"
+        "    result = original(self, *a, **k)\n"
+        f"    seen.extend(m for m in {heavy!r} if m in sys.modules)\n"
+        "    return result\n"
+        "sup.Supervisor.start = start\n"
+        "from mlaunch.cli import main\n"
+        "rc = main([sys.argv[1], '-q'])\n"
+        "print('AT-FIRST-CHILD', sorted(set(seen)))\n"
+        "sys.exit(rc)\n"
+    )
+    done = __import__("subprocess").run(
+        [PY, "-c", code, path], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "AT-FIRST-CHILD []" in done.stdout
+    show = (
+        "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '--show-args']);"
+        " runtime = ('mlaunch.supervisor', 'mlaunch.process', 'mlaunch.output', 'subprocess', 'selectors');"
+        " print('SHOW-ARGS', sorted(m for m in runtime if m in sys.modules)); sys.exit(rc)"
+    )
+    done = __import__("subprocess").run(
+        [PY, "-c", show, path], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "SHOW-ARGS []" in done.stdout
+
+
 def test_python_m_and_console_script_agree(tmp_path: Path, env: dict[str, str]) -> None:
     script = Path(sys.executable).parent / "mlaunch"
     if not script.exists():
