@@ -17,6 +17,7 @@ import sys
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Sequence
+    from typing import Any
 
 SUBCOMMANDS = {
     "test": "mlaunch.smoke",
@@ -291,15 +292,45 @@ def configure_packages(opts: Options, path: str) -> None:
     ros.configure_packages(search_paths=opts.package_path, launch_file=path, environ=os.environ)
 
 
-def run_cli(argv: Sequence[str]) -> int:
-    opts = parse_options(argv)
+def load_target(opts: Options) -> tuple[str, object]:
+    """The launch file the command line names (a path, or PKG FILE) and its description."""
     if opts.second is None and os.path.exists(opts.target):
         configure_packages(opts, os.path.abspath(opts.target))
     path = find_launch_file(opts)
     configure_packages(opts, path)
     from mlaunch import frontends
 
-    description = frontends.load(path)
+    return path, frontends.load(path)
+
+
+def resolve_for_run(
+    opts: Options, path: str, description: object, *, temp_dir: str, log_dir: str
+) -> tuple[Any, Any, Any]:
+    """(plan, resolve options, label counter) for a run of ``description`` as opts say."""
+    from mlaunch.resolve import LabelCounter, ResolveOptions, resolve
+
+    options = ResolveOptions(
+        standins=opts.standins,
+        use_sim_time=opts.use_sim_time,
+        package_path=tuple(opts.package_path),
+        temp_dir=temp_dir,
+    )
+    labels = LabelCounter()
+    plan = resolve(
+        description,
+        path=path,
+        arguments=opts.arguments,
+        environ=dict(os.environ),
+        log_dir=log_dir,
+        options=options,
+        labels=labels,
+    )
+    return plan, options, labels
+
+
+def run_cli(argv: Sequence[str]) -> int:
+    opts = parse_options(argv)
+    path, description = load_target(opts)
     if opts.show_args:
         from mlaunch.resolve import collect_arguments
 
@@ -347,33 +378,15 @@ def remove_private_dir(path: str) -> None:
 
 
 def launch(opts: Options, path: str, description: object) -> int:
-    from mlaunch.resolve import ResolveOptions, resolve
-
     temp_dir = private_temp_dir()
     try:
-        environ = dict(os.environ)
         log_dir = ""
         if not opts.print_plan:
             from mlaunch.output import make_run_log_dir
 
-            log_dir = make_run_log_dir(environ)
-        options = ResolveOptions(
-            standins=opts.standins,
-            use_sim_time=opts.use_sim_time,
-            package_path=tuple(opts.package_path),
-            temp_dir=temp_dir,
-        )
-        from mlaunch.resolve import LabelCounter
-
-        labels = LabelCounter()
-        plan = resolve(
-            description,
-            path=path,
-            arguments=opts.arguments,
-            environ=environ,
-            log_dir=log_dir,
-            options=options,
-            labels=labels,
+            log_dir = make_run_log_dir(os.environ)
+        plan, options, labels = resolve_for_run(
+            opts, path, description, temp_dir=temp_dir, log_dir=log_dir
         )
         if opts.print_plan:
             from mlaunch.describe import describe_plan

@@ -465,44 +465,26 @@ def main(args: Sequence[str]) -> int:
 
 def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
-    import shutil
-    import tempfile
-
-    from mlaunch import cli, frontends
+    from mlaunch import cli
     from mlaunch.actions import LaunchDescription
     from mlaunch.output import make_run_log_dir
-    from mlaunch.resolve import LabelCounter, ResolveOptions, resolve
 
-    if opts.second is None and os.path.exists(opts.target):
-        cli.configure_packages(opts, os.path.abspath(opts.target))
-    path = cli.find_launch_file(opts)
-    cli.configure_packages(opts, path)
-    description = frontends.load(path)
+    path, description = cli.load_target(opts)
     collector = _CollectConfigurations()
-    temp_dir = tempfile.mkdtemp(prefix="mlaunch-")
+    temp_dir = cli.private_temp_dir()
     try:
-        environ = dict(os.environ)
-        log_dir = make_run_log_dir(environ)
-        options = ResolveOptions(
-            standins=opts.standins,
-            use_sim_time=opts.use_sim_time,
-            package_path=tuple(opts.package_path),
-            temp_dir=temp_dir,
-        )
-        labels = LabelCounter()
-        plan = resolve(
+        log_dir = make_run_log_dir(os.environ)
+        plan, options, labels = cli.resolve_for_run(
+            opts,
+            path,
             LaunchDescription([description, collector]),
-            path=path,
-            arguments=opts.arguments,
-            environ=environ,
+            temp_dir=temp_dir,
             log_dir=log_dir,
-            options=options,
-            labels=labels,
         )
         expectations = build_expectations(plan, settings, collector, bool(opts.use_sim_time))
         return supervise(opts, settings, plan, options, labels, log_dir, path, expectations)
     finally:
-        shutil.rmtree(temp_dir, ignore_errors=True)
+        cli.remove_private_dir(temp_dir)
 
 
 def build_expectations(
