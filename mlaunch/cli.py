@@ -285,7 +285,7 @@ def report_error(error: BaseException, debug: bool) -> int:
     return 70
 
 
-def configure_packages(opts: Options, path: str) -> None:
+def configure_packages(opts: Options, path: str | None) -> None:
     """Tell the ROS layer where source packages are, before anything is resolved."""
     from mlaunch import ros
 
@@ -294,8 +294,9 @@ def configure_packages(opts: Options, path: str) -> None:
 
 def load_target(opts: Options) -> tuple[str, object]:
     """The launch file the command line names (a path, or PKG FILE) and its description."""
-    if opts.second is None and os.path.exists(opts.target):
-        configure_packages(opts, os.path.abspath(opts.target))
+    # Search settings first: `mlaunch PKG FILE` looks the package up with them.
+    given = os.path.abspath(opts.target) if opts.second is None else None
+    configure_packages(opts, given if given and os.path.exists(given) else None)
     path = find_launch_file(opts)
     configure_packages(opts, path)
     from mlaunch import frontends

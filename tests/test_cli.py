@@ -340,3 +340,29 @@ def test_python_m_and_console_script_agree(tmp_path: Path, env: dict[str, str]) 
     )
     assert done.returncode == 0 and "[INFO] [launch.user]: same" in done.stdout
     assert os.path.exists(env["ROS_LOG_DIR"])
+
+
+def test_package_and_file_form(tmp_path: Path, env: dict[str, str]) -> None:
+    """`mlaunch PKG FILE args`: FILE found in the package's share folder, as ros2 launch does."""
+    pkg = tmp_path / "src" / "demo_bringup"
+    (pkg / "launch").mkdir(parents=True)
+    (pkg / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>demo_bringup</name></package>\n'
+    )
+    (pkg / "launch" / "demo.launch.yaml").write_text(
+        "launch:\n- arg: {name: who, default: nobody}\n- log: {message: hello $(var who)}\n"
+    )
+    done = run_mlaunch(
+        "--package-path",
+        str(tmp_path / "src"),
+        "demo_bringup",
+        "demo.launch.yaml",
+        "who:=pkg",
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "[INFO] [launch.user]: hello pkg" in done.stdout
+    missing = run_mlaunch(
+        "--package-path", str(tmp_path / "src"), "demo_bringup", "x.launch.py", env=env
+    )
+    assert missing.returncode == 2 and "was not found in the share directory" in missing.stderr

@@ -131,3 +131,29 @@ def test_jtbot_sim_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: Path) 
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
     report = junit.read_text()
     assert 'failures="0"' in report and "/scan" in report and "/clock" in report
+
+
+def test_jtbot_display_without_simulator(ros_env: dict[str, str], tmp_path: Path) -> None:
+    """State publisher, joint state publisher and viewer: the description and joints flow."""
+    env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    done = subprocess.run(
+        mlaunch(
+            "test",
+            str(REPO / "launches" / "jtbot_display.launch.py"),
+            "--expect-topic",
+            "/joint_states",
+            "--expect-topic",
+            "/robot_description",
+            "--expect-node",
+            "/robot_state_publisher",
+            "--expect-output",
+            "rviz2:viewer: open http://127.0.0.1:",
+        ),
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+    assert "stand-in" in done.stdout
