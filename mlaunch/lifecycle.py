@@ -630,10 +630,9 @@ class LifecycleManager:
         held = [m.process for m in targets if m.process is not None and m.process.running]
         if not held or not self.graph.started:
             return []
-        # Supervisor.stop() passes over a process already marked stopping, so these keep
-        # running until _release() hands them to the ladder.
+        # They keep running until _release() hands them to the ladder.
         for process in held:
-            process.stopping = True
+            self.supervisor.hold_stop(process)
         self._held = held
         self._released = False
         bound = self.deactivate_timeout * len(held) + 1.0
@@ -659,9 +658,7 @@ class LifecycleManager:
             return
         self._released = True
         for process in self._held:
-            if process.running:
-                process.stopping = False
-                self.supervisor.stop(process)
+            self.supervisor.release_stop(process)
         self._held = []
 
     def close(self) -> None:

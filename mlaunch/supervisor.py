@@ -239,6 +239,7 @@ class Supervisor:
         self._signals: list[int] = []
         self._index = itertools.count()
         self.shutting_down = False
+        self._held: set[Process] = set()
         self.shutdown_reason = ""
         self.exit_code = EXIT_OK
         self._stop_presses = 0
@@ -835,11 +836,26 @@ class Supervisor:
             ev.Shutdown(reason=reason, due_to_sigint=due_to_signal == signal.SIGINT),
         )
         for process in self.processes:
-            if process.running:
+            if process.running and process not in self._held:
                 self.stop(process)
         for process in self.lingering:
             if process.check_group() and not process.stopping:
                 self.stop(process)
+
+    def hold_stop(self, process: Process) -> None:
+        """Keep ``process`` out of the stop ladder until ``release_stop`` (or a second Ctrl-C).
+
+        For work that must happen while a process still runs at shutdown, such as deactivating
+        a lifecycle node before it is signalled. Call it from a shutdown handler: the ladder
+        starts for every process not held right after those handlers run.
+        """
+        self._held.add(process)
+
+    def release_stop(self, process: Process) -> None:
+        """Hand a held process to the stop ladder (now, if the launch is shutting down)."""
+        self._held.discard(process)
+        if self.shutting_down and process.running:
+            self.stop(process)
 
     def stop(self, process: Process) -> None:
         """The ladder for one process group: SIGINT, SIGTERM, SIGKILL, each after its timeout."""

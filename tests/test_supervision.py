@@ -708,3 +708,44 @@ def test_process_io_handlers_see_the_last_words_too(tmp_path: Path) -> None:
     assert h.run() == 0
     assert "saw one" in h.text
     assert "saw last" in h.text  # the unterminated line flushed at exit reaches handlers
+
+
+def test_held_process_is_signalled_only_when_released() -> None:
+    """hold_stop keeps a process out of the ladder (lifecycle deactivation) until release_stop."""
+    code = "import sys, time; print('up', sys.argv[1], flush=True); time.sleep(30)"
+    h = Harness(
+        [
+            make_spec("held-1", code, argv=(PY, "-c", code, "held")),
+            make_spec("free-2", code, argv=(PY, "-c", code, "free")),
+        ]
+    )
+    order: list[str] = []
+
+    def on_shutdown_hold(*_: object) -> None:
+        held = next(p for p in h.sup.processes if p.label == "held-1")
+        h.sup.hold_stop(held)
+
+        def release() -> None:
+            order.append("release")
+            h.sup.release_stop(held)
+
+        h.sup.schedule(0.3, release, cancel_on_shutdown=False)
+
+    started: set[str] = set()
+
+    def ready(label: str, _line: bytes) -> None:
+        started.add(label)
+        if started == {"held-1", "free-2"}:
+            on_shutdown_hold()
+            h.shutdown()
+
+    h.when(b"up held", ready)
+    h.when(b"up free", ready)
+    h.sup.listeners.append(
+        lambda what, p: order.append(f"{what} {p.label}") if what == "exited" else None
+    )
+    h.run()
+    # The free one was stopped at once; the held one only after its release.
+    assert order.index("exited free-2") < order.index("release") < order.index("exited held-1"), (
+        order
+    )
