@@ -330,6 +330,29 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     assert "SHOW-ARGS []" in done.stdout
 
 
+@pytest.mark.parametrize(
+    ("name", "text"),
+    [
+        ("one.launch.yaml", "launch:\n- executable: {cmd: echo hi, output: screen}\n"),
+        ("one.launch.xml", '<launch><executable cmd="echo hi" output="screen"/></launch>\n'),
+    ],
+)
+def test_frontends_stay_light(tmp_path: Path, env: dict[str, str], name: str, text: str) -> None:
+    """YAML and XML launches keep the same budget: no dataclasses, typing or inspect either."""
+    path = tmp_path / name
+    path.write_text(text)
+    code = (
+        "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '-q']);"
+        " heavy = ('rclpy', 'rich', 'dataclasses', 'typing', 'inspect', 'mlaunch.ros.actions');"
+        " print('LOADED', sorted(m for m in heavy if m in sys.modules)); sys.exit(rc)"
+    )
+    done = __import__("subprocess").run(
+        [PY, "-c", code, str(path)], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "LOADED []" in done.stdout
+
+
 def test_python_m_and_console_script_agree(tmp_path: Path, env: dict[str, str]) -> None:
     script = Path(sys.executable).parent / "mlaunch"
     if not script.exists():

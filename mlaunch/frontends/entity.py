@@ -15,12 +15,14 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.frontends.subst import Parts, TemplateError, parse_template
 from mlaunch.substitutions import to_bool
+
+TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms to import
+if TYPE_CHECKING:
+    from typing import Any
 
 # The literal values conditions accept (ROS 2's evaluate_condition_expression).
 CONDITION_WORDS = ("true", "false", "1", "0")
@@ -32,18 +34,30 @@ _YAML_FLOAT = "tag:yaml.org,2002:float"
 _YAML_NULL = "tag:yaml.org,2002:null"
 
 
-@dataclass
 class Attr:
     """An attribute value and where its text starts (1-based line and column).
 
     ``value`` is the XML string, or the YAML node (``yaml.Node``) for YAML files. ``locate``,
     when given, computes the position on demand (XML: only an error needs it).
+    A plain class: dataclasses costs ~8 ms to import on every YAML/XML launch.
     """
 
-    value: Any
-    line: int
-    col: int
-    locate: Callable[[], tuple[int, int]] | None = None
+    __slots__ = ("col", "line", "locate", "value")
+
+    def __init__(
+        self,
+        value: Any,
+        line: int,
+        col: int,
+        locate: Callable[[], tuple[int, int]] | None = None,
+    ) -> None:
+        self.value = value
+        self.line = line
+        self.col = col
+        self.locate = locate
+
+    def __repr__(self) -> str:
+        return f"Attr({self.value!r}, line={self.line}, col={self.col})"
 
     def position(self) -> tuple[int, int]:
         if self.locate is not None:
@@ -52,26 +66,56 @@ class Attr:
         return self.line, self.col
 
 
-@dataclass(eq=False)
 class Entity:
     """A tag with its attributes and child entities, in either format."""
 
-    tag: str
-    path: str
-    line: int
-    col: int
-    fmt: str  # "xml" or "yaml"
-    attrs: dict[str, Attr] = field(default_factory=dict)
-    # XML: the child elements. YAML: the children list (a list value, or the `children` key).
-    children: list[Entity] | None = None
-    # YAML only: builds Entities for a list-of-maps attribute (param, remap, env ...).
-    yaml_subentities: Any = None
-    # YAML only: turns a node into Python data.
-    yaml_construct: Any = None
-    _asked: dict[str, None] = field(default_factory=dict)
-    _used: set[str] = field(default_factory=set)
-    _sub_tags: dict[str, None] = field(default_factory=dict)
-    _actions_read: bool = False
+    __slots__ = (
+        "_actions_read",
+        "_asked",
+        "_sub_tags",
+        "_used",
+        "attrs",
+        "children",
+        "col",
+        "fmt",
+        "line",
+        "path",
+        "tag",
+        "yaml_construct",
+        "yaml_subentities",
+    )
+
+    def __init__(
+        self,
+        tag: str,
+        path: str,
+        line: int,
+        col: int,
+        fmt: str,  # "xml" or "yaml"
+        attrs: dict[str, Attr] | None = None,
+        # XML: the child elements. YAML: the children list (a list value, or `children`).
+        children: list[Entity] | None = None,
+        # YAML only: builds Entities for a list-of-maps attribute (param, remap, env ...).
+        yaml_subentities: Any = None,
+        # YAML only: turns a node into Python data.
+        yaml_construct: Any = None,
+    ) -> None:
+        self.tag = tag
+        self.path = path
+        self.line = line
+        self.col = col
+        self.fmt = fmt
+        self.attrs: dict[str, Attr] = {} if attrs is None else attrs
+        self.children = children
+        self.yaml_subentities = yaml_subentities
+        self.yaml_construct = yaml_construct
+        self._asked: dict[str, None] = {}
+        self._used: set[str] = set()
+        self._sub_tags: dict[str, None] = {}
+        self._actions_read = False
+
+    def __repr__(self) -> str:
+        return f"Entity({self.tag!r}, {self.path}:{self.line}:{self.col})"
 
     # --- where and what -------------------------------------------------------------------------
 
