@@ -637,6 +637,8 @@ class Supervisor:
             callback = handler.io_callbacks.get(stream)
             if callback is None:
                 continue
+            if handler.once:
+                self.handlers.remove(handler)
             event = event_type(
                 action=process.spec.action,
                 name=process.label,
@@ -645,10 +647,23 @@ class Supervisor:
                 text=data,
                 fd=1 if stream == "stdout" else 2,
             )
-            result = callback(event)
+            try:
+                result = callback(event)
+            except Exception as e:  # launch-file code: report it where it was written
+                from mlaunch.origin import user_location
+
+                where = user_location(e.__traceback__) or handler.origin
+                self.printer.message(
+                    "ERROR",
+                    "launch",
+                    f"{where}: OnProcessIO callback failed: {type(e).__name__}: {e}",
+                )
+                self.exit_code = max(self.exit_code, EXIT_LAUNCH_ERROR)
+                self.begin_shutdown("an event handler failed")
+                return
             if result and handler.body is not None:
-                handler.body.entities = list(result)
-                self.fire(Deferred(list(result), handler.body.context, handler.body.origin), event)
+                body = handler.body
+                self.fire(Deferred(list(result), body.context, body.origin), event)
 
     def _drain(self, process: Process) -> None:
         """Read what is left in a finished process's pipes before reporting its exit."""

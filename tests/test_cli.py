@@ -389,3 +389,34 @@ def test_package_and_file_form(tmp_path: Path, env: dict[str, str]) -> None:
         "--package-path", str(tmp_path / "src"), "demo_bringup", "x.launch.py", env=env
     )
     assert missing.returncode == 2 and "was not found in the share directory" in missing.stderr
+
+
+def test_on_process_io_callbacks(tmp_path: Path, env: dict[str, str]) -> None:
+    """OnProcessIO callbacks get the bytes and may return actions; one that raises is reported."""
+    path = launch_file(
+        tmp_path,
+        """
+        ExecuteProcess(cmd=[PY, '-c', 'print("ready"); print("again")'], name='w', output='screen'),
+        RegisterEventHandler(OnProcessIO(
+            on_stdout=lambda event: [LogInfo(msg='saw ' + event.text.decode().split()[0])],
+            handle_once=True)),
+        """,
+    )
+    done = run_mlaunch(path, env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("[launch.user]: saw ") == 1 and "saw ready" in done.stdout
+    broken = launch_file(
+        tmp_path,
+        """
+        ExecuteProcess(cmd=[PY, '-c', 'import time; print("x", flush=True); time.sleep(30)'], name='w'),
+        RegisterEventHandler(OnProcessIO(on_stdout=lambda event: 1 / 0)),
+        """,
+        name="broken.launch.py",
+    )
+    done = run_mlaunch(broken, env=env)
+    assert done.returncode == 2, done.stdout
+    assert "OnProcessIO callback failed: ZeroDivisionError" in done.stdout
+    assert f"{broken}:" in done.stdout
+    # No traceback from mlaunch itself (the child's own KeyboardInterrupt lines are [w-1] ...).
+    assert "Traceback" not in done.stderr
+    assert not [line for line in done.stdout.splitlines() if line.startswith("Traceback")]
