@@ -366,10 +366,12 @@ def test_absent_node_times_out_at_the_deadline(ros_env: dict[str, str]) -> None:
 def test_close_releases_waiters_threads_and_context(ros_env: dict[str, str]) -> None:
     with RosGraph(environ=ros_env):
         pass  # Fast DDS keeps a few process-wide threads from its first use on: start them now
-    native_before = len(os.listdir("/proc/self/task"))
+    native_before = set(os.listdir("/proc/self/task"))
     threads_before = set(threading.enumerate())
     graph = RosGraph(environ=ros_env)
     graph.start()
+    # The native threads this graph started (DDS participant, executor): they must all end.
+    native_started = set(os.listdir("/proc/self/task")) - native_before
     watch = graph.watch_topic("/never", "std_msgs/msg/String")
     results: list[bool] = []
     waiters = [
@@ -387,8 +389,11 @@ def test_close_releases_waiters_threads_and_context(ros_env: dict[str, str]) -> 
         waiter.join(timeout=5)
     assert results == [False, False] and time.monotonic() - closing < 1.0
     assert set(threading.enumerate()) == threads_before
-    # The context is destroyed with close(), and the DDS participant's threads with it.
-    assert len(os.listdir("/proc/self/task")) == native_before
+    # The context is destroyed with close(), and the DDS participant's threads with it. They
+    # take a moment to exit, and other threads of the test process may come and go meanwhile,
+    # so the check is on exactly the threads this graph started, with a deadline.
+    assert native_started
+    assert wait_until(lambda: not native_started & set(os.listdir("/proc/self/task")), 3.0)
     assert not graph.running
     with pytest.raises(GraphNotRunning, match="closed"):
         graph.node_names()
