@@ -76,8 +76,10 @@ def test_jtbot_sim_end_to_end(ros_env: dict[str, str], tmp_path: Path) -> None:
         run.kill()
     assert code == 130, run.text[-3000:]
     assert wait_until(lambda: not any(pid_alive(p) for p in everything), 2.0)
+    # Typically about 0.7 s here (benchmarks measure it); the bound only catches a hang or a
+    # ladder step (5 s) being needed, with room for a loaded CI machine.
     print(f"shutdown took {took:.2f} s for {len(everything)} processes")
-    assert took < 3.0, f"Ctrl-C took {took:.2f} s"
+    assert took < 4.5, f"Ctrl-C took {took:.2f} s: something needed the SIGTERM step"
     assert "Traceback" not in run.text, run.text[-3000:]
 
 

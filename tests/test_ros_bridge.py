@@ -355,7 +355,8 @@ def test_absent_node_times_out_at_the_deadline(ros_env: dict[str, str]) -> None:
     with RosGraph(environ=ros_env) as graph:
         started = time.monotonic()
         assert not graph.wait_for(lambda g: "/nobody" in g.node_names(), 0.5)
-        assert 0.5 <= time.monotonic() - started < 1.5
+        # Not before its deadline, and not much after (generous: the machine may be loaded).
+        assert 0.5 <= time.monotonic() - started < 5.0
         with pytest.raises(RosTimeout, match=r"/nobody/get_state not available within 0.3 s"):
             graph.lifecycle_state("/nobody", 0.3)
         result = graph.change_state("/nobody", "configure", 0.3)
@@ -387,7 +388,8 @@ def test_close_releases_waiters_threads_and_context(ros_env: dict[str, str]) -> 
     graph.close()
     for waiter in waiters:
         waiter.join(timeout=5)
-    assert results == [False, False] and time.monotonic() - closing < 1.0
+    # Released by close(), not by their 30 s deadlines (generous bound for a loaded machine).
+    assert results == [False, False] and time.monotonic() - closing < 10.0
     assert set(threading.enumerate()) == threads_before
     # The context is destroyed with close(), and the DDS participant's threads with it. They
     # take a moment to exit, and other threads of the test process may come and go meanwhile,
