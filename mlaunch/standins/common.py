@@ -6,6 +6,7 @@ Nothing here imports rclpy at module level; ``spin_until_shutdown`` imports it w
 from __future__ import annotations
 
 import signal
+import sys
 from collections.abc import Callable
 from types import FrameType
 from typing import Any
@@ -31,8 +32,45 @@ def install_stop_flag() -> StopFlag:
     return stop
 
 
+def init_ros(args: list[str], node_name: str) -> StopFlag | None:
+    """rclpy.init with our own SIGINT/SIGTERM handling; None (after one error line) on bad args.
+
+    rclpy's own handler shuts the context down from inside the signal handler, which races
+    with a subscription being taken: a Ctrl-C at the wrong moment ended a node with a pybind11
+    RuntimeError traceback. With rclpy's handlers off, the signal only sets a flag and the spin
+    loop ends cleanly.
+    """
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
+
+    stop = install_stop_flag()
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except Exception as exc:  # rcl reports bad --ros-args as a generic RCLError
+        print(f"[ERROR] [{node_name}]: invalid ROS arguments: {exc}", file=sys.stderr)
+        return None
+    return stop
+
+
+def spin(node: Any, stop: StopFlag) -> None:
+    """Run the node's callbacks until the stop flag is set or ROS shuts down."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+
+    executor = SingleThreadedExecutor(context=node.context)
+    executor.add_node(node)
+    try:
+        while not stop.requested and rclpy.ok(context=node.context):
+            executor.spin_once(timeout_sec=0.1)
+    finally:
+        executor.remove_node(node)
+
+
 def spin_until_shutdown(
-    node: Any, start: Callable[[], object], input_errors: dict[type[Exception], str]
+    node: Any,
+    start: Callable[[], object],
+    input_errors: dict[type[Exception], str],
+    stop: StopFlag,
 ) -> int:
     """``start()`` then spin until Ctrl-C or shutdown; unusable input is one logged line, exit 1.
 
@@ -44,7 +82,7 @@ def spin_until_shutdown(
 
     try:
         start()
-        rclpy.spin(node)
+        spin(node, stop)
     except tuple(input_errors) as exc:
         prefix = next(p for kind, p in input_errors.items() if isinstance(exc, kind))
         node.get_logger().error(f"{prefix}{exc}")

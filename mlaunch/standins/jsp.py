@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from mlaunch.standins.common import EXIT_FAILURE, spin_until_shutdown
+from mlaunch.standins.common import EXIT_FAILURE, init_ros, spin_until_shutdown
 from mlaunch.standins.rsp import INPUT_ERRORS, ParameterError, ParamSpec, declare
 from mlaunch.standins.urdf import Joint, Robot, UrdfError, parse_urdf
 
@@ -163,20 +163,17 @@ def start(node: Node, urdf_file: str | None) -> JointPublisher:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the node until shutdown; 1 with a one-line error when its input is unusable."""
-    import rclpy
     from rclpy.node import Node
     from rclpy.utilities import remove_ros_args
 
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
     options = parse_args(remove_ros_args(args)[1:])
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # rcl reports bad --ros-args as a generic RCLError
-        print(f"[ERROR] [{NODE_NAME}]: invalid ROS arguments: {exc}", file=sys.stderr)
+    stop = init_ros(args, NODE_NAME)
+    if stop is None:
         return EXIT_FAILURE
     # zeros.<joint> are free-form names, so take whatever the overrides declare.
     node = Node(NODE_NAME, automatically_declare_parameters_from_overrides=True)
-    return spin_until_shutdown(node, lambda: start(node, options.urdf_file), INPUT_ERRORS)
+    return spin_until_shutdown(node, lambda: start(node, options.urdf_file), INPUT_ERRORS, stop)
 
 
 if __name__ == "__main__":

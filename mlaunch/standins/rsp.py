@@ -14,7 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.standins.common import EXIT_FAILURE, spin_until_shutdown
+from mlaunch.standins.common import EXIT_FAILURE, init_ros, spin_until_shutdown
 from mlaunch.standins.urdf import Robot, UrdfError, parse_urdf
 
 if TYPE_CHECKING:
@@ -175,17 +175,14 @@ def start(node: Node) -> StatePublisher:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the node until shutdown; 1 with a one-line error when its input is unusable."""
-    import rclpy
     from rclpy.node import Node
 
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # rcl reports bad --ros-args as a generic RCLError
-        print(f"[ERROR] [{NODE_NAME}]: invalid ROS arguments: {exc}", file=sys.stderr)
+    stop = init_ros(args, NODE_NAME)
+    if stop is None:
         return EXIT_FAILURE
     node = Node(NODE_NAME)
-    return spin_until_shutdown(node, lambda: start(node), INPUT_ERRORS)
+    return spin_until_shutdown(node, lambda: start(node), INPUT_ERRORS, stop)
 
 
 if __name__ == "__main__":

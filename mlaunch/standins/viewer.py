@@ -23,6 +23,7 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.standins.common import init_ros, spin
 from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
 
 if TYPE_CHECKING:
@@ -448,10 +449,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = read_display_config(options.display_config)
     if options.fixed_frame:
         config = replace(config, fixed_frame=options.fixed_frame)
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # rcl reports bad --ros-args as a generic RCLError
-        print(f"[ERROR] [{NODE_NAME}]: invalid ROS arguments: {exc}", file=sys.stderr)
+    stop = init_ros(args, NODE_NAME)
+    if stop is None:
         return EXIT_FAILURE
     node = Node(NODE_NAME)
     server = None
@@ -466,7 +465,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"{config.description_topic}, {config.odom_topic}, {config.scan_topic}"
         )
         print(f"viewer: open http://127.0.0.1:{server.server_address[1]}/", flush=True)
-        rclpy.spin(node)
+        spin(node, stop)
     except ViewerError as exc:
         node.get_logger().error(str(exc))
         return EXIT_FAILURE
