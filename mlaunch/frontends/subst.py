@@ -321,17 +321,9 @@ class _Scanner:
             c = s[i]
             if c == " " or c == ")":
                 break
-            if c == "\\":
-                if i + 1 < n and s[i + 1] in _ESCAPABLE:
-                    buf.append(s[i + 1])
-                    i += 2
-                else:
-                    buf.append("\\")
-                    i += 1
-            elif c == "$" and i + 1 < n and s[i + 1] == "(":
-                _flush(buf, value)
-                sub, i = self.substitution(i, quote)
-                value.append(sub)
+            after = self.escape_or_nested(i, buf, value, quote)
+            if after is not None:
+                i = after
             elif c == "(":
                 raise TemplateError(
                     f"unescaped '(' in an argument of '$({name} ...)'; write \\( or quote"
@@ -354,6 +346,28 @@ class _Scanner:
         _flush(buf, value)
         return i
 
+    def escape_or_nested(
+        self, i: int, buf: list[str], value: Parts, quote: str | None
+    ) -> int | None:
+        """A backslash escape or a nested ``$(`` at ``i``: consume it, return the next index.
+
+        None when ``s[i]`` is neither, so the caller handles that character itself.
+        """
+        s, n = self.s, self.n
+        c = s[i]
+        if c == "\\":
+            if i + 1 < n and s[i + 1] in _ESCAPABLE:
+                buf.append(s[i + 1])
+                return i + 2
+            buf.append("\\")
+            return i + 1
+        if c == "$" and i + 1 < n and s[i + 1] == "(":
+            _flush(buf, value)
+            sub, i = self.substitution(i, quote)
+            value.append(sub)
+            return i
+        return None
+
     def quoted(self, i: int, value: Parts) -> int:
         """A '...' or "..." argument starting at the quote ``i``; returns the index after it."""
         s, n = self.s, self.n
@@ -375,17 +389,9 @@ class _Scanner:
                 if not value:
                     value.append("")
                 return i + 1
-            if c == "\\":
-                if i + 1 < n and s[i + 1] in _ESCAPABLE:
-                    buf.append(s[i + 1])
-                    i += 2
-                else:
-                    buf.append("\\")
-                    i += 1
-            elif c == "$" and i + 1 < n and s[i + 1] == "(":
-                _flush(buf, value)
-                sub, i = self.substitution(i, q)
-                value.append(sub)
+            after = self.escape_or_nested(i, buf, value, q)
+            if after is not None:
+                i = after
             else:
                 buf.append(c)
                 i += 1
