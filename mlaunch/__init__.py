@@ -15,14 +15,14 @@ if TYPE_CHECKING:
 __version__ = "0.1.0"
 
 _MODULES = (
-    "mlaunch.actions",
-    "mlaunch.substitutions",
-    "mlaunch.conditions",
-    "mlaunch.event_handlers",
-    "mlaunch.launch_description_sources",
-    "mlaunch.ros.actions",
-    "mlaunch.ros.substitutions",
-    "mlaunch.ros.parameter_descriptions",
+    "mlaunch.launch.actions",
+    "mlaunch.launch.substitutions",
+    "mlaunch.launch.conditions",
+    "mlaunch.launch.event_handlers",
+    "mlaunch.launch.launch_description_sources",
+    "mlaunch.launch_ros.actions",
+    "mlaunch.launch_ros.substitutions",
+    "mlaunch.launch_ros.parameter_descriptions",
 )
 
 

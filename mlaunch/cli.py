@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 
 SUBCOMMANDS = {
     "test": "mlaunch.smoke",
-    "convert": "mlaunch.convert",
+    "convert": "mlaunch.ros1.convert",
 }
 
 
@@ -228,7 +228,7 @@ def parse_options(argv: Sequence[str]) -> Options:
     if ns.show_all_subprocesses_output:
         os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
     if opts.use_sim_time is None and "use_sim_time" in opts.arguments:
-        from mlaunch.substitutions import to_bool
+        from mlaunch.launch.substitutions import to_bool
 
         try:
             opts.use_sim_time = to_bool(opts.arguments["use_sim_time"], "use_sim_time")
@@ -308,7 +308,7 @@ def resolve_for_run(
     opts: Options, path: str, description: object, *, temp_dir: str, log_dir: str
 ) -> tuple[Any, Any, Any]:
     """(plan, resolve options, label counter) for a run of ``description`` as opts say."""
-    from mlaunch.resolve import LabelCounter, ResolveOptions, resolve
+    from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
     options = ResolveOptions(
         standins=opts.standins,
@@ -333,7 +333,7 @@ def run_cli(argv: Sequence[str]) -> int:
     opts = parse_options(argv)
     path, description = load_target(opts)
     if opts.show_args:
-        from mlaunch.resolve import collect_arguments
+        from mlaunch.run.resolve import collect_arguments
 
         infos = collect_arguments(
             description, path=path, arguments=opts.arguments, environ=os.environ
@@ -383,14 +383,14 @@ def launch(opts: Options, path: str, description: object) -> int:
     try:
         log_dir = ""
         if not opts.print_plan:
-            from mlaunch.output import make_run_log_dir
+            from mlaunch.run.output import make_run_log_dir
 
             log_dir = make_run_log_dir(os.environ)
         plan, options, labels = resolve_for_run(
             opts, path, description, temp_dir=temp_dir, log_dir=log_dir
         )
         if opts.print_plan:
-            from mlaunch.describe import describe_plan
+            from mlaunch.run.describe import describe_plan
 
             sys.stdout.write(describe_plan(plan, path))
             return 0
@@ -401,9 +401,9 @@ def launch(opts: Options, path: str, description: object) -> int:
 
 def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
     from mlaunch.errors import UsageError
-    from mlaunch.guard import Guard, new_run_id
-    from mlaunch.output import DEFAULT_ROTATE_BYTES, Printer, stdout_is_color_terminal
-    from mlaunch.supervisor import Supervisor
+    from mlaunch.run.guard import Guard, new_run_id
+    from mlaunch.run.output import DEFAULT_ROTATE_BYTES, Printer, stdout_is_color_terminal
+    from mlaunch.run.supervisor import Supervisor
 
     if opts.log_max_bytes is not None and opts.log_max_bytes < 0:
         raise UsageError(
@@ -443,7 +443,7 @@ def _extensions(opts: Options, supervisor: object) -> list[object]:
     """Optional parts that attach to a running supervisor (status view, lifecycle, summary)."""
     attached: list[object] = []
     try:
-        from mlaunch import extensions
+        from mlaunch.run import extensions
     except ImportError:
         return attached
     for attach in extensions.ATTACH:

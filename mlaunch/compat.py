@@ -8,7 +8,7 @@ mlaunch, and inside mlaunch every description is built from classes mlaunch can 
 
 from __future__ import annotations
 
-import importlib
+import importlib.util
 import sys
 from importlib.machinery import ModuleSpec
 
@@ -17,42 +17,49 @@ if TYPE_CHECKING:
     from types import ModuleType
     from typing import Any
 
-ALIASES: dict[str, str] = {
-    "launch": "mlaunch.launch_api",
-    "launch.actions": "mlaunch.actions",
-    "launch.action": "mlaunch.actions",
-    "launch.substitutions": "mlaunch.substitutions",
-    "launch.substitution": "mlaunch.substitutions",
-    "launch.conditions": "mlaunch.conditions",
-    "launch.condition": "mlaunch.conditions",
-    "launch.event_handlers": "mlaunch.event_handlers",
-    "launch.event_handler": "mlaunch.event_handlers",
-    "launch.events": "mlaunch.events",
-    "launch.events.process": "mlaunch.events",
-    "launch.event": "mlaunch.events",
-    "launch.launch_description": "mlaunch.actions",
-    "launch.launch_description_entity": "mlaunch.actions",
-    "launch.launch_description_sources": "mlaunch.launch_description_sources",
-    "launch.launch_context": "mlaunch.context",
-    "launch.some_substitutions_type": "mlaunch.substitutions",
-    "launch.utilities": "mlaunch.launch_api",
-    "launch.frontend": "mlaunch.launch_api",
-    "launch_xml": "mlaunch.launch_description_sources",
-    "launch_xml.launch_description_sources": "mlaunch.launch_description_sources",
-    "launch_yaml": "mlaunch.launch_description_sources",
-    "launch_yaml.launch_description_sources": "mlaunch.launch_description_sources",
-    "launch_ros": "mlaunch.ros.api",
-    "launch_ros.actions": "mlaunch.ros.actions",
-    "launch_ros.substitutions": "mlaunch.ros.substitutions",
-    "launch_ros.parameter_descriptions": "mlaunch.ros.parameter_descriptions",
-    "launch_ros.descriptions": "mlaunch.ros.parameter_descriptions",
-    "launch_ros.event_handlers": "mlaunch.ros.events",
-    "launch_ros.events": "mlaunch.ros.events",
-    "launch_ros.events.lifecycle": "mlaunch.ros.events",
-    "launch_ros.utilities": "mlaunch.ros.api",
+# The ROS 2 top-level packages and the mlaunch package serving each: ``launch.X.Y`` is
+# ``mlaunch.launch.X.Y``, and so on (a prefix rule: a new module needs no entry here).
+ROOTS: dict[str, str] = {
+    "launch": "mlaunch.launch",
+    "launch_ros": "mlaunch.launch_ros",
+    "launch_xml": "mlaunch.launch.launch_description_sources",
+    "launch_yaml": "mlaunch.launch.launch_description_sources",
     "ament_index_python": "mlaunch.ros.ament_index",
+}
+
+# Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per
+# module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.actions``).
+SYNONYMS: dict[str, str] = {
+    "launch.action": "mlaunch.launch.actions",
+    "launch.launch_description": "mlaunch.launch.actions",
+    "launch.launch_description_entity": "mlaunch.launch.actions",
+    "launch.substitution": "mlaunch.launch.substitutions",
+    "launch.some_substitutions_type": "mlaunch.launch.substitutions",
+    "launch.condition": "mlaunch.launch.conditions",
+    "launch.event_handler": "mlaunch.launch.event_handlers",
+    "launch.event": "mlaunch.launch.events",
+    "launch.events.process": "mlaunch.launch.events",
+    "launch.utilities": "mlaunch.launch",
+    "launch.frontend": "mlaunch.launch",
+    "launch_xml.launch_description_sources": "mlaunch.launch.launch_description_sources",
+    "launch_yaml.launch_description_sources": "mlaunch.launch.launch_description_sources",
+    "launch_ros.descriptions": "mlaunch.launch_ros.parameter_descriptions",
+    "launch_ros.event_handlers": "mlaunch.launch_ros.events",
+    "launch_ros.events.lifecycle": "mlaunch.launch_ros.events",
+    "launch_ros.utilities": "mlaunch.launch_ros",
     "ament_index_python.packages": "mlaunch.ros.ament_index",
 }
+
+
+def target_of(fullname: str) -> str | None:
+    """The mlaunch module that serves the ROS 2 module ``fullname``, or None if none does."""
+    if fullname in SYNONYMS:
+        return SYNONYMS[fullname]
+    root, dot, rest = fullname.partition(".")
+    base = ROOTS.get(root)
+    if base is None:
+        return None
+    return base + dot + rest
 
 
 # Plain classes, not importlib.abc's: importing importlib.abc pulls in importlib.resources and
@@ -72,10 +79,12 @@ class AliasFinder:
     """Answers the ROS 2 module names with mlaunch modules."""
 
     def find_spec(self, fullname, path=None, target=None):  # type: ignore[no-untyped-def]
-        target_name = ALIASES.get(fullname)
+        target_name = target_of(fullname)
         if target_name is None:
             return None
-        is_package = any(alias.startswith(fullname + ".") for alias in ALIASES)
+        if importlib.util.find_spec(target_name) is None:
+            return None
+        is_package = fullname in ROOTS or any(s.startswith(fullname + ".") for s in SYNONYMS)
         loader: Any = _AliasLoader(target_name)
         return ModuleSpec(fullname, loader, is_package=is_package)
 
@@ -90,5 +99,6 @@ def install() -> None:
     sys.meta_path.insert(0, _FINDER)
     # A real launch/launch_ros/ament_index_python imported earlier must not win.
     for name in list(sys.modules):
-        if name in ALIASES and not sys.modules[name].__name__.startswith("mlaunch"):
+        module = sys.modules[name]
+        if target_of(name) is not None and not module.__name__.startswith("mlaunch"):
             del sys.modules[name]

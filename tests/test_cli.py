@@ -300,7 +300,7 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'print(1)'], output='screen'),")
     code = (
         "import sys\n"
-        "import mlaunch.supervisor as sup\n"
+        "import mlaunch.run.supervisor as sup\n"
         "seen = []\n"
         "original = sup.Supervisor.start\n"
         "def start(self, *a, **k):\n"
@@ -320,7 +320,7 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     assert "AT-FIRST-CHILD []" in done.stdout
     show = (
         "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '--show-args']);"
-        " runtime = ('mlaunch.supervisor', 'mlaunch.process', 'mlaunch.output', 'subprocess', 'selectors');"
+        " runtime = ('mlaunch.run.supervisor', 'mlaunch.run.process', 'mlaunch.run.output', 'subprocess', 'selectors');"
         " print('SHOW-ARGS', sorted(m for m in runtime if m in sys.modules)); sys.exit(rc)"
     )
     done = __import__("subprocess").run(
@@ -343,7 +343,7 @@ def test_frontends_stay_light(tmp_path: Path, env: dict[str, str], name: str, te
     path.write_text(text)
     code = (
         "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '-q']);"
-        " heavy = ('rclpy', 'rich', 'dataclasses', 'typing', 'inspect', 'mlaunch.ros.actions');"
+        " heavy = ('rclpy', 'rich', 'dataclasses', 'typing', 'inspect', 'mlaunch.launch_ros.actions');"
         " print('LOADED', sorted(m for m in heavy if m in sys.modules)); sys.exit(rc)"
     )
     done = __import__("subprocess").run(

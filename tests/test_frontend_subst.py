@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch.context import LaunchContext
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.frontends import load
 from mlaunch.frontends.subst import SUBSTITUTIONS, TemplateError, parse_template
-from mlaunch.substitutions import Substitution, normalize, perform_substitutions
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import Substitution, normalize, perform_substitutions
 
 
 def ctx(**configs: str) -> LaunchContext:
@@ -137,7 +137,7 @@ def test_boolean_substitutions(text: str, expected: str) -> None:
 
 
 def test_launch_ros_substitutions_build_the_launch_ros_classes() -> None:
-    from mlaunch.ros import substitutions as ros
+    from mlaunch.launch_ros import substitutions as ros
 
     assert isinstance(parse_template("$(find-pkg-share demo)")[0], ros.FindPackageShare)
     assert isinstance(parse_template("$(find-pkg-prefix demo)")[0], ros.FindPackagePrefix)

@@ -9,11 +9,12 @@ from typing import Any
 
 import pytest
 
-from mlaunch import actions, frontends
-from mlaunch.conditions import IfCondition, UnlessCondition
+from mlaunch import frontends
 from mlaunch.errors import LaunchFileError
-from mlaunch.plan import Log, Plan, RequestShutdown, StartTimer
-from mlaunch.resolve import ResolveOptions, resolve
+from mlaunch.launch import actions
+from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.run.plan import Log, Plan, RequestShutdown, StartTimer
+from mlaunch.run.resolve import ResolveOptions, resolve
 
 ENV = {"PATH": os.environ["PATH"], "HOME": "/home/u", "KEEP": "k"}
 

@@ -16,9 +16,9 @@ import pytest
 from conftest import requires_rclpy
 from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
 
-from mlaunch.actions import DeclareLaunchArgument, GroupAction, LaunchDescription
 from mlaunch.errors import LaunchFileError
-from mlaunch.lifecycle import (
+from mlaunch.launch.actions import DeclareLaunchArgument, GroupAction, LaunchDescription
+from mlaunch.ros.lifecycle import (
     LifecycleSequence,
     LoopCall,
     SequenceStep,
@@ -26,7 +26,7 @@ from mlaunch.lifecycle import (
     plan_needs_lifecycle,
     sequence_from_arguments,
 )
-from mlaunch.resolve import resolve
+from mlaunch.run.resolve import resolve
 
 LAUNCHES = Path(__file__).resolve().parent / "launches"
 
@@ -45,7 +45,7 @@ def _sequences(plan) -> list[SequenceStep]:  # type: ignore[no-untyped-def]
 
 
 def test_sequence_names_are_qualified_by_the_pushed_namespace() -> None:
-    from mlaunch.ros.actions import PushROSNamespace
+    from mlaunch.launch_ros.actions import PushROSNamespace
 
     plan = _plan(
         GroupAction(
@@ -98,7 +98,7 @@ def test_sequence_argument_is_the_yaml_and_xml_form() -> None:
 def test_plain_plans_attach_nothing_and_lifecycle_plans_attach_without_rclpy() -> None:
     """A plan without lifecycle work gets no manager; one with it gets one, yet imports no rclpy
     until a lifecycle process starts (checked in a fresh interpreter)."""
-    from mlaunch.actions import ExecuteProcess, TimerAction
+    from mlaunch.launch.actions import ExecuteProcess, TimerAction
 
     plain = _plan(ExecuteProcess(cmd=["true"]), TimerAction(period=1.0, actions=[]))
     assert not plan_needs_lifecycle(plain)
@@ -110,12 +110,12 @@ def test_plain_plans_attach_nothing_and_lifecycle_plans_attach_without_rclpy() -
 
     code = f"""
 import sys
-from mlaunch.actions import LaunchDescription, TimerAction
-from mlaunch.lifecycle import attach, plan_needs_lifecycle
-from mlaunch.output import Printer
-from mlaunch.resolve import resolve
-from mlaunch.ros.actions import LifecycleNode
-from mlaunch.supervisor import Supervisor
+from mlaunch.launch.actions import LaunchDescription, TimerAction
+from mlaunch.ros.lifecycle import attach, plan_needs_lifecycle
+from mlaunch.run.output import Printer
+from mlaunch.run.resolve import resolve
+from mlaunch.launch_ros.actions import LifecycleNode
+from mlaunch.run.supervisor import Supervisor
 node = LifecycleNode(executable={sys.executable!r}, name="cam", namespace="r", autostart=True)
 ld = LaunchDescription([TimerAction(period=5.0, actions=[node])])
 plan = resolve(ld, path=None, arguments={{}}, environ={{}})

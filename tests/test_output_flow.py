@@ -24,10 +24,10 @@ from pathlib import Path
 import pytest
 from test_supervision import Harness, gone, make_spec, wait_until
 
-from mlaunch import guard as guards
-from mlaunch.output import Printer, Screen
-from mlaunch.plan import Plan, Spawn
-from mlaunch.supervisor import Supervisor
+from mlaunch.run import guard as guards
+from mlaunch.run.output import Printer, Screen
+from mlaunch.run.plan import Plan, Spawn
+from mlaunch.run.supervisor import Supervisor
 
 PY = sys.executable
 DROP = re.compile(rb"the terminal fell behind: (\d+) lines")

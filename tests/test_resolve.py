@@ -9,7 +9,8 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.actions import (
+from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.launch.actions import (
     AppendEnvironmentVariable,
     DeclareLaunchArgument,
     ExecuteProcess,
@@ -25,13 +26,12 @@ from mlaunch.actions import (
     TimerAction,
     UnsetEnvironmentVariable,
 )
-from mlaunch.conditions import IfCondition, UnlessCondition
-from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
-from mlaunch.event_handlers import OnProcessExit
-from mlaunch.launch_description_sources import PythonLaunchDescriptionSource
-from mlaunch.plan import AddHandler, Log, Plan, StartTimer
-from mlaunch.resolve import ResolveOptions, collect_arguments, resolve
-from mlaunch.substitutions import EnvironmentVariable, LaunchConfiguration
+from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.launch.event_handlers import OnProcessExit
+from mlaunch.launch.launch_description_sources import PythonLaunchDescriptionSource
+from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
+from mlaunch.run.plan import AddHandler, Log, Plan, StartTimer
+from mlaunch.run.resolve import ResolveOptions, collect_arguments, resolve
 
 ENV = {"PATH": os.environ["PATH"], "HOME": "/home/u"}
 

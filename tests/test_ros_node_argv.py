@@ -17,12 +17,10 @@ import pytest
 import yaml
 
 from mlaunch import standins
-from mlaunch.actions import GroupAction, LaunchDescription
 from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
-from mlaunch.plan import Plan, ProcessSpec
-from mlaunch.resolve import ResolveOptions, resolve
-from mlaunch.ros import packages
-from mlaunch.ros.actions import (
+from mlaunch.launch.actions import GroupAction, LaunchDescription
+from mlaunch.launch.substitutions import LaunchConfiguration, TextSubstitution, perform
+from mlaunch.launch_ros.actions import (
     LifecycleNode,
     Node,
     PushRosNamespace,
@@ -34,11 +32,18 @@ from mlaunch.ros.actions import (
     apply_options,
     prefix_namespace,
 )
-from mlaunch.ros.events import ChangeState, OnStateTransition, StateTransition, matches_node_name
-from mlaunch.ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
-from mlaunch.ros.substitutions import FindPackageShare
-from mlaunch.ros.substitutions import Parameter as ParameterSubstitution
-from mlaunch.substitutions import LaunchConfiguration, TextSubstitution, perform
+from mlaunch.launch_ros.events import (
+    ChangeState,
+    OnStateTransition,
+    StateTransition,
+    matches_node_name,
+)
+from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
+from mlaunch.launch_ros.substitutions import FindPackageShare
+from mlaunch.launch_ros.substitutions import Parameter as ParameterSubstitution
+from mlaunch.ros import packages
+from mlaunch.run.plan import Plan, ProcessSpec
+from mlaunch.run.resolve import ResolveOptions, resolve
 
 THIS = os.path.abspath(__file__)
 
@@ -470,8 +475,8 @@ def test_global_parameter_values_use_python_str_and_yaml_lists(prefix: Path, tem
 
 
 def test_parameter_substitution_reads_globals(prefix: Path, temp_dir: str) -> None:
-    from mlaunch.actions import LogInfo
-    from mlaunch.plan import Log
+    from mlaunch.launch.actions import LogInfo
+    from mlaunch.run.plan import Log
 
     entities = [
         SetParameter("speed", 1.5),
@@ -547,7 +552,7 @@ def test_unscoped_group_forwards_ros_state(prefix: Path, temp_dir: str) -> None:
 
 
 def test_use_sim_time_option_is_the_first_global(prefix: Path, temp_dir: str) -> None:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
     ctx = LaunchContext(environment={})
     ctx.launch_configurations["global_params"] = (("x", 1),)
@@ -565,7 +570,7 @@ def test_set_use_sim_time_warns_that_nodes_are_not_affected(prefix: Path, temp_d
 
 
 def test_set_ros_log_dir_joins_relative_dirs(prefix: Path, temp_dir: str) -> None:
-    from mlaunch.actions import ExecuteProcess
+    from mlaunch.launch.actions import ExecuteProcess
 
     entities = [
         SetROSLogDir("first"),
@@ -823,7 +828,7 @@ def test_source_only_package_executable_is_not_built(
 
 
 def test_find_package_share_joins_with_slash(prefix: Path, temp_dir: str) -> None:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
     ctx = LaunchContext(environment={"AMENT_PREFIX_PATH": str(prefix)})
     joined = FindPackageShare("demo") / "launch" / TextSubstitution(text="x.launch.py")

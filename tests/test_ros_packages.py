@@ -14,15 +14,15 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.actions import LaunchDescription, LogInfo
-from mlaunch.context import LaunchContext
 from mlaunch.errors import LaunchFileError
-from mlaunch.plan import Log
-from mlaunch.resolve import ResolveOptions, resolve
+from mlaunch.launch.actions import LaunchDescription, LogInfo
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import perform
+from mlaunch.launch_ros.substitutions import FindPackagePrefix, FindPackageShare
 from mlaunch.ros import ament_index, packages
 from mlaunch.ros.packages import PackageNotFoundError
-from mlaunch.ros.substitutions import FindPackagePrefix, FindPackageShare
-from mlaunch.substitutions import perform
+from mlaunch.run.plan import Log
+from mlaunch.run.resolve import ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -21,11 +21,9 @@ import xacro
 from conftest import requires_rclpy
 from procutil import Running
 
-from mlaunch.actions import GroupAction, LaunchDescription, OpaqueFunction
-from mlaunch.plan import ProcessSpec
-from mlaunch.resolve import ResolveOptions, resolve
-from mlaunch.ros import packages
-from mlaunch.ros.actions import (
+from mlaunch.launch.actions import GroupAction, LaunchDescription, OpaqueFunction
+from mlaunch.launch.substitutions import Command, LaunchConfiguration
+from mlaunch.launch_ros.actions import (
     Node,
     PushRosNamespace,
     SetParameter,
@@ -33,8 +31,10 @@ from mlaunch.ros.actions import (
     SetRemap,
     apply_options,
 )
-from mlaunch.ros.parameter_descriptions import Parameter, ParameterValue
-from mlaunch.substitutions import Command, LaunchConfiguration
+from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterValue
+from mlaunch.ros import packages
+from mlaunch.run.plan import ProcessSpec
+from mlaunch.run.resolve import ResolveOptions, resolve
 
 pytestmark = [requires_rclpy, pytest.mark.timeout(60)]
 

@@ -19,9 +19,9 @@ import yaml
 
 from mlaunch import frontends
 from mlaunch.errors import MlaunchError
-from mlaunch.plan import Plan, ProcessSpec
-from mlaunch.resolve import LabelCounter, ResolveOptions, resolve
 from mlaunch.ros import packages
+from mlaunch.run.plan import Plan, ProcessSpec
+from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 PREFIX = REPO / "launches" / "examples" / "prefix"
@@ -431,7 +431,7 @@ def test_robot_description_goes_to_robot_state_publisher_only(tmp_path: Path) ->
         </launch>
         """,
     )
-    from mlaunch.frontends import roslaunch
+    from mlaunch.ros1 import roslaunch
 
     model_items = roslaunch.read(path)
     rsp = next(i for i in model_items if isinstance(i, roslaunch.NodeItem) and i.name == ("rsp",))
@@ -447,7 +447,7 @@ def test_robot_description_goes_to_robot_state_publisher_only(tmp_path: Path) ->
 
 
 def test_unconsumed_robot_description_and_starved_rsp_are_warnings(tmp_path: Path) -> None:
-    from mlaunch.frontends import roslaunch
+    from mlaunch.ros1 import roslaunch
 
     lone = write(
         tmp_path,
@@ -653,7 +653,7 @@ def test_static_transforms_without_tf2_ros_are_dropped_with_a_warning(tmp_path: 
 
 
 def test_joint_state_publisher_use_gui_chooses_the_gui_package(tmp_path: Path) -> None:
-    from mlaunch.frontends import roslaunch
+    from mlaunch.ros1 import roslaunch
 
     path = write(
         tmp_path,
@@ -689,7 +689,7 @@ def test_joint_state_publisher_use_gui_chooses_the_gui_package(tmp_path: Path) -
 
 
 def test_rviz_and_arbotix_map_to_ros2_programs(tmp_path: Path) -> None:
-    from mlaunch.frontends import roslaunch
+    from mlaunch.ros1 import roslaunch
 
     cfg = package(tmp_path, "viz")
     (cfg / "old.rviz").write_text("Panels:\n  - Class: rviz/Displays\n")
@@ -729,7 +729,7 @@ def test_rviz_and_arbotix_map_to_ros2_programs(tmp_path: Path) -> None:
 
 
 def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
-    from mlaunch.frontends import roslaunch
+    from mlaunch.ros1 import roslaunch
 
     model = package(tmp_path, "bot")
     (model / "bot.urdf.xacro").write_text(
@@ -754,8 +754,8 @@ def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
     value = rsp.parameters[0][1]
     assert value.dynamic == (roslaunch.CommandRef((roslaunch.ArgRef("model"),)),)
     assert value.vtype is str
-    from mlaunch.context import LaunchContext
-    from mlaunch.substitutions import perform
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.substitutions import perform
 
     context = LaunchContext(environment=ENV)
     context.launch_configurations["model"] = f"xacro '{model}/bot.urdf.xacro'"
@@ -765,7 +765,7 @@ def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
 
 
 def test_split_arguments_keeps_substitutions_whole() -> None:
-    from mlaunch.frontends.roslaunch import ArgRef, split_arguments
+    from mlaunch.ros1.roslaunch import ArgRef, split_arguments
 
     found = split_arguments(("-a ", ArgRef("x"), "/y 'q r' z", ArgRef("w")))
     assert found == [("-a",), (ArgRef("x"), "/y"), ("q r",), ("z", ArgRef("w"))]

@@ -14,8 +14,8 @@ from conftest import requires_rclpy
 from procutil import Running, clean_env
 from test_roslaunch import params, plan_of, summarize
 
-from mlaunch import convert
 from mlaunch.ros import packages
+from mlaunch.ros1 import convert
 
 REPO = Path(__file__).resolve().parent.parent
 LAUNCH = REPO / "launches" / "smartcar_display.launch"

@@ -13,19 +13,19 @@ import pytest
 from conftest import requires_rclpy
 from procutil import clean_env, mlaunch, run_mlaunch
 
-from mlaunch import junit
-from mlaunch.actions import (
+from mlaunch.errors import LaunchFileError, UsageError
+from mlaunch.launch.actions import (
     ExecuteProcess,
     LaunchDescription,
     SetLaunchConfiguration,
 )
-from mlaunch.errors import LaunchFileError, UsageError
-from mlaunch.resolve import resolve
+from mlaunch.run.resolve import resolve
 from mlaunch.smoke import (
     Expect,
     Settings,
     _CollectConfigurations,
     build_expectations,
+    junit,
     parse_settings,
     parse_spec,
     parse_target,
@@ -86,7 +86,7 @@ def test_command_line_options_are_split_from_mlaunchs_own() -> None:
 def test_defaults_launch_file_expectations_and_overrides() -> None:
     """Defaults come from the plan; Expect actions and mlaunch_expect_* configurations add to
     them; the command line wins over the same check."""
-    from mlaunch.ros.actions import LifecycleNode, Node, SetParameter
+    from mlaunch.launch_ros.actions import LifecycleNode, Node, SetParameter
 
     collector = _CollectConfigurations()
     ld = LaunchDescription(

@@ -13,8 +13,8 @@ import time
 
 from test_supervision import Harness, make_spec
 
-from mlaunch.plan import ProcessSpec, RespawnPolicy
-from mlaunch.status import (
+from mlaunch.run.plan import ProcessSpec, RespawnPolicy
+from mlaunch.run.status import (
     ExitSummary,
     StatusView,
     attach_status_view,
@@ -23,7 +23,7 @@ from mlaunch.status import (
     render_summary,
     summary_wanted,
 )
-from mlaunch.supervisor import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
+from mlaunch.run.supervisor import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
 
 CSI = re.compile(r"\x1b\[(\d*)([A-Za-z])")
 

@@ -7,15 +7,15 @@ import sys
 
 import pytest
 
-from mlaunch.conditions import (
+from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
+from mlaunch.launch.conditions import (
     IfCondition,
     LaunchConfigurationEquals,
     LaunchConfigurationNotEquals,
     UnlessCondition,
 )
-from mlaunch.context import LaunchContext
-from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
-from mlaunch.substitutions import (
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import (
     AndSubstitution,
     AnonName,
     Command,

@@ -19,11 +19,11 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import guard as guards
-from mlaunch.output import LogFile, Printer, Screen
-from mlaunch.plan import Plan, ProcessSpec, RespawnPolicy, Spawn
-from mlaunch.process import MAX_PARTIAL, core_dump_hint, expand_core_pattern, utf8_safe_cut
-from mlaunch.supervisor import (
+from mlaunch.run import guard as guards
+from mlaunch.run.output import LogFile, Printer, Screen
+from mlaunch.run.plan import Plan, ProcessSpec, RespawnPolicy, Spawn
+from mlaunch.run.process import MAX_PARTIAL, core_dump_hint, expand_core_pattern, utf8_safe_cut
+from mlaunch.run.supervisor import (
     FAILED,
     GAVE_UP,
     STABLE_UPTIME,
@@ -337,7 +337,7 @@ def write_launch(tmp_path: Path, body: str) -> Path:
 
 def plan_from(path: Path, tmp_path: Path) -> Plan:
     from mlaunch import frontends
-    from mlaunch.resolve import ResolveOptions, resolve
+    from mlaunch.run.resolve import ResolveOptions, resolve
 
     temp = tmp_path / "temp"
     temp.mkdir(exist_ok=True)

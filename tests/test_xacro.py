@@ -19,13 +19,13 @@ import pytest
 import xacro
 
 from mlaunch import frontends
-from mlaunch.context import LaunchContext
 from mlaunch.errors import SubstitutionFailure
-from mlaunch.plan import Log
-from mlaunch.resolve import ResolveOptions, resolve
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS, Command, perform
 from mlaunch.ros import packages
 from mlaunch.ros import xacro as in_process
-from mlaunch.substitutions import IN_PROCESS_COMMANDS, Command, perform
+from mlaunch.run.plan import Log
+from mlaunch.run.resolve import ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 PROGRAM = Path(sys.executable).parent / "xacro"
@@ -140,7 +140,7 @@ def test_state_is_restored_after_a_run(ament_env: dict[str, str]) -> None:
 
 
 def test_command_runs_xacro_in_process_in_every_spelling(ament_env: dict[str, str]) -> None:
-    import mlaunch.ros.actions  # noqa: F401  (importing launch_ros registers it)
+    import mlaunch.launch_ros.actions  # noqa: F401  (importing launch_ros registers it)
 
     assert IN_PROCESS_COMMANDS["xacro"] is in_process.run
     assert IN_PROCESS_COMMANDS["xacro.py"] is in_process.run
@@ -206,9 +206,9 @@ def test_errors_name_the_file_line_and_xacros_message(tmp_path: Path) -> None:
 
 
 def test_a_broken_robot_description_is_located_at_the_node(tmp_path: Path) -> None:
-    from mlaunch.actions import LaunchDescription
-    from mlaunch.ros.actions import Node
-    from mlaunch.ros.parameter_descriptions import ParameterValue
+    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch_ros.actions import Node
+    from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 
     broken = tmp_path / "broken.urdf.xacro"
     broken.write_text(BROKEN)

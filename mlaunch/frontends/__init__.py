@@ -21,7 +21,7 @@ FRONTENDS: dict[str, str] = {
     ".yml": "mlaunch.frontends.yaml",
     ".launch.xml": "mlaunch.frontends.xml",
     ".xml": "mlaunch.frontends.xml",
-    ".launch": "mlaunch.frontends.roslaunch",
+    ".launch": "mlaunch.ros1.roslaunch",
 }
 
 FORMAT_MODULES = {

@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.frontends.subst import Parts, TemplateError, parse_template
-from mlaunch.substitutions import to_bool
+from mlaunch.launch.substitutions import to_bool
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms to import
 if TYPE_CHECKING:

@@ -15,7 +15,7 @@ if TYPE_CHECKING:
 
 def load(path: str) -> Any:
     from mlaunch import compat
-    from mlaunch.actions import LaunchDescription
+    from mlaunch.launch.actions import LaunchDescription
 
     compat.install()
     try:

@@ -24,8 +24,8 @@ import difflib
 import re
 from collections.abc import Callable
 
-import mlaunch.substitutions as core
-from mlaunch.substitutions import Substitution
+import mlaunch.launch.substitutions as core
+from mlaunch.launch.substitutions import Substitution
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -77,7 +77,7 @@ class SubstitutionSpec:
 
 def _ros() -> Any:
     # launch_ros substitutions: imported only when a file uses one.
-    import mlaunch.ros.substitutions as ros
+    import mlaunch.launch_ros.substitutions as ros
 
     return ros
 

@@ -1,7 +1,7 @@
 """The tag table shared by the YAML and XML frontends: each tag builds the Python API's action.
 
 A builder reads its Entity through the typed getters (which parse ``$(...)`` once), builds the
-same object a ``.launch.py`` file would (mlaunch.actions, and mlaunch.ros for the launch_ros
+same object a ``.launch.py`` file would (mlaunch.launch.actions, and mlaunch.ros for the launch_ros
 tags, imported only when such a tag appears) and the dispatcher then adds ``if``/``unless``,
 stamps ``origin`` with the tag's file:line and rejects anything left unread.
 """
@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import mlaunch.actions as core
-from mlaunch.conditions import IfCondition, UnlessCondition
+import mlaunch.launch.actions as core
 from mlaunch.errors import LaunchFileError, MlaunchError
 from mlaunch.frontends.entity import Attr, Entity, did_you_mean
 from mlaunch.frontends.subst import Part, Parts
-from mlaunch.plan import OUTPUT_MODES
-from mlaunch.substitutions import Substitution, to_bool
+from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.launch.substitutions import Substitution, to_bool
+from mlaunch.run.plan import OUTPUT_MODES
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -160,7 +160,7 @@ def _let(e: Entity) -> Any:
 
 
 def _include(e: Entity) -> Any:
-    from mlaunch.launch_description_sources import AnyLaunchDescriptionSource
+    from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
 
     subs = e.subentities("arg") + e.subentities("let")
     subs.sort(key=lambda s: (s.line, s.col))  # XML keeps document order across arg and let
@@ -391,9 +391,11 @@ def _split(parts: Parts) -> list[Any]:
 
 def _ros_actions() -> Any:
     try:
-        import mlaunch.ros.actions as ros
+        import mlaunch.launch_ros.actions as ros
     except ImportError as err:
-        raise LaunchFileError(f"launch_ros tags need mlaunch.ros.actions, which is missing: {err}")
+        raise LaunchFileError(
+            f"launch_ros tags need mlaunch.launch_ros.actions, which is missing: {err}"
+        )
     return ros
 
 
@@ -477,7 +479,7 @@ def _set_ros_log_dir(e: Entity) -> Any:
 
 
 def _descriptions() -> Any:
-    import mlaunch.ros.parameter_descriptions as descriptions
+    import mlaunch.launch_ros.parameter_descriptions as descriptions
 
     return descriptions
 

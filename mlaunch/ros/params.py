@@ -32,22 +32,22 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
-from mlaunch.ros.parameter_descriptions import (
-    Parameter,
-    ParameterFile,
-    ParameterValue,
-    is_substitution,
-)
-from mlaunch.substitutions import (
+from mlaunch.launch.substitutions import (
     Substitution,
     TextSubstitution,
     describe,
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros.parameter_descriptions import (
+    Parameter,
+    ParameterFile,
+    ParameterValue,
+    is_substitution,
+)
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 Subs = tuple[Substitution, ...]
 PARAMS_FILE_PREFIX = "launch_params_"

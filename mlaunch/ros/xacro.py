@@ -35,10 +35,10 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.errors import SubstitutionFailure
-from mlaunch.substitutions import IN_PROCESS_COMMANDS
+from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.ros.packages import PackageIndex
 
 PROGRAM_NAMES = ("xacro", "xacro.py")

@@ -20,7 +20,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch_ros.actions import LifecycleNode, Node
 
-from mlaunch.lifecycle import LifecycleSequence
+from mlaunch.ros.lifecycle import LifecycleSequence
 from mlaunch.smoke import Expect
 
 NODES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "nodes")

@@ -9,8 +9,17 @@ from __future__ import annotations
 import os
 
 from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.launch.substitutions import (
+    LaunchConfiguration,
+    Substitution,
+    describe,
+    normalize,
+    perform,
+    perform_substitutions,
+    to_bool,
+)
 from mlaunch.origin import caller_origin
-from mlaunch.plan import (
+from mlaunch.run.plan import (
     OUTPUT_MODES,
     AddHandler,
     ArgumentInfo,
@@ -22,26 +31,17 @@ from mlaunch.plan import (
     RespawnPolicy,
     StartTimer,
 )
-from mlaunch.plan import EmitEvent as EmitEventStep
-from mlaunch.substitutions import (
-    LaunchConfiguration,
-    Substitution,
-    describe,
-    normalize,
-    perform,
-    perform_substitutions,
-    to_bool,
-)
+from mlaunch.run.plan import EmitEvent as EmitEventStep
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
     from typing import Any
 
-    from mlaunch.conditions import Condition
-    from mlaunch.context import LaunchContext
-    from mlaunch.resolve import Resolver
-    from mlaunch.substitutions import SomeSubstitutionsType
+    from mlaunch.launch.conditions import Condition
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.run.resolve import Resolver
 
 
 class LaunchDescriptionEntity:
@@ -354,7 +354,7 @@ class IncludeLaunchDescription(Action):
         **kwargs: Any,
     ) -> None:
         super().__init__(**kwargs)
-        from mlaunch.launch_description_sources import LaunchDescriptionSource, source_for
+        from mlaunch.launch.launch_description_sources import LaunchDescriptionSource, source_for
 
         if not isinstance(launch_description_source, LaunchDescriptionSource):
             launch_description_source = source_for(launch_description_source)
@@ -505,7 +505,7 @@ class EmitEvent(Action):
         self.event = event
 
     def execute(self, resolver: Resolver) -> None:
-        from mlaunch.events import Shutdown as ShutdownEvent
+        from mlaunch.launch.events import Shutdown as ShutdownEvent
 
         if isinstance(self.event, ShutdownEvent):
             resolver.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
@@ -801,7 +801,7 @@ ExecuteLocal = ExecuteProcess
 
 
 def which(name: str, env: dict[str, str]) -> str | None:
-    from mlaunch.substitutions import which as which_on_path
+    from mlaunch.launch.substitutions import which as which_on_path
 
     return which_on_path(name, env.get("PATH", os.defpath))
 

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from mlaunch.substitutions import describe, normalize, perform_substitutions
+from mlaunch.launch.substitutions import describe, normalize, perform_substitutions
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 
 class LaunchDescriptionSource:
@@ -62,7 +62,7 @@ class YAMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
 
 def source_for(value: Any) -> LaunchDescriptionSource:
     """IncludeLaunchDescription also takes a bare path or a LaunchDescription."""
-    from mlaunch.actions import LaunchDescription
+    from mlaunch.launch.actions import LaunchDescription
 
     if isinstance(value, LaunchDescription):
         return LaunchDescriptionSource(launch_description=value)

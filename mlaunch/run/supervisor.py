@@ -11,7 +11,7 @@ Nothing is left behind:
 - every child's environment carries ``MLAUNCH_RUN_ID=<run id>`` (inherited by grandchildren), so
   at shutdown any process of the run is found in /proc even if it escaped before the subreaper
   was set, and is ended (SIGTERM, SIGKILL after STRAY_GRACE);
-- a guard process (mlaunch.guard, a constructor seam) ends the run if mlaunch itself is killed;
+- a guard process (mlaunch.run.guard, a constructor seam) ends the run if mlaunch itself is killed;
 - if the loop itself fails, every group is killed before the error propagates.
 
 At shutdown the stray sweep walks mlaunch's process tree (/proc/<pid>/task/*/children, a few
@@ -39,11 +39,11 @@ import signal
 import time
 from collections.abc import Callable
 
-from mlaunch import events as ev
-from mlaunch import guard as guards
 from mlaunch.errors import MlaunchError
-from mlaunch.output import Printer
-from mlaunch.plan import (
+from mlaunch.launch import events as ev
+from mlaunch.run import guard as guards
+from mlaunch.run.output import Printer
+from mlaunch.run.plan import (
     AddHandler,
     Deferred,
     EmitEvent,
@@ -57,7 +57,7 @@ from mlaunch.plan import (
     StartTimer,
     Step,
 )
-from mlaunch.process import (
+from mlaunch.run.process import (
     Process,
     core_dump_hint,
     core_limit,
@@ -65,7 +65,7 @@ from mlaunch.process import (
     read_core_pattern,
     signal_name,
 )
-from mlaunch.resolve import LabelCounter, ResolveOptions, resolve_deferred
+from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve_deferred
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

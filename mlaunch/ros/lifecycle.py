@@ -37,16 +37,16 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.actions import Action
 from mlaunch.errors import LaunchFileError
-from mlaunch.plan import AddHandler, Deferred, EmitEvent, ProcessSpec, StartTimer, Step
-from mlaunch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
+from mlaunch.launch.actions import Action
+from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
+from mlaunch.run.plan import AddHandler, Deferred, EmitEvent, ProcessSpec, StartTimer, Step
 
 if TYPE_CHECKING:
-    from mlaunch.process import Process
-    from mlaunch.resolve import Resolver
     from mlaunch.ros.bridge import RosGraph, TransitionResult
-    from mlaunch.supervisor import Supervisor
+    from mlaunch.run.process import Process
+    from mlaunch.run.resolve import Resolver
+    from mlaunch.run.supervisor import Supervisor
 
 # How long a node's lifecycle services may take to appear, and each transition to answer.
 DEFAULT_TIMEOUT = 20.0
@@ -357,15 +357,15 @@ class LifecycleManager:
         return None
 
     def _hook_events(self) -> None:
-        from mlaunch.ros.events import ChangeState
+        from mlaunch.launch_ros.events import ChangeState
 
         self.supervisor.event_hooks[ChangeState] = self._on_change_state
         # Runs inside begin_shutdown, before it sends the first stop signal.
         self.supervisor.handlers.append(
             AddHandler(
-                origin="mlaunch.lifecycle",
+                origin="mlaunch.ros.lifecycle",
                 kind="shutdown",
-                body=Deferred([], _empty_context(), "mlaunch.lifecycle", self._on_shutdown),
+                body=Deferred([], _empty_context(), "mlaunch.ros.lifecycle", self._on_shutdown),
                 handler=self,
             )
         )
@@ -554,7 +554,7 @@ class LifecycleManager:
 
     def _transition(self, event: Any) -> None:
         """A ``transition_event`` message: track the state, fire OnStateTransition handlers."""
-        from mlaunch.ros.events import StateTransition
+        from mlaunch.launch_ros.events import StateTransition
 
         managed = self.nodes.get(event.node)
         if managed is None:
@@ -681,7 +681,7 @@ def _matches(event: Any, managed: Managed) -> bool:
 
 
 def _empty_context() -> Any:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
     return LaunchContext(environment={})
 

@@ -22,7 +22,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import Any
 
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 
 class Substitution:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import shlex
 
-from mlaunch.plan import (
+from mlaunch.run.plan import (
     AddHandler,
     EmitEvent,
     Log,

@@ -10,7 +10,7 @@ from collections.abc import Callable, Mapping
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.plan import ProcessSpec
+    from mlaunch.run.plan import ProcessSpec
 
 READ_SIZE = 256 * 1024
 # A line longer than this without a newline is passed on in pieces, so an endless line can

@@ -30,25 +30,25 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from mlaunch import standins
-from mlaunch.actions import Action, ExecuteProcess
 from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
-from mlaunch.plan import NodeInfo, ProcessSpec
-from mlaunch.ros import packages, params
-from mlaunch.ros import xacro as _xacro
-from mlaunch.ros.packages import PackageNotFoundError
-from mlaunch.ros.parameter_descriptions import ParameterFile, normalize_typed, perform_typed
-from mlaunch.ros.substitutions import ExecutableInPackage
-from mlaunch.substitutions import (
+from mlaunch.launch.actions import Action, ExecuteProcess
+from mlaunch.launch.substitutions import (
     SomeSubstitutionsType,
     Substitution,
     describe,
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros.parameter_descriptions import ParameterFile, normalize_typed, perform_typed
+from mlaunch.launch_ros.substitutions import ExecutableInPackage
+from mlaunch.ros import packages, params
+from mlaunch.ros import xacro as _xacro
+from mlaunch.ros.packages import PackageNotFoundError
+from mlaunch.run.plan import NodeInfo, ProcessSpec
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
-    from mlaunch.resolve import ResolveOptions, Resolver
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.run.resolve import ResolveOptions, Resolver
 
 _xacro.register()
 

@@ -11,9 +11,7 @@ import collections.abc
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.errors import SubstitutionFailure
-from mlaunch.ros import packages
-from mlaunch.ros import xacro as _xacro
-from mlaunch.substitutions import (
+from mlaunch.launch.substitutions import (
     PathJoinSubstitution,
     SomeSubstitutionsType,
     Substitution,
@@ -21,9 +19,11 @@ from mlaunch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.ros import packages
+from mlaunch.ros import xacro as _xacro
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 _xacro.register()
 

@@ -17,8 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from mlaunch.event_handlers import EventHandler
-from mlaunch.events import Event, matches_action
+from mlaunch.launch.event_handlers import EventHandler
+from mlaunch.launch.events import Event, matches_action
 
 # lifecycle_msgs/msg/Transition and State ids, with their names.
 TRANSITIONS: dict[int, str] = {
@@ -123,7 +123,7 @@ class OnStateTransition(EventHandler):
         matcher: Callable[[Any], bool] | None = None,
         handle_once: bool = False,
     ) -> None:
-        from mlaunch.ros.actions import LifecycleNode
+        from mlaunch.launch_ros.actions import LifecycleNode
 
         if target_lifecycle_node is not None and not isinstance(
             target_lifecycle_node, LifecycleNode

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mlaunch.substitutions import (
+from mlaunch.launch.substitutions import (
     describe,
     evaluate_condition_expression,
     normalize,
@@ -14,8 +14,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
-    from mlaunch.context import LaunchContext
-    from mlaunch.substitutions import SomeSubstitutionsType
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.substitutions import SomeSubstitutionsType
 
 
 class Condition:

@@ -17,20 +17,20 @@ def _lifecycle(options: Any, supervisor: Any) -> Any:
     """Lifecycle (managed) node driving; None unless the plan has lifecycle work."""
     if not _may_have_lifecycle_work(options, supervisor.plan):
         return None
-    from mlaunch.lifecycle import attach
+    from mlaunch.ros.lifecycle import attach
 
     return attach(options, supervisor)
 
 
 def _may_have_lifecycle_work(options: Any, plan: Any) -> bool:
-    """A cheap look that can rule lifecycle out without importing mlaunch.lifecycle (~5 ms).
+    """A cheap look that can rule lifecycle out without importing mlaunch.ros.lifecycle (~5 ms).
 
     False only when nothing in the plan can involve a managed node; lifecycle.attach then
     makes the exact decision.
     """
     import sys
 
-    if "mlaunch.lifecycle" in sys.modules:  # a LifecycleSequence or Expect was built
+    if "mlaunch.ros.lifecycle" in sys.modules:  # a LifecycleSequence or Expect was built
         return True
     sequence = "mlaunch_lifecycle_sequence"
     if sequence in plan.arguments or sequence in getattr(options, "arguments", {}):
@@ -48,22 +48,22 @@ def _may_have_lifecycle_work(options: Any, plan: Any) -> bool:
         deferred = deferred or (spec is not None and spec.on_exit is not None)
     # Deferred parts resolve later; a lifecycle node can only be among them if the ROS
     # actions were loaded.
-    return deferred and "mlaunch.ros.actions" in sys.modules
+    return deferred and "mlaunch.launch_ros.actions" in sys.modules
 
 
 def _status_view(options: Any, supervisor: Any) -> Any:
     """``--status``: the live table pinned below the output (rich and psutil, only then)."""
     if not getattr(options, "status", False):
         return None
-    from mlaunch.status import attach_status_view
+    from mlaunch.run.status import attach_status_view
 
     return attach_status_view(supervisor)
 
 
 class _ExitSummary:
-    """Prints mlaunch.status's exit summary at close, importing it only then.
+    """Prints mlaunch.run.status's exit summary at close, importing it only then.
 
-    mlaunch.status (with typing) costs ~1.5 ms, which attaching before the run would spend
+    mlaunch.run.status (with typing) costs ~1.5 ms, which attaching before the run would spend
     before the first child starts.
     """
 
@@ -72,7 +72,7 @@ class _ExitSummary:
         self.quiet = quiet
 
     def close(self) -> None:
-        from mlaunch.status import ExitSummary
+        from mlaunch.run.status import ExitSummary
 
         ExitSummary(self.supervisor, quiet=self.quiet).close()
 

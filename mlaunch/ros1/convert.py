@@ -2,7 +2,7 @@
 
     mlaunch convert old.launch [--to py|yaml|xml] [-o FILE]
 
-The file is read by the roslaunch frontend (``mlaunch.frontends.roslaunch.read``), which maps it
+The file is read by the roslaunch frontend (``mlaunch.ros1.roslaunch.read``), which maps it
 to the ROS 2 description it becomes; this module only *writes* that description, in Python
 (launch / launch_ros classes), YAML (launch_yaml) or XML (launch_xml). Because running the ROS 1
 file builds the very same description, the converted file resolves to the same plan. Every
@@ -25,8 +25,8 @@ from xml.sax.saxutils import escape
 import yaml
 
 from mlaunch.errors import LaunchFileError, MlaunchError, UsageError
-from mlaunch.frontends import roslaunch as r1
-from mlaunch.frontends.roslaunch import (
+from mlaunch.ros1 import roslaunch as r1
+from mlaunch.ros1.roslaunch import (
     AnonRef,
     ArgRef,
     CommandRef,

@@ -7,7 +7,7 @@ Reading goes in two steps, and ``mlaunch convert`` shares the first one:
    it becomes: ``Item`` objects (arguments, SetParameter, groups, includes, nodes, processes,
    warnings). Every ROS 1 -> ROS 2 decision is taken here, once (docs/ros1.md lists them).
 2. ``to_actions(items)`` builds that model into mlaunch's own actions (the ROS 2 classes);
-   ``mlaunch.convert`` writes the same model out as a ROS 2 launch file instead. Running the
+   ``mlaunch.ros1.convert`` writes the same model out as a ROS 2 launch file instead. Running the
    ROS 1 file and running its conversion therefore resolve to the same plan.
 
 What has no ROS 2 equivalent becomes a warning naming the file and line: a warning action in
@@ -30,13 +30,13 @@ from xml.parsers import expat
 
 import yaml
 
-from mlaunch.actions import Action, SetLaunchConfiguration
 from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
-from mlaunch.substitutions import Substitution
+from mlaunch.launch.actions import Action, SetLaunchConfiguration
+from mlaunch.launch.substitutions import Substitution
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
-    from mlaunch.resolve import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.run.resolve import Resolver
 
 
 # --- the model of the ROS 2 description a ROS 1 file becomes -------------------------------------
@@ -1793,7 +1793,7 @@ def read(path: str) -> list[Item]:
 
 def load(path: str) -> Any:
     """The LaunchDescription of the roslaunch XML file at ``path``."""
-    from mlaunch.actions import LaunchDescription
+    from mlaunch.launch.actions import LaunchDescription
 
     description = LaunchDescription(to_actions(read(path)))
     description.origin = f"{os.path.abspath(path)}:1"
@@ -1851,8 +1851,8 @@ def to_actions(items: list[Item]) -> list[Any]:
 
 
 def _action(item: Item) -> Any:
-    import mlaunch.actions as core
-    import mlaunch.ros.actions as ros
+    import mlaunch.launch.actions as core
+    import mlaunch.launch_ros.actions as ros
 
     if isinstance(item, Warn):
         return MappingWarning(item.message, item.origin, None)
@@ -1877,7 +1877,7 @@ def _action(item: Item) -> Any:
             actions.insert(0, push)
         return core.GroupAction(actions, scoped=item.scoped)
     if isinstance(item, Include):
-        from mlaunch.launch_description_sources import AnyLaunchDescriptionSource
+        from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
 
         source = AnyLaunchDescriptionSource(subs(item.path))
         arguments = [(name, subs(value)) for name, value in item.arguments]
@@ -1909,7 +1909,7 @@ def node_keywords(node: NodeItem) -> dict[str, Any]:
 
 
 def process_keywords(item: Process) -> dict[str, Any]:
-    import mlaunch.actions as core
+    import mlaunch.launch.actions as core
 
     kwargs: dict[str, Any] = {}
     if item.output is not None:
@@ -1941,7 +1941,7 @@ def _key(value: Value) -> Any:
 def _condition(cond: Cond | None) -> Any:
     if cond is None:
         return None
-    from mlaunch.conditions import IfCondition, UnlessCondition
+    from mlaunch.launch.conditions import IfCondition, UnlessCondition
 
     return (UnlessCondition if cond.unless else IfCondition)(subs(cond.value))
 
@@ -1953,7 +1953,7 @@ def parameter_value(value: PValue) -> Any:
     converted = subs(value.dynamic)
     if value.vtype is None:
         return converted
-    from mlaunch.ros.parameter_descriptions import ParameterValue
+    from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 
     return ParameterValue(converted, value_type=value.vtype)
 
@@ -1964,14 +1964,14 @@ def subs(value: Value) -> list[Any]:
 
 
 def _substitution(part: Part) -> Any:
-    import mlaunch.substitutions as core
+    import mlaunch.launch.substitutions as core
 
     if isinstance(part, str):
         return part
     if isinstance(part, ArgRef):
         return core.LaunchConfiguration(part.name)
     if isinstance(part, FindRef):
-        from mlaunch.ros.substitutions import FindPackageShare
+        from mlaunch.launch_ros.substitutions import FindPackageShare
 
         return FindPackageShare(part.package)
     if isinstance(part, EnvRef):
@@ -2045,7 +2045,7 @@ class RoslaunchEval(Substitution):
             return os.path.dirname(context.current_launch_file_path or "")
 
         def anon(name: str) -> str:
-            from mlaunch.substitutions import AnonName
+            from mlaunch.launch.substitutions import AnonName
 
             return AnonName(name).perform(context)
 

@@ -18,7 +18,7 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")

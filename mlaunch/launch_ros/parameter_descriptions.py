@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
-from mlaunch.substitutions import (
+from mlaunch.launch.substitutions import (
     Substitution,
     describe,
     normalize,
@@ -31,7 +31,7 @@ from mlaunch.substitutions import (
 )
 
 if TYPE_CHECKING:
-    from mlaunch.context import LaunchContext
+    from mlaunch.launch.launch_context import LaunchContext
 
 SCALAR_TYPES = (int, float, bool, str)
 Subs = tuple[Substitution, ...]

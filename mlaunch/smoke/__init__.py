@@ -54,17 +54,17 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.actions import Action
 from mlaunch.errors import LaunchFileError, UsageError
-from mlaunch.plan import Step
-from mlaunch.substitutions import perform
+from mlaunch.launch.actions import Action
+from mlaunch.launch.substitutions import perform
+from mlaunch.run.plan import Step
 
 if TYPE_CHECKING:
-    from mlaunch.lifecycle import LifecycleManager, Outcome, SharedGraph
-    from mlaunch.plan import Plan, ProcessSpec
-    from mlaunch.process import Process
-    from mlaunch.resolve import Resolver
-    from mlaunch.supervisor import Supervisor
+    from mlaunch.ros.lifecycle import LifecycleManager, Outcome, SharedGraph
+    from mlaunch.run.plan import Plan, ProcessSpec
+    from mlaunch.run.process import Process
+    from mlaunch.run.resolve import Resolver
+    from mlaunch.run.supervisor import Supervisor
 
 _HELP = __doc__ or ""
 EXIT_PASS = 0
@@ -466,8 +466,8 @@ def main(args: Sequence[str]) -> int:
 def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
     from mlaunch import cli
-    from mlaunch.actions import LaunchDescription
-    from mlaunch.output import make_run_log_dir
+    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.run.output import make_run_log_dir
 
     path, description = cli.load_target(opts)
     collector = _CollectConfigurations()
@@ -561,12 +561,13 @@ def supervise(
     any, already exists), which keeps every supervision detail (guard, printer, status view,
     exit summary) exactly that of a normal run.
     """
-    from mlaunch import cli, extensions
+    from mlaunch import cli
+    from mlaunch.run import extensions
 
     runs: list[SmokeRun] = []
 
     def attach(_opts: Any, supervisor: Supervisor) -> SmokeRun:
-        from mlaunch.lifecycle import LifecycleManager
+        from mlaunch.ros.lifecycle import LifecycleManager
 
         smoke = SmokeRun(
             supervisor, expectations, settings, lifecycle=LifecycleManager.of(supervisor)
@@ -611,7 +612,7 @@ class SmokeRun:
         *,
         lifecycle: LifecycleManager | None = None,
     ) -> None:
-        from mlaunch.lifecycle import LoopCall, SharedGraph
+        from mlaunch.ros.lifecycle import LoopCall, SharedGraph
 
         self.supervisor = supervisor
         self.expectations = expectations
@@ -678,7 +679,7 @@ class SmokeRun:
         self._exited(e, process)
 
     def _exited(self, e: Expectation, process: Process) -> None:
-        from mlaunch.process import describe_status
+        from mlaunch.run.process import describe_status
 
         code = process.returncode if process.returncode is not None else 0
         uptime = max(0.0, process.ended_at - process.started_at)
@@ -1007,7 +1008,7 @@ class Report:
         return "\n".join(parts)
 
     def write_junit(self, path: str) -> None:
-        from mlaunch import junit
+        from mlaunch.smoke import junit
 
         stem = os.path.basename(self.path).split(".")[0] or "launch"
         cases = []

@@ -67,7 +67,7 @@ class LaunchContext:
         self._locals.update(values)
 
     def perform_substitution(self, substitution: Any) -> str:
-        from mlaunch.substitutions import perform
+        from mlaunch.launch.substitutions import perform
 
         return perform(self, substitution)
 

@@ -10,11 +10,11 @@ from __future__ import annotations
 import itertools
 import os
 
-from mlaunch.context import LaunchContext
 from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
 from mlaunch.origin import user_location
-from mlaunch.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Record, Spawn, Step
-from mlaunch.substitutions import Substitution, normalize, perform, perform_substitutions
+from mlaunch.run.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Record, Spawn, Step
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -164,7 +164,7 @@ class Resolver:
             if os.access(program, os.X_OK) and not os.path.isdir(program):
                 return argv, None
         else:
-            from mlaunch.actions import which
+            from mlaunch.launch.actions import which
 
             if which(program, env) is not None:
                 return argv, None
@@ -210,7 +210,7 @@ def resolve(
     )
     context.launch_configurations.update(arguments)
     if options.use_sim_time is not None:
-        from mlaunch.ros.actions import apply_options
+        from mlaunch.launch_ros.actions import apply_options
 
         apply_options(context, options)
     resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
@@ -272,7 +272,7 @@ def collect_arguments(
     Conditional declarations (under a condition, in a timer or handler) are marked; nothing is
     spawned and no command substitution beyond what an include path needs is run.
     """
-    from mlaunch.actions import (
+    from mlaunch.launch.actions import (
         DeclareLaunchArgument,
         GroupAction,
         IncludeLaunchDescription,

@@ -23,7 +23,7 @@ import os
 import time
 from collections.abc import Callable, Iterable
 
-from mlaunch.supervisor import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
+from mlaunch.run.supervisor import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -243,7 +243,7 @@ class StatusView:
 
     def _groups(self) -> dict[int, list[int]]:
         """Living members of each running process's group (one /proc scan for all)."""
-        from mlaunch.guard import scan
+        from mlaunch.run.guard import scan
 
         running = {p.pid for p in self.supervisor.processes if p.running}
         groups: dict[int, list[int]] = {pgid: [] for pgid in running}

@@ -1,0 +1,87 @@
+"""The ``launch`` API of ROS 2, served by mlaunch (see mlaunch.compat).
+
+Launch files import ``launch``, ``launch.actions``, ``launch.substitutions`` ... and get these
+modules. The top-level names load on first use, so importing one submodule stays cheap.
+"""
+
+from __future__ import annotations
+
+import importlib
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.actions import Action, LaunchDescription, LaunchDescriptionEntity
+    from mlaunch.launch.conditions import Condition
+    from mlaunch.launch.event_handlers import EventHandler
+    from mlaunch.launch.events import Event
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+    from mlaunch.launch.substitutions import (
+        SomeSubstitutionsType,
+        SomeSubstitutionsType_types_tuple,
+        Substitution,
+        perform_substitutions,
+    )
+
+# name -> (module, attribute in it)
+_NAMES: dict[str, tuple[str, str]] = {
+    "Action": ("mlaunch.launch.actions", "Action"),
+    "LaunchDescription": ("mlaunch.launch.actions", "LaunchDescription"),
+    "LaunchDescriptionEntity": ("mlaunch.launch.actions", "LaunchDescriptionEntity"),
+    "Condition": ("mlaunch.launch.conditions", "Condition"),
+    "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
+    "EventHandler": ("mlaunch.launch.event_handlers", "EventHandler"),
+    "Event": ("mlaunch.launch.events", "Event"),
+    "LaunchDescriptionSource": (
+        "mlaunch.launch.launch_description_sources",
+        "LaunchDescriptionSource",
+    ),
+    "SomeSubstitutionsType": ("mlaunch.launch.substitutions", "SomeSubstitutionsType"),
+    "SomeSubstitutionsType_types_tuple": (
+        "mlaunch.launch.substitutions",
+        "SomeSubstitutionsType_types_tuple",
+    ),
+    "Substitution": ("mlaunch.launch.substitutions", "Substitution"),
+    "normalize_to_list_of_substitutions": ("mlaunch.launch.substitutions", "normalize"),
+    "perform_substitutions": ("mlaunch.launch.substitutions", "perform_substitutions"),
+}
+
+_SUBMODULES = (
+    "actions",
+    "substitutions",
+    "conditions",
+    "event_handlers",
+    "events",
+    "launch_context",
+    "launch_description_sources",
+)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _NAMES:
+        module_name, attribute = _NAMES[name]
+        value = getattr(importlib.import_module(module_name), attribute)
+        globals()[name] = value
+        return value
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module 'launch' (mlaunch) has no attribute {name!r}")
+
+
+__all__ = [
+    "Action",
+    "Condition",
+    "Event",
+    "EventHandler",
+    "LaunchContext",
+    "LaunchDescription",
+    "LaunchDescriptionEntity",
+    "LaunchDescriptionSource",
+    "SomeSubstitutionsType",
+    "SomeSubstitutionsType_types_tuple",
+    "Substitution",
+    "normalize_to_list_of_substitutions",
+    "perform_substitutions",
+]

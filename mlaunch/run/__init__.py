@@ -1,0 +1,1 @@
+"""The engine: resolve a description into a plan, then spawn, supervise and report it."""
