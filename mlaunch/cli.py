@@ -383,7 +383,7 @@ def launch(opts: Options, path: str, description: object) -> int:
     try:
         log_dir = ""
         if not opts.print_plan:
-            from mlaunch.run.output import make_run_log_dir
+            from mlaunch.run.logfiles import make_run_log_dir
 
             log_dir = make_run_log_dir(os.environ)
         plan, options, labels = resolve_for_run(
@@ -402,7 +402,8 @@ def launch(opts: Options, path: str, description: object) -> int:
 def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
     from mlaunch.errors import UsageError
     from mlaunch.run.guard import Guard, new_run_id
-    from mlaunch.run.output import DEFAULT_ROTATE_BYTES, Printer, stdout_is_color_terminal
+    from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
+    from mlaunch.run.output import Printer, stdout_is_color_terminal
     from mlaunch.run.supervisor import Supervisor
 
     if opts.log_max_bytes is not None and opts.log_max_bytes < 0:

@@ -25,8 +25,10 @@ import pytest
 from test_supervision import Harness, gone, make_spec, wait_until
 
 from mlaunch.run import guard as guards
-from mlaunch.run.output import Printer, Screen
+from mlaunch.run.output import Printer
 from mlaunch.run.plan import Plan, Spawn
+from mlaunch.run.screen import Screen
+from mlaunch.run.strays import Strays
 from mlaunch.run.supervisor import Supervisor
 
 PY = sys.executable
@@ -315,7 +317,7 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
     h.printer.hooks.append(saw)
     during_run = count_during_run(h, calls)
     assert h.run() == 0
-    assert not h.sup._escaped, "a child of this process had exited before the run began"
+    assert not h.sup.strays.escaped, "a child of this process had exited before the run began"
     assert during_run == [0]
 
 
@@ -323,24 +325,24 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
 def test_an_orphan_from_before_the_subreaper_is_found_by_its_marker(monkeypatch: object) -> None:
     calls = counting_marker_scans(monkeypatch)
 
-    class LateSubreaper(Supervisor):
+    class LateSubreaper(Strays):
         """Becomes subreaper only after the child has exited: its orphan went to init."""
 
-        def _set_subreaper(self, on: bool) -> None:
+        def set_subreaper(self, on: bool) -> None:
             if on:
-                assert wait_until(self._a_child_has_exited, 10)
-            super()._set_subreaper(on)
+                assert wait_until(self.a_child_has_exited, 10)
+            super().set_subreaper(on)
 
     # The grandchild leaves the child's session (or it would linger in the child's group).
     daemonize = "setsid sleep 30 & echo $!; exit 0"
     spec = make_spec("daemonizer", "", argv=("/bin/sh", "-c", daemonize))
     h = Harness([spec], stray_grace=0.3)
-    h.sup = LateSubreaper(h.sup.plan, h.printer, install_signals=False, stray_grace=0.3)
+    h.sup.strays = LateSubreaper(h.sup.run_id, grace=0.3)
     orphans: list[int] = []
     h.when(b"", lambda label, line: orphans.append(int(line)))
     during_run = count_during_run(h, calls)
     assert h.run() == 0
-    assert h.sup._escaped and during_run[0] > 0
+    assert h.sup.strays.escaped and during_run[0] > 0
     assert orphans and wait_until(lambda: gone(orphans[0]), 5)
     assert "ending stray descendant sleep" in h.text
 

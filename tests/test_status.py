@@ -14,6 +14,7 @@ import time
 from test_supervision import Harness, make_spec
 
 from mlaunch.run.plan import ProcessSpec, RespawnPolicy
+from mlaunch.run.records import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
 from mlaunch.run.status import (
     ExitSummary,
     StatusView,
@@ -23,7 +24,6 @@ from mlaunch.run.status import (
     render_summary,
     summary_wanted,
 )
-from mlaunch.run.supervisor import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
 
 CSI = re.compile(r"\x1b\[(\d*)([A-Za-z])")
 

@@ -20,16 +20,14 @@ from pathlib import Path
 import pytest
 
 from mlaunch.run import guard as guards
-from mlaunch.run.output import LogFile, Printer, Screen
+from mlaunch.run.logfiles import LogFile
+from mlaunch.run.output import Printer
 from mlaunch.run.plan import Plan, ProcessSpec, RespawnPolicy, Spawn
 from mlaunch.run.process import MAX_PARTIAL, core_dump_hint, expand_core_pattern, utf8_safe_cut
-from mlaunch.run.supervisor import (
-    FAILED,
-    GAVE_UP,
-    STABLE_UPTIME,
-    Supervisor,
-    respawn_delay,
-)
+from mlaunch.run.records import FAILED, GAVE_UP
+from mlaunch.run.respawn import STABLE_UPTIME, respawn_delay
+from mlaunch.run.screen import Screen
+from mlaunch.run.supervisor import Supervisor
 
 PY = sys.executable
 

@@ -23,7 +23,7 @@ import os
 import time
 from collections.abc import Callable, Iterable
 
-from mlaunch.run.supervisor import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
+from mlaunch.run.records import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

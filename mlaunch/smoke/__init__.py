@@ -467,7 +467,7 @@ def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
     from mlaunch import cli
     from mlaunch.launch.actions import LaunchDescription
-    from mlaunch.run.output import make_run_log_dir
+    from mlaunch.run.logfiles import make_run_log_dir
 
     path, description = cli.load_target(opts)
     collector = _CollectConfigurations()

@@ -1,0 +1,146 @@
+"""The run's log folder and its files: ``launch.log`` and one rotating file per process.
+
+Log files get every line (the screen may drop some for a stalled reader, never these). A file is
+opened on its first write, buffered, and rotated at a size limit.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Mapping
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import IO
+
+DEFAULT_ROTATE_BYTES = 64 * 1024 * 1024
+DEFAULT_ROTATE_KEEP = 3
+# Per log file: a hundred processes must not pin a hundred large buffers.
+LOG_BUFFER = 64 * 1024
+
+
+class LogFile:
+    """An append-only log file that rotates at a size limit (name -> name.1 -> name.2 ...).
+
+    It is opened on the first write (so starting a hundred processes does not first open a
+    hundred files). A write error (disk full) stops this file, once, through ``on_error``;
+    it never stops the run.
+    """
+
+    def __init__(
+        self,
+        path: str,
+        *,
+        rotate_bytes: int,
+        keep: int,
+        lazy: bool = False,
+        on_error: Callable[[str, OSError], None] | None = None,
+    ) -> None:
+        self.path = path
+        self.rotate_bytes = rotate_bytes
+        self.keep = keep
+        self.on_error = on_error
+        self.error: OSError | None = None
+        self.size = 0
+        self._file: IO[bytes] | None = None
+        if not lazy:
+            self._open()
+
+    def _open(self) -> None:
+        self._file = open(self.path, "ab", buffering=LOG_BUFFER)  # noqa: SIM115
+        self.size = self._file.tell()
+
+    def write(self, data: bytes) -> None:
+        if self.error is not None:
+            return
+        try:
+            if self._file is None:
+                self._open()
+            limit = self.rotate_bytes
+            while limit and self.size + len(data) > limit:
+                # Fill this file up to the limit at a line boundary, then start the next one;
+                # only a single line longer than the limit makes a file exceed it.
+                cut = data.rfind(b"\n", 0, max(0, limit - self.size)) + 1
+                if cut:
+                    self._append(data[:cut])
+                    data = data[cut:]
+                if self.size:
+                    self.rotate()
+                elif not cut:
+                    break
+            if data:
+                self._append(data)
+        except OSError as e:
+            self._failed(e)
+
+    def _append(self, data: bytes) -> None:
+        assert self._file is not None
+        self._file.write(data)
+        self.size += len(data)
+
+    def _failed(self, error: OSError) -> None:
+        self.error = error
+        if self._file is not None:
+            try:
+                self._file.close()
+            except OSError:
+                pass  # the buffered rest cannot be written either
+        if self.on_error is not None:
+            self.on_error(self.path, error)
+
+    def rotate(self) -> None:
+        if self._file is not None:
+            self._file.close()
+        for i in range(self.keep - 1, 0, -1):
+            older = f"{self.path}.{i}"
+            if os.path.exists(older):
+                os.replace(older, f"{self.path}.{i + 1}")
+        if self.keep > 0:
+            os.replace(self.path, f"{self.path}.1")
+        else:
+            os.unlink(self.path)
+        self._open()
+        self.size = 0
+
+    def flush(self) -> None:
+        if self._file is None or self.error is not None:
+            return
+        try:
+            self._file.flush()
+        except OSError as e:
+            self._failed(e)
+
+    def close(self) -> None:
+        self.flush()
+        if self._file is not None and self.error is None:
+            self._file.close()
+
+
+def log_base_dir(environ: Mapping[str, str]) -> str:
+    """``$ROS_LOG_DIR``, else ``$ROS_HOME/log``, else ``~/.ros/log`` (as ROS 2)."""
+    if environ.get("ROS_LOG_DIR"):
+        base = environ["ROS_LOG_DIR"]
+    elif environ.get("ROS_HOME"):
+        base = os.path.join(environ["ROS_HOME"], "log")
+    else:
+        base = os.path.join(os.path.expanduser("~"), ".ros", "log")
+    return os.path.normpath(os.path.expanduser(base))
+
+
+def make_run_log_dir(environ: Mapping[str, str]) -> str:
+    """Create ``<base>/<timestamp>-<host>-<pid>/`` and point ``<base>/latest`` at it."""
+    base = log_base_dir(environ)
+    stamp = time.strftime("%Y-%m-%d-%H-%M-%S", time.localtime())
+    micro = f"{time.time() % 1:.6f}"[2:]
+    path = os.path.join(base, f"{stamp}-{micro}-{os.uname().nodename}-{os.getpid()}")
+    os.makedirs(path, exist_ok=True)
+    latest = os.path.join(base, "latest")
+    if not os.path.exists(latest) or os.path.islink(latest):
+        tmp = f"{latest}.{os.getpid()}"
+        try:
+            os.symlink(os.path.basename(path), tmp)
+            os.replace(tmp, latest)
+        except OSError:
+            pass
+    return path
