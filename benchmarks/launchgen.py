@@ -453,3 +453,44 @@ def big_system() -> list[LaunchFile]:
     for level in range(1, LEVELS + 1):
         files.append(LaunchFile(f"big_l{level}", [*_level_args(), *_level_body(level)]))
     return files
+
+
+NODE_LAUNCH = """\
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, PushROSNamespace, SetParameter
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument("ns", default_value="robot"),
+        PushROSNamespace(LaunchConfiguration("ns")),
+        SetParameter("use_sim_time", True),
+        Node(package="bench_pkg", executable="ready", name="ready", namespace="sub",
+             arguments=[{fifo!r}], remappings=[("chatter", "out")], output="screen"),
+    ])
+"""
+
+
+def write_node_launch(directory: Path, child: Path, fifo: Path) -> tuple[Path, Path]:
+    """A one-Node launch and the ament prefix holding its package: (launch file, prefix).
+
+    The package ``bench_pkg`` is installed as colcon would lay it out (resource index marker,
+    share folder, ``lib/bench_pkg/ready``), its executable a link to the ready child, so the
+    figure covers the package lookup and launch_ros's command line (name, namespace, remaps,
+    global parameters) on top of what an ExecuteProcess launch does.
+    """
+    prefix = directory / "install"
+    marker = prefix / "share" / "ament_index" / "resource_index" / "packages" / "bench_pkg"
+    marker.parent.mkdir(parents=True, exist_ok=True)
+    marker.write_text("")
+    (prefix / "share" / "bench_pkg").mkdir(parents=True, exist_ok=True)
+    lib = prefix / "lib" / "bench_pkg"
+    lib.mkdir(parents=True, exist_ok=True)
+    ready = lib / "ready"
+    if not ready.exists():
+        ready.symlink_to(child)
+    path = directory / "node.launch.py"
+    path.write_text(NODE_LAUNCH.format(fifo=str(fifo)))
+    return path, prefix

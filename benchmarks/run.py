@@ -370,11 +370,22 @@ class Bench:
             )
         return self.interpreter[venv.name]
 
-    def children_run(self, argv: Sequence[str], n: int, idle: float = 0.0) -> dict[str, float]:
+    def children_run(
+        self,
+        argv: Sequence[str],
+        n: int,
+        idle: float = 0.0,
+        env: dict[str, str] | None = None,
+    ) -> dict[str, float]:
         """Start a launcher of N ready-children; time first/all running, idle CPU, RSS, stop."""
         probe = pr.ReadyProbe(self.fifo).open()
         with open(self.out_file, "wb") as out:
-            proc = pr.launch(argv, self.env, stdout=out.fileno(), stderr=subprocess.STDOUT)
+            proc = pr.launch(
+                argv,
+                self.env if env is None else env,
+                stdout=out.fileno(),
+                stderr=subprocess.STDOUT,
+            )
         try:
             first, last = probe.wait_ready(n, proc, time.perf_counter() + 30 + n / 10)
             result = {"first": first - proc.started, "all": last - proc.started}
@@ -427,6 +438,34 @@ class Bench:
                         break  # the frontend cannot run this format at all
                     continue
                 self._startup_rows(venv, fmt, n, samples, floors.get(n, []))
+        self.node_startup(venv, floors.get(1, []))
+
+    def node_startup(self, venv: Venv, floors: list[dict[str, float]]) -> None:
+        """First child of a one-Node launch (an installed package, launch_ros's command line)."""
+        path, prefix = gen.write_node_launch(self.launches / "node", self.scripts.ready, self.fifo)
+        env = {**self.env, "AMENT_PREFIX_PATH": str(prefix)}
+        samples: list[float] = []
+        try:
+            for i in self.runs():
+                one = self.children_run([str(venv.mlaunch), str(path)], 1, env=env)
+                if i:
+                    samples.append(one["first"])
+        except BenchError as e:
+            self.results.skip("startup", venv.name, "py one Node", str(e))
+            return
+        self.results.rows.append(
+            Row(
+                "startup",
+                "first child running, py, one Node",
+                venv.name,
+                "s",
+                samples,
+                "bare Popen loop",
+                [f["first"] for f in floors],
+                Target(0.06),
+                {"format": "py", "n": 1, "node": True},
+            )
+        )
 
     def _startup_rows(
         self,

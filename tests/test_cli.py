@@ -289,15 +289,25 @@ def test_plain_launch_never_imports_rclpy(tmp_path: Path, env: dict[str, str]) -
     assert "IMPORTED []" in done.stdout
 
 
-def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
-    """The start-up budget (first child within 60 ms): what must not load before the first child.
+HEAVY_AT_START = (
+    "rclpy",
+    "rich",
+    "asyncio",
+    "yaml",
+    "dataclasses",
+    "typing",
+    "inspect",
+    "psutil",
+    "tempfile",
+)
 
-    The child's own start is the moment checked: the launch's only process is started, then the
-    heavy modules are looked for in mlaunch's sys.modules as its first output line arrives.
-    --show-args must not load the runtime at all.
+
+def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
+    """The HEAVY_AT_START modules mlaunch has loaded once it has started the launch's first child.
+
+    The child's own start is the moment checked: the supervisor's start() is wrapped, and the
+    modules are looked for in mlaunch's sys.modules as soon as it returns.
     """
-    heavy = ("rclpy", "rich", "asyncio", "yaml", "dataclasses", "typing", "inspect", "psutil")
-    path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'print(1)'], output='screen'),")
     code = (
         "import sys\n"
         "import mlaunch.run.supervisor as sup\n"
@@ -305,7 +315,7 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
         "original = sup.Supervisor.start\n"
         "def start(self, *a, **k):\n"
         "    result = original(self, *a, **k)\n"
-        f"    seen.extend(m for m in {heavy!r} if m in sys.modules)\n"
+        f"    seen.extend(m for m in {HEAVY_AT_START!r} if m in sys.modules)\n"
         "    return result\n"
         "sup.Supervisor.start = start\n"
         "from mlaunch.cli import main\n"
@@ -317,7 +327,17 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
         [PY, "-c", code, path], capture_output=True, text=True, env=env, timeout=30
     )
     assert done.returncode == 0, done.stderr
-    assert "AT-FIRST-CHILD []" in done.stdout
+    (line,) = [x for x in done.stdout.splitlines() if x.startswith("AT-FIRST-CHILD")]
+    return list(eval(line.partition(" ")[2]))
+
+
+def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
+    """The start-up budget (first child within 60 ms): what must not load before the first child.
+
+    --show-args must not load the runtime at all.
+    """
+    path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'print(1)'], output='screen'),")
+    assert loaded_at_first_child(path, env) == []
     show = (
         "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '--show-args']);"
         " runtime = ('mlaunch.run.supervisor', 'mlaunch.run.process', 'mlaunch.run.output', 'subprocess', 'selectors');"
@@ -328,6 +348,43 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     )
     assert done.returncode == 0, done.stderr
     assert "SHOW-ARGS []" in done.stdout
+
+
+def test_node_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
+    """A launch of installed ROS nodes keeps the ExecuteProcess budget: the package lookup, names,
+    namespaces, remaps, arguments and global parameters load nothing heavy before the first child.
+    """
+    prefix = tmp_path / "install"
+    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
+    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
+    (prefix / "share/demo").mkdir()
+    (prefix / "lib/demo").mkdir(parents=True)
+    talker = prefix / "lib/demo/talker"
+    talker.write_text(f"#!{PY}\nprint('talking')\n")
+    talker.chmod(0o755)
+    path = tmp_path / "nodes.launch.py"
+    path.write_text(
+        textwrap.dedent(
+            """
+            from launch import LaunchDescription
+            from launch.actions import DeclareLaunchArgument
+            from launch.substitutions import LaunchConfiguration
+            from launch_ros.actions import Node, PushROSNamespace, SetParameter
+
+            def generate_launch_description():
+                return LaunchDescription([
+                    DeclareLaunchArgument('ns', default_value='robot'),
+                    PushROSNamespace(LaunchConfiguration('ns')),
+                    SetParameter('use_sim_time', True),
+                    Node(package='demo', executable='talker', name='talker', namespace='sub',
+                         arguments=['--rate', '5'], remappings=[('chatter', 'out')],
+                         output='screen'),
+                ])
+            """
+        )
+    )
+    env = {**env, "AMENT_PREFIX_PATH": str(prefix)}
+    assert loaded_at_first_child(str(path), env) == []
 
 
 @pytest.mark.parametrize(

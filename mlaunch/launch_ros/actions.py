@@ -21,13 +21,9 @@ Importing this module registers the in-process xacro for ``Command(['xacro ', ..
 
 from __future__ import annotations
 
-import collections
 import os
 import re
-import tempfile
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
 
 from mlaunch import standins
 from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
@@ -41,12 +37,16 @@ from mlaunch.launch.substitutions import (
 )
 from mlaunch.launch_ros.parameter_descriptions import ParameterFile, normalize_typed, perform_typed
 from mlaunch.launch_ros.substitutions import ExecutableInPackage
+from mlaunch.record import Record
 from mlaunch.ros import packages, params
 from mlaunch.ros import xacro as _xacro
 from mlaunch.ros.packages import PackageNotFoundError
 from mlaunch.run.plan import NodeInfo, ProcessSpec
 
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from typing import Any
+
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.run.resolve import ResolveOptions, Resolver
 
@@ -278,12 +278,15 @@ def ros_log_dir(environ: Mapping[str, str]) -> str:
 # --- Node ------------------------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class NodeNames:
+class NodeNames(Record):
     """A node's name and namespace as resolved (None: not given, the node's own default)."""
 
-    name: str | None
-    namespace: str | None
+    _fields = ("name", "namespace")
+    __slots__ = _fields
+
+    def __init__(self, name: str | None, namespace: str | None) -> None:
+        self.name = name
+        self.namespace = namespace
 
     @property
     def fully_qualified(self) -> str | None:
@@ -299,16 +302,27 @@ class NodeNames:
         return "/**"
 
 
-@dataclass
-class _Resolved:
+class _Resolved(Record):
     """What one resolution of a Node found, for the spec hooks that run after command()."""
 
-    names: NodeNames
-    package: str | None
-    executable: str
-    exe_argv: list[str]
-    standin: str | None
-    temp_files: tuple[str, ...]
+    _fields = ("names", "package", "executable", "exe_argv", "standin", "temp_files")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        names: NodeNames,
+        package: str | None,
+        executable: str,
+        exe_argv: list[str],
+        standin: str | None,
+        temp_files: tuple[str, ...],
+    ) -> None:
+        self.names = names
+        self.package = package
+        self.executable = executable
+        self.exe_argv = exe_argv
+        self.standin = standin
+        self.temp_files = temp_files
 
 
 class Node(ExecuteProcess):
@@ -489,6 +503,8 @@ class Node(ExecuteProcess):
         private = None
         if temp_dir is None and _writes_files(self.parameters):
             # No run directory to write into: a private one, removed with the process's files.
+            import tempfile
+
             temp_dir = private = tempfile.mkdtemp(prefix="mlaunch-params-")
 
         def warn(message: str) -> None:
@@ -523,7 +539,7 @@ class Node(ExecuteProcess):
         if fqn is None:
             return
         counts = _node_name_counts(resolver)
-        counts[fqn] += 1
+        counts[fqn] = counts.get(fqn, 0) + 1
         if counts[fqn] > 1:
             resolver.warn(
                 f"{self.origin}: there are now at least {counts[fqn]} nodes with the name {fqn}"
@@ -560,12 +576,12 @@ class LifecycleNode(Node):
         self.autostart = autostart
 
 
-def _node_name_counts(resolver: Resolver) -> collections.Counter[str]:
+def _node_name_counts(resolver: Resolver) -> dict[str, int]:
     # One count per launch: the label counter is the object every resolution of a run shares.
     holder = resolver.labels
-    counts = getattr(holder, "ros_node_names", None)
+    counts: dict[str, int] | None = getattr(holder, "ros_node_names", None)
     if counts is None:
-        counts = collections.Counter()
+        counts = {}
         holder.ros_node_names = counts  # type: ignore[attr-defined]
     return counts
 

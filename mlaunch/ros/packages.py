@@ -29,12 +29,14 @@ from __future__ import annotations
 import os
 import re
 import sys
-import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
-from typing import Any
 
 from mlaunch import errors
+from mlaunch.record import Record
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Iterator, Mapping, Sequence
+    from typing import Any
 
 RESOURCE_INDEX = os.path.join("share", "ament_index", "resource_index")
 ROOT_MARKERS = (".git", "pyproject.toml", "COLCON_IGNORE")
@@ -58,14 +60,17 @@ class PackageNotFoundError(errors.PackageNotFoundError, KeyError):
         return errors.PackageNotFoundError.__str__(self)
 
 
-@dataclass(frozen=True)
-class Package:
+class Package(Record):
     """Where one package is: its share directory, and the prefix it is installed in."""
 
-    name: str
-    share_directory: str
-    prefix: str  # the ament prefix; for a source package, its folder
-    installed: bool
+    _fields = ("name", "share_directory", "prefix", "installed")
+    __slots__ = _fields
+
+    def __init__(self, name: str, share_directory: str, prefix: str, installed: bool) -> None:
+        self.name = name
+        self.share_directory = share_directory
+        self.prefix = prefix  # the ament prefix; for a source package, its folder
+        self.installed = installed
 
     @property
     def libexec_directory(self) -> str:
@@ -75,11 +80,11 @@ class Package:
 # --- configuration (the CLI calls configure() before loading and resolving) --------------------
 
 
-@dataclass
 class _Settings:
-    search_paths: tuple[str, ...] = ()
-    launch_file: str | None = None
-    environ: Mapping[str, str] | None = None
+    def __init__(self) -> None:
+        self.search_paths: tuple[str, ...] = ()
+        self.launch_file: str | None = None
+        self.environ: Mapping[str, str] | None = None
 
 
 _settings = _Settings()
@@ -112,14 +117,19 @@ def configured_environ() -> Mapping[str, str]:
 # --- the index ------------------------------------------------------------------------------
 
 
-@dataclass
 class PackageIndex:
     """One view of the packages: ament prefixes from an environment, then source folders."""
 
-    environ: Mapping[str, str]
-    explicit_paths: tuple[str, ...] = ()
-    trees_from: tuple[str, ...] = ()  # files or folders whose source trees are searched
-    _sources: dict[str, str] | None = field(default=None, repr=False)
+    def __init__(
+        self,
+        environ: Mapping[str, str],
+        explicit_paths: tuple[str, ...] = (),
+        trees_from: tuple[str, ...] = (),
+    ) -> None:
+        self.environ = environ
+        self.explicit_paths = explicit_paths
+        self.trees_from = trees_from  # files or folders whose source trees are searched
+        self._sources: dict[str, str] | None = None
 
     # --- ament prefixes -------------------------------------------------------------------------
 
@@ -406,6 +416,8 @@ def _skipped(entry: os.DirEntry[str]) -> bool:
 
 def package_name(manifest: str) -> str | None:
     """The ``<name>`` of a package.xml, or None when the file is not a readable manifest."""
+    import xml.etree.ElementTree as ET  # only when a source tree is scanned
+
     try:
         root = ET.parse(manifest).getroot()
     except (OSError, ET.ParseError):

@@ -22,14 +22,10 @@ writes Python tuples (``!!python/tuple``, which only rcl's lenient parser accept
 
 from __future__ import annotations
 
-import functools
 import os
 import re
-import tempfile
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.launch.substitutions import (
@@ -45,8 +41,14 @@ from mlaunch.launch_ros.parameter_descriptions import (
     ParameterValue,
     is_substitution,
 )
+from mlaunch.record import Record
+from mlaunch.ros.files import write_temp
 
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any, TypeAlias
+
     from mlaunch.launch.launch_context import LaunchContext
 
 Subs = tuple[Substitution, ...]
@@ -60,30 +62,40 @@ _HINT = (
 # --- normalized values (built with the Node, performed when it is resolved) ---------------------
 
 
-@dataclass(frozen=True)
-class Plain:
+class Plain(Record):
     """A value that is already typed (bool, int, float, bytes, str, or a uniform tuple)."""
 
-    value: Any
+    _fields = ("value",)
+    __slots__ = _fields
+
+    def __init__(self, value: Any) -> None:
+        self.value = value
 
 
-@dataclass(frozen=True)
-class Text:
+class Text(Record):
     """Substitutions performed to one string, then read with YAML."""
 
-    subs: Subs
+    _fields = ("subs",)
+    __slots__ = _fields
+
+    def __init__(self, subs: Subs) -> None:
+        self.subs = subs
 
 
-@dataclass(frozen=True)
-class Items:
+class Items(Record):
     """A list whose items are typed values or substitutions, each read with YAML."""
 
-    items: tuple[Any, ...]  # scalars, or Subs tuples
+    _fields = ("items",)
+    __slots__ = _fields
+
+    def __init__(self, items: tuple[Any, ...]) -> None:
+        self.items = items  # scalars, or Subs tuples
 
 
-NormalizedValue = Plain | Text | Items | ParameterValue
-NormalizedDict = dict[Subs, NormalizedValue]
-NormalizedEntry = NormalizedDict | ParameterFile | Parameter
+if TYPE_CHECKING:
+    NormalizedValue: TypeAlias = Plain | Text | Items | ParameterValue
+    NormalizedDict: TypeAlias = dict[Subs, NormalizedValue]
+    NormalizedEntry: TypeAlias = NormalizedDict | ParameterFile | Parameter
 
 
 def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
@@ -237,13 +249,16 @@ def _uniform(items: Sequence[Any], name: str) -> tuple[Any, ...]:
     )
 
 
-@dataclass(frozen=True)
-class ParamsArgument:
+class ParamsArgument(Record):
     """One params argument of a node, in order: a file (``--params-file``) or a rule (``-p``)."""
 
-    flag: str  # "--params-file" or "-p"
-    value: str
-    written: bool = False  # a file mlaunch wrote (to clean up), not one the user gave
+    _fields = ("flag", "value", "written")
+    __slots__ = _fields
+
+    def __init__(self, flag: str, value: str, written: bool = False) -> None:
+        self.flag = flag  # "--params-file" or "-p"
+        self.value = value
+        self.written = written  # a file mlaunch wrote (to clean up), not one the user gave
 
 
 def parameter_arguments(
@@ -252,7 +267,7 @@ def parameter_arguments(
     *,
     node_key: str,
     temp_dir: str | None,
-    warn: Any,
+    warn: Callable[[str], None],
 ) -> list[ParamsArgument]:
     """The node's own parameters as arguments: one file per dict, files, ``-p`` rules.
 
@@ -320,11 +335,7 @@ def params_file_text(node_key: str, params: Mapping[str, Any]) -> str:
 
 def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | None) -> str:
     """Write one params file (``launch_params_XXXXXXXX``) in ``temp_dir``; return its path."""
-    with tempfile.NamedTemporaryFile(
-        mode="w", prefix=PARAMS_FILE_PREFIX, dir=temp_dir, delete=False, encoding="utf-8"
-    ) as f:
-        f.write(params_file_text(node_key, params))
-        return f.name
+    return write_temp(PARAMS_FILE_PREFIX, params_file_text(node_key, params), temp_dir)
 
 
 def _plain(value: Any) -> Any:
@@ -365,12 +376,16 @@ def rcl_reads_as_text(text: str) -> bool:
     return text not in _RCL_BOOLS and _RCL_NUMBER.fullmatch(text) is None
 
 
-@functools.cache
+_DUMPER: list[Any] = []  # the dumper class, once built
+
+
 def _dumper() -> Any:
     """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype.
 
     Built on first use: PyYAML is imported only by launches that write parameters.
     """
+    if _DUMPER:
+        return _DUMPER[0]
     import yaml
 
     def represent_text(dumper: yaml.Dumper, data: _TextValue) -> yaml.ScalarNode:
@@ -381,6 +396,7 @@ def _dumper() -> Any:
         pass
 
     ParamsDumper.add_representer(_TextValue, represent_text)
+    _DUMPER.append(ParamsDumper)
     return ParamsDumper
 
 

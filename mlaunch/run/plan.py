@@ -7,10 +7,12 @@ the trigger fires.
 
 The classes are plain classes with ``__slots__``, not dataclasses: importing dataclasses costs
 ~8 ms (it imports inspect, ast, dis and tokenize) and creating each dataclass ~0.4 ms, all before
-the first child starts. ``Record`` gives them the equality and repr a dataclass would have.
+the first child starts. ``Record`` (mlaunch.record) gives them a dataclass's equality and repr.
 """
 
 from __future__ import annotations
+
+from mlaunch.record import Record
 
 # typing is imported by type checkers only (~4 ms at start-up); mypy treats this name as
 # typing.TYPE_CHECKING.
@@ -22,29 +24,6 @@ if TYPE_CHECKING:
 
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")
-
-
-class Record:
-    """Equality and repr over the names in ``_fields``, as a dataclass compares and shows itself.
-
-    Equal when of the same class with equal fields; unhashable (defining ``__eq__`` removes the
-    inherited ``__hash__``), as a mutable dataclass is.
-    """
-
-    __slots__ = ()
-    _fields: tuple[str, ...] = ()
-
-    def _values(self) -> tuple[Any, ...]:
-        return tuple(getattr(self, name) for name in self._fields)
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Record) or other.__class__ is not self.__class__:
-            return NotImplemented
-        return self._values() == other._values()
-
-    def __repr__(self) -> str:
-        fields = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._fields)
-        return f"{type(self).__qualname__}({fields})"
 
 
 class RespawnPolicy(Record):

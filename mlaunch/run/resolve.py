@@ -14,7 +14,8 @@ from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, 
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
 from mlaunch.origin import user_location
-from mlaunch.run.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Record, Spawn, Step
+from mlaunch.record import Record
+from mlaunch.run.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
