@@ -431,31 +431,29 @@ def test_robot_description_goes_to_robot_state_publisher_only(tmp_path: Path) ->
         </launch>
         """,
     )
-    from mlaunch.ros1 import roslaunch
+    from mlaunch.ros1 import model, reading
 
-    model_items = roslaunch.read(path)
-    rsp = next(i for i in model_items if isinstance(i, roslaunch.NodeItem) and i.name == ("rsp",))
+    model_items = reading.read(path)
+    rsp = next(i for i in model_items if isinstance(i, model.NodeItem) and i.name == ("rsp",))
     assert rsp.executable == ("robot_state_publisher",)
-    names = [roslaunch.static_text(n) for n, _ in rsp.parameters]
+    names = [model.static_text(n) for n, _ in rsp.parameters]
     assert names == ["robot_description", "publish_frequency"]
-    other = next(
-        i for i in model_items if isinstance(i, roslaunch.NodeItem) and i.name == ("other",)
-    )
+    other = next(i for i in model_items if isinstance(i, model.NodeItem) and i.name == ("other",))
     assert other.parameters == []
-    assert not any(isinstance(i, roslaunch.SetParam) for i in model_items)
+    assert not any(isinstance(i, model.SetParam) for i in model_items)
     assert any("tf_prefix of ROS 1 robot_state_publisher" in w for w in rsp.warnings)
 
 
 def test_unconsumed_robot_description_and_starved_rsp_are_warnings(tmp_path: Path) -> None:
-    from mlaunch.ros1 import roslaunch
+    from mlaunch.ros1 import model, reading
 
     lone = write(
         tmp_path,
         "lone.launch",
         '<launch>\n  <param name="robot_description" value="&lt;robot/&gt;"/>\n</launch>\n',
     )
-    (warning,) = roslaunch.read(lone)
-    assert isinstance(warning, roslaunch.Warn)
+    (warning,) = reading.read(lone)
+    assert isinstance(warning, model.Warn)
     assert "no robot_state_publisher of this file's scope takes it" in warning.message
     starved = write(
         tmp_path,
@@ -463,7 +461,7 @@ def test_unconsumed_robot_description_and_starved_rsp_are_warnings(tmp_path: Pat
         '<launch>\n  <node pkg="robot_state_publisher" type="robot_state_publisher" name="r"/>\n'
         "</launch>\n",
     )
-    (node,) = roslaunch.read(starved)
+    (node,) = reading.read(starved)
     assert "robot_state_publisher gets no robot_description" in node.warnings[0]
 
 
@@ -653,7 +651,7 @@ def test_static_transforms_without_tf2_ros_are_dropped_with_a_warning(tmp_path: 
 
 
 def test_joint_state_publisher_use_gui_chooses_the_gui_package(tmp_path: Path) -> None:
-    from mlaunch.ros1 import roslaunch
+    from mlaunch.ros1 import model, reading
 
     path = write(
         tmp_path,
@@ -671,25 +669,25 @@ def test_joint_state_publisher_use_gui_chooses_the_gui_package(tmp_path: Path) -
         </launch>
         """,
     )
-    items = roslaunch.read(path)
+    items = reading.read(path)
     switch = items[1]
-    assert isinstance(switch, roslaunch.Group) and switch.warnings
+    assert isinstance(switch, model.Group) and switch.warnings
     plain, gui = switch.items
-    assert isinstance(plain, roslaunch.NodeItem) and isinstance(gui, roslaunch.NodeItem)
+    assert isinstance(plain, model.NodeItem) and isinstance(gui, model.NodeItem)
     assert plain.executable == ("joint_state_publisher",)
-    assert plain.condition == roslaunch.Cond((roslaunch.ArgRef("gui"),), unless=True)
+    assert plain.condition == model.Cond((model.ArgRef("gui"),), unless=True)
     assert gui.executable == ("joint_state_publisher_gui",)
-    assert gui.condition == roslaunch.Cond((roslaunch.ArgRef("gui"),))
+    assert gui.condition == model.Cond((model.ArgRef("gui"),))
     group = items[2]
-    assert isinstance(group, roslaunch.Group)
+    assert isinstance(group, model.Group)
     (fixed,) = group.items
-    assert isinstance(fixed, roslaunch.NodeItem)
+    assert isinstance(fixed, model.NodeItem)
     assert fixed.package == ("joint_state_publisher_gui",) and fixed.parameters == []
-    assert not any(isinstance(i, roslaunch.SetParam) for i in items)  # use_gui was consumed
+    assert not any(isinstance(i, model.SetParam) for i in items)  # use_gui was consumed
 
 
 def test_rviz_and_arbotix_map_to_ros2_programs(tmp_path: Path) -> None:
-    from mlaunch.ros1 import roslaunch
+    from mlaunch.ros1 import model, reading
 
     cfg = package(tmp_path, "viz")
     (cfg / "old.rviz").write_text("Panels:\n  - Class: rviz/Displays\n")
@@ -709,18 +707,18 @@ def test_rviz_and_arbotix_map_to_ros2_programs(tmp_path: Path) -> None:
         </launch>
         """,
     )
-    warning, old, new, sim, spawn = roslaunch.read(path)
-    assert isinstance(warning, roslaunch.Warn)  # no robot_state_publisher takes the description
-    assert isinstance(old, roslaunch.NodeItem) and isinstance(new, roslaunch.NodeItem)
+    warning, old, new, sim, spawn = reading.read(path)
+    assert isinstance(warning, model.Warn)  # no robot_state_publisher takes the description
+    assert isinstance(old, model.NodeItem) and isinstance(new, model.NodeItem)
     assert old.package == old.executable == ("rviz2",)
     assert old.arguments[0] == ("-d",)
     assert any("is a ROS 1 RViz config" in w for w in old.warnings)
     assert not new.warnings
-    assert isinstance(sim, roslaunch.ProcessItem) and sim.cmd[0] == ("gzserver",)
+    assert isinstance(sim, model.ProcessItem) and sim.cmd[0] == ("gzserver",)
     assert sim.respawn is True and sim.output == ("screen",)
     assert "replaced by a Gazebo simulator" in sim.warnings[0]
-    assert isinstance(spawn, roslaunch.NodeItem)
-    assert [roslaunch.static_text(a) for a in spawn.arguments] == [
+    assert isinstance(spawn, model.NodeItem)
+    assert [model.static_text(a) for a in spawn.arguments] == [
         "-topic",
         "robot_description",
         "-entity",
@@ -729,7 +727,8 @@ def test_rviz_and_arbotix_map_to_ros2_programs(tmp_path: Path) -> None:
 
 
 def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
-    from mlaunch.ros1 import roslaunch
+    from mlaunch.ros1 import build, reading
+    from mlaunch.ros1.model import ArgRef, CommandRef, DeclareArg, NodeItem
 
     model = package(tmp_path, "bot")
     (model / "bot.urdf.xacro").write_text(
@@ -747,12 +746,12 @@ def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
         </launch>
         """,
     )
-    (declare, rsp) = roslaunch.read(path)
-    assert isinstance(declare, roslaunch.DeclareArg) and declare.default is not None
+    (declare, rsp) = reading.read(path)
+    assert isinstance(declare, DeclareArg) and declare.default is not None
     assert declare.default[0] == "xacro '"
-    assert isinstance(rsp, roslaunch.NodeItem)
+    assert isinstance(rsp, NodeItem)
     value = rsp.parameters[0][1]
-    assert value.dynamic == (roslaunch.CommandRef((roslaunch.ArgRef("model"),)),)
+    assert value.dynamic == (CommandRef((ArgRef("model"),)),)
     assert value.vtype is str
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import perform
@@ -760,12 +759,13 @@ def test_xacro_commands_run_xacro_in_process(tmp_path: Path) -> None:
     context = LaunchContext(environment=ENV)
     context.launch_configurations["model"] = f"xacro '{model}/bot.urdf.xacro'"
     with context.file_locals(path):
-        urdf = perform(context, roslaunch.subs(value.dynamic))
+        urdf = perform(context, build.subs(value.dynamic))
     assert '<link name="base_2"/>' in urdf
 
 
 def test_split_arguments_keeps_substitutions_whole() -> None:
-    from mlaunch.ros1.roslaunch import ArgRef, split_arguments
+    from mlaunch.ros1.model import ArgRef
+    from mlaunch.ros1.values import split_arguments
 
     found = split_arguments(("-a ", ArgRef("x"), "/y 'q r' z", ArgRef("w")))
     assert found == [("-a",), (ArgRef("x"), "/y"), ("q r",), ("z", ArgRef("w"))]
