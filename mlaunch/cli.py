@@ -417,6 +417,7 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
     printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet, rotate_bytes=rotate)
     printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
+    spawner = _spawner(plan, labels, run_id)
     supervisor = Supervisor(
         plan,  # type: ignore[arg-type]
         printer,
@@ -424,9 +425,12 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
         labels=labels,  # type: ignore[arg-type]
         guard=guard,
         run_id=run_id,
+        **({} if spawner is None else {"spawner": spawner}),
     )
     extensions: list[object] = []
     try:
+        if spawner is not None:
+            spawner.connect(plan.processes())  # type: ignore[attr-defined]
         extensions = _extensions(opts, supervisor)
         code = supervisor.run()
     finally:
@@ -434,10 +438,24 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
             close = getattr(ext, "close", None)
             if close is not None:
                 close()
+        if spawner is not None:
+            spawner.close()
         printer.close()
         # Everything the run started has ended (run() kills what is left even when it fails).
         guard.close()
     return code
+
+
+def _spawner(plan: object, labels: object, run_id: str) -> Any:
+    """The remote-process spawner when the launch declared other machines, else None."""
+    from mlaunch.machines.spec import remote_machines
+
+    if not remote_machines(labels):
+        return None
+    from mlaunch.machines.remote import Spawner
+    from mlaunch.run.guard import MARKER
+
+    return Spawner(os.environ, {MARKER: run_id})
 
 
 def _extensions(opts: Options, supervisor: object) -> list[object]:

@@ -577,6 +577,7 @@ class ExecuteProcess(Action):
         respawn_backoff: Any = 2.0,
         respawn_max_delay: Any = 30.0,
         required: Any = False,
+        machine: SomeSubstitutionsType | None = None,
         **kwargs: Any,
     ) -> None:
         super().__init__(**kwargs)
@@ -610,6 +611,10 @@ class ExecuteProcess(Action):
         self.respawn_backoff = respawn_backoff
         self.respawn_max_delay = respawn_max_delay
         self.required = required
+        # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
+        self.machine = None if machine is None else normalize(machine)
+        # The machine of the spec being built, for the command hooks (None: this computer).
+        self.remote_machine: Any = None
 
     # The ROS layer (Node) overrides these three to build a node's command line.
     def command(self, resolver: Resolver) -> list[str]:
@@ -629,11 +634,15 @@ class ExecuteProcess(Action):
 
     def build_spec(self, resolver: Resolver) -> ProcessSpec:
         ctx = resolver.context
+        machine = self._machine(resolver)
+        self.remote_machine = machine if machine is not None and not machine.local else None
         argv = self.command(resolver)
         if not argv or not argv[0]:
             raise SubstitutionFailure("the command is empty", where=self.origin)
         named = argv
-        argv, standin = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
+        standin = None
+        if self.remote_machine is None:  # another computer's programs are found there
+            argv, standin = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
         prefix = self._prefix(ctx, named)
         # The label comes from the program the launch file named, not from its stand-in.
         base = self.label_base(resolver, prefix + named if prefix else named)
@@ -656,12 +665,23 @@ class ExecuteProcess(Action):
             action=self,
             node=self.node_info(resolver),
             standin=standin,
+            machine=machine,
         )
-        if spec.cwd is not None and not os.path.isdir(spec.cwd):
+        if self.remote_machine is None and spec.cwd is not None and not os.path.isdir(spec.cwd):
             raise MlaunchError(
                 f"working directory {spec.cwd!r} does not exist", where=self.origin, what=base
             )
         return spec
+
+    def _machine(self, resolver: Resolver) -> Any:
+        """The MachineSpec this process runs on, or None (no machine given or pushed)."""
+        from mlaunch.machines.spec import PUSHED
+
+        if self.machine is None and not resolver.context.launch_configurations.get(PUSHED):
+            return None  # the common case: nothing of mlaunch.machines is imported
+        from mlaunch.machines.actions import machine_for
+
+        return machine_for(resolver, self.machine, self.origin)
 
     def _prefix(self, ctx: LaunchContext, argv: list[str]) -> list[str]:
         if self.prefix is not None:

@@ -473,6 +473,10 @@ class Node(ExecuteProcess):
             return None, executable, [executable], None
         package = perform_substitutions(ctx, self.node_package)
         index = packages.for_context(ctx, resolver.options.package_path)
+        if self.remote_machine is not None:
+            # Found on that computer (mlaunch.machines.agent looks the package up there); this
+            # computer's path is only a hint, and there are no stand-ins on other computers.
+            return package, executable, [remote_executable(index, package, executable)], None
         if index.installed(package) is not None:
             return package, executable, [index.executable(package, executable)], None
         if resolver.options.standins:
@@ -574,6 +578,16 @@ class LifecycleNode(Node):
     ) -> None:
         super().__init__(name=name, namespace=namespace, **kwargs)
         self.autostart = autostart
+
+
+def remote_executable(index: Any, package: str, executable: str) -> str:
+    """A remote node's program: this computer's path when installed here, else ``PKG/EXE``."""
+    if index.installed(package) is not None:
+        try:
+            return str(index.executable(package, executable))
+        except MlaunchError:
+            pass
+    return f"{package}/{executable}"
 
 
 def _node_name_counts(resolver: Resolver) -> dict[str, int]:

@@ -77,6 +77,8 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         kind = "lifecycle node" if spec.node.lifecycle else "node"
         auto = " (autostart)" if spec.node.autostart else ""
         lines.append(f"  {kind}:    {spec.node.fully_qualified_name}{auto}")
+    if spec.machine is not None:
+        lines.append(f"  machine: {spec.machine.describe()}")
     lines.append(f"  cwd:     {spec.cwd or '(inherited)'}")
     if spec.env_changes:
         changes = [

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.machines.spec import MachineSpec
 
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")
@@ -129,6 +130,7 @@ class ProcessSpec(Record):
         "node",
         "standin",
         "temp_files",
+        "machine",
     )
     __slots__ = _fields
 
@@ -151,6 +153,7 @@ class ProcessSpec(Record):
         node: NodeInfo | None = None,
         standin: str | None = None,
         temp_files: tuple[str, ...] = (),
+        machine: MachineSpec | None = None,
     ) -> None:
         self.label = label
         self.argv = argv
@@ -169,6 +172,8 @@ class ProcessSpec(Record):
         self.node = node
         self.standin = standin
         self.temp_files = temp_files
+        # Where it runs: None for this computer, else a declared machine (mlaunch.machines).
+        self.machine = machine
 
     @property
     def base_name(self) -> str:

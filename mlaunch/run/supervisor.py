@@ -86,6 +86,7 @@ class Supervisor:
     ``adopt``: become the subreaper and end every descendant at shutdown; an embedder with
     children of its own passes False (the run's processes are still found by their marker).
     ``stray_grace``: seconds between SIGTERM and SIGKILL for a stray descendant.
+    ``spawner(spec, index, restarts)``: makes the Process for a spec (``Process`` by default).
     """
 
     def __init__(
@@ -101,6 +102,7 @@ class Supervisor:
         run_id: str | None = None,
         adopt: bool = True,
         stray_grace: float = STRAY_GRACE,
+        spawner: Callable[[ProcessSpec, int, int], Process] = Process,
     ) -> None:
         self.plan = plan
         self.printer = printer
@@ -109,6 +111,8 @@ class Supervisor:
         self.clock = clock
         self.guard = guard
         self.run_id = run_id or guards.new_run_id()
+        # Makes the Process for a spec: remote machines plug in here (mlaunch.machines.remote).
+        self.spawner = spawner
         self.selector = selectors.DefaultSelector()
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
@@ -310,7 +314,7 @@ class Supervisor:
         if self.shutting_down:
             self.printer.message("WARNING", spec.label, "not started: the launch is shutting down")
             return None
-        process = Process(spec, index=next(self._index), restarts=restarts)
+        process = self.spawner(spec, next(self._index), restarts)
         self.printer.register(spec.label, process.index)
         record = self.records.get(spec.label)
         if record is None:

@@ -1,0 +1,168 @@
+"""The launch-file spelling of machines: ``Machine``, ``PushMachine`` and ``machine=``.
+
+They read like the rest of launch: ``Machine`` declares a computer (as DeclareLaunchArgument
+declares an argument) and, with ``default=True``, makes it the machine of the nodes after it in
+its scope; ``PushMachine`` does only the latter (as PushROSNamespace does for namespaces); a
+``machine=`` keyword on a node or process names one for that process alone. Declarations are
+global to the run, as ROS 1's ``<machine>`` tags were; the pushed machine is scoped like any
+launch configuration, so a scoped GroupAction keeps it inside.
+"""
+
+from __future__ import annotations
+
+from mlaunch.errors import LaunchFileError
+from mlaunch.launch.actions import Action
+from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
+from mlaunch.machines.spec import DEFAULT_TIMEOUT, PUSHED, MachineSpec, check_name, declared
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.run.resolve import Resolver
+
+
+class Machine(Action):
+    """Declare a computer that processes can run on (ROS 1's ``<machine>``).
+
+    ``address`` is a host name, an address or an ssh ``Host`` alias; ``user`` and ``ssh_port``
+    default to what the ssh configuration says; ``env_loader`` is a program on that computer
+    that sets up the environment and runs its arguments (``/opt/ros/jazzy/env.sh``-style);
+    ``timeout`` is how long to wait for the connection. ``default=True`` runs the nodes after it
+    in this scope on this machine (ROS 1's ``default="true"``; ``"never"`` reads as false).
+    """
+
+    def __init__(
+        self,
+        *,
+        name: SomeSubstitutionsType,
+        address: SomeSubstitutionsType,
+        user: SomeSubstitutionsType | None = None,
+        ssh_port: Any = None,
+        env_loader: SomeSubstitutionsType | None = None,
+        default: Any = False,
+        timeout: Any = DEFAULT_TIMEOUT,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+        self.address = normalize(address)
+        self.user = None if user is None else normalize(user)
+        self.ssh_port = ssh_port
+        self.env_loader = None if env_loader is None else normalize(env_loader)
+        self.default = default
+        self.timeout = timeout
+
+    def execute(self, resolver: Resolver) -> None:
+        spec = self.resolve_spec(resolver)
+        table = declared(resolver.labels)
+        known = table.get(spec.name)
+        if known is not None and known._values()[:-1] != spec._values()[:-1]:
+            raise LaunchFileError(
+                f"machine {spec.name!r} is declared again with other settings"
+                f" ({spec.describe()}; first: {known.describe()} at {known.origin or '?'})",
+                where=self.origin,
+            )
+        table.setdefault(spec.name, spec)
+        if _flag(resolver, self.default):
+            resolver.context.launch_configurations[PUSHED] = spec.name
+
+    def resolve_spec(self, resolver: Resolver) -> MachineSpec:
+        from mlaunch.machines.spec import is_local
+
+        ctx = resolver.context
+        name = perform_substitutions(ctx, self.name)
+        problem = check_name(name)
+        if problem is not None:
+            raise LaunchFileError(f"machine name {name!r} is invalid: {problem}", where=self.origin)
+        address = perform_substitutions(ctx, self.address).strip()
+        if not address:
+            raise LaunchFileError(f"machine {name!r} has an empty address", where=self.origin)
+        user = None if self.user is None else perform_substitutions(ctx, self.user) or None
+        port = None
+        if self.ssh_port is not None and str(self.ssh_port) != "":
+            number = resolver.float_value(self.ssh_port, "ssh_port", self.origin)
+            if number != int(number) or not 0 < number < 65536:
+                raise LaunchFileError(
+                    f"ssh_port of machine {name!r} is {self.ssh_port!r};"
+                    " valid: a port number from 1 to 65535",
+                    where=self.origin,
+                )
+            port = int(number)
+        loader = None
+        if self.env_loader is not None:
+            loader = perform_substitutions(ctx, self.env_loader) or None
+        timeout = resolver.float_value(self.timeout, "timeout", self.origin)
+        if timeout <= 0:
+            raise LaunchFileError(
+                f"timeout of machine {name!r} is {timeout:g}; valid: seconds above 0",
+                where=self.origin,
+            )
+        return MachineSpec(
+            name=name,
+            address=address,
+            user=user,
+            ssh_port=port,
+            env_loader=loader,
+            timeout=timeout,
+            local=is_local(address, user),
+            origin=self.origin,
+        )
+
+    def describe_short(self) -> str:
+        return f"Machine(name={describe(self.name)}, address={describe(self.address)})"
+
+
+class PushMachine(Action):
+    """Run the nodes and processes after it, in this scope, on the machine named ``name``."""
+
+    def __init__(self, name: SomeSubstitutionsType, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+
+    def execute(self, resolver: Resolver) -> None:
+        name = perform_substitutions(resolver.context, self.name)
+        lookup(resolver, name, self.origin)
+        resolver.context.launch_configurations[PUSHED] = name
+
+    def describe_short(self) -> str:
+        return f"PushMachine({describe(self.name)})"
+
+
+def lookup(resolver: Resolver, name: str, origin: str) -> MachineSpec:
+    """The declared machine ``name``, or a located error naming the declared ones."""
+    table = declared(resolver.labels)
+    spec = table.get(name)
+    if spec is not None:
+        return spec
+    import difflib
+
+    close = difflib.get_close_matches(name, list(table), n=1)
+    if close:
+        hint = f" (did you mean {close[0]!r}?)"
+    elif table:
+        hint = f"; declared: {', '.join(sorted(table))}"
+    else:
+        hint = "; no machine is declared (Machine(...), <machine>) before it"
+    raise LaunchFileError(f"machine {name!r} is not declared{hint}", where=origin)
+
+
+def machine_for(resolver: Resolver, given: Any, origin: str) -> MachineSpec | None:
+    """The machine a process runs on: its own ``machine=``, else the pushed one, else None."""
+    if given is not None:
+        name = perform_substitutions(resolver.context, given)
+    else:
+        name = str(resolver.context.launch_configurations.get(PUSHED, ""))
+    if not name:
+        return None
+    return lookup(resolver, name, origin)
+
+
+def _flag(resolver: Resolver, value: Any) -> bool:
+    if isinstance(value, bool):
+        return value
+    text = perform_substitutions(resolver.context, normalize(value)).strip().lower()
+    if text == "never":
+        return False
+    return to_bool(text, "the machine's default")
