@@ -186,7 +186,10 @@ def test_kill_9_of_mlaunch_leaves_nothing_on_either_side(
     path = write_launch(
         tmp_path,
         token,
-        [remote("echo up; sleep 100 & sleep 100"), remote("trap '' TERM INT; echo up; sleep 100", sigkill_timeout=1.0)],
+        [
+            remote("echo up; sleep 100 & sleep 100"),
+            remote("trap '' TERM INT; echo up; sleep 100", sigkill_timeout=1.0),
+        ],
     )
     run = Running(mlaunch(str(path)), env=env_for(sshd, token))
     try:

@@ -51,6 +51,7 @@ def _process_kwargs(e: Entity, *, label: str | None) -> dict[str, Any]:
     put("sigterm_timeout", e.number("sigterm_timeout", minimum=0.0))
     put("sigkill_timeout", e.number("sigkill_timeout", minimum=0.0))
     put("required", e.flag("required"))
+    put("machine", e.text("machine"))
     on_exit = e.literal("on_exit")
     if on_exit is not None:
         if on_exit != "shutdown":

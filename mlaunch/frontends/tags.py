@@ -6,7 +6,8 @@ tags, imported only when such a tag appears) and the dispatcher then adds ``if``
 stamps ``origin`` with the tag's file:line and rejects anything left unread.
 
 This module holds the dispatcher and the core ``launch`` tags; the process and launch_ros tags
-are in ``process_tags``, the ``param`` values in ``param_tags``.
+are in ``process_tags``, the machine tags in ``machine_tags``, the ``param`` values in
+``param_tags``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from mlaunch.frontends.fields import (
     required_literal,
     required_text,
 )
+from mlaunch.frontends.machine_tags import MACHINE_TAGS
 from mlaunch.frontends.process_tags import PROCESS_TAGS
 from mlaunch.launch.conditions import IfCondition, UnlessCondition
 
@@ -218,6 +220,7 @@ ACTIONS: dict[str, Builder] = {
     "shutdown": _shutdown,
     "reset": _reset,
     **PROCESS_TAGS,
+    **MACHINE_TAGS,
 }
 
 # The tags whose children are actions.
@@ -239,6 +242,5 @@ MISPLACED: dict[str, str] = {
     "keep": "it belongs inside <group> or <reset>",
     "choice": "it belongs inside <arg>",
     "rosparam": "that is ROS 1 (a .launch file); use <param from=...> inside <node>",
-    "machine": "that is ROS 1 (a .launch file)",
     "test": "that is ROS 1 (a .launch file)",
 }

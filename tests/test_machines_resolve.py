@@ -1,0 +1,136 @@
+"""Machines in launch files: Machine, PushMachine and machine= resolve the same in py, yaml, xml.
+
+Pure resolve tests (no ssh): which process gets which machine, scoping, defaults, local
+machines, and the located errors.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+from mlaunch import frontends
+from mlaunch.errors import MlaunchError
+from mlaunch.run.plan import Plan
+from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
+
+PY = """
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess, GroupAction
+from mlaunch.actions import Machine, PushMachine
+
+def generate_launch_description():
+    return LaunchDescription([
+        Machine(name="robot", address="robot-alias", user="ros", ssh_port=2200,
+                env_loader="/opt/env.sh", timeout=3),
+        Machine(name="gpu", address="gpu-alias", default=True),
+        ExecuteProcess(cmd=["a"], name="a"),
+        ExecuteProcess(cmd=["b"], name="b", machine="robot"),
+        GroupAction([PushMachine("robot"), ExecuteProcess(cmd=["c"], name="c")]),
+        ExecuteProcess(cmd=["d"], name="d"),
+    ])
+"""
+
+XML = """<launch>
+  <machine name="robot" address="robot-alias" user="ros" ssh-port="2200"
+           env-loader="/opt/env.sh" timeout="3"/>
+  <machine name="gpu" address="gpu-alias" default="true"/>
+  <executable cmd="a" name="a"/>
+  <executable cmd="b" name="b" machine="robot"/>
+  <group>
+    <push-machine name="robot"/>
+    <executable cmd="c" name="c"/>
+  </group>
+  <executable cmd="d" name="d"/>
+</launch>
+"""
+
+YAML = """launch:
+- machine: {name: robot, address: robot-alias, user: ros, ssh-port: 2200,
+            env-loader: /opt/env.sh, timeout: 3}
+- machine: {name: gpu, address: gpu-alias, default: true}
+- executable: {cmd: a, name: a}
+- executable: {cmd: b, name: b, machine: robot}
+- group:
+    children:
+    - push-machine: {name: robot}
+    - executable: {cmd: c, name: c}
+- executable: {cmd: d, name: d}
+"""
+
+
+def resolve_text(tmp_path: Path, suffix: str, text: str) -> Plan:
+    path = tmp_path / f"m.launch.{suffix}"
+    path.write_text(text)
+    return resolve(
+        frontends.load(str(path)),
+        path=str(path),
+        arguments={},
+        environ={"PATH": os.environ["PATH"]},
+        options=ResolveOptions(temp_dir=str(tmp_path)),
+        labels=LabelCounter(),
+    )
+
+
+def placement(plan: Plan) -> dict[str, str | None]:
+    return {
+        spec.base_name: None if spec.machine is None else spec.machine.name
+        for spec in plan.processes()
+    }
+
+
+@pytest.mark.parametrize(("suffix", "text"), [("py", PY), ("xml", XML), ("yaml", YAML)])
+def test_the_three_spellings_place_processes_alike(tmp_path: Path, suffix: str, text: str) -> None:
+    plan = resolve_text(tmp_path, suffix, text)
+    # gpu is the default from its declaration on; the group's push stays in the group.
+    assert placement(plan) == {"a": "gpu", "b": "robot", "c": "robot", "d": "gpu"}
+    robot = next(s.machine for s in plan.processes() if s.base_name == "b")
+    assert robot is not None
+    assert (robot.address, robot.user, robot.ssh_port) == ("robot-alias", "ros", 2200)
+    assert (robot.env_loader, robot.timeout, robot.local) == ("/opt/env.sh", 3.0, False)
+    # A remote program is found on that computer: not looked up (or replaced) here.
+    assert next(s.argv for s in plan.processes() if s.base_name == "b") == ("b",)
+
+
+def test_a_local_address_runs_here(tmp_path: Path) -> None:
+    text = """
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+from mlaunch.actions import Machine
+
+def generate_launch_description():
+    return LaunchDescription([
+        Machine(name="here", address="127.0.0.1"),
+        ExecuteProcess(cmd=["true"], machine="here"),
+    ])
+"""
+    spec = resolve_text(tmp_path, "py", text).processes()[0]
+    assert spec.machine is not None and spec.machine.local
+    # Found here, as any local program: a missing one is this computer's error.
+    with pytest.raises(MlaunchError, match="'no-such-program' not found on the PATH"):
+        resolve_text(tmp_path, "py", text.replace('"true"', '"no-such-program"'))
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (('machine="robot")', 'machine="robt")'), r"machine 'robt' is not declared \(did you mean"),
+        (("ssh_port=2200", "ssh_port=70000"), r"ssh_port of machine 'robot' is 70000"),
+        (("timeout=3", "timeout=0"), r"timeout of machine 'robot' is 0"),
+        (('name="gpu", address="gpu-alias"', 'name="robot", address="x"'), r"declared again"),
+    ],
+)
+def test_bad_machines_are_located_errors(
+    tmp_path: Path, change: tuple[str, str], message: str
+) -> None:
+    with pytest.raises(MlaunchError, match=message) as info:
+        resolve_text(tmp_path, "py", PY.replace(*change))
+    assert "m.launch.py:" in str(info.value)
+
+
+def test_xml_machine_attribute_of_an_undeclared_machine_names_the_line(tmp_path: Path) -> None:
+    text = '<launch>\n  <executable cmd="a" machine="nowhere"/>\n</launch>\n'
+    with pytest.raises(MlaunchError, match=r"m\.launch\.xml:2.*'nowhere' is not declared"):
+        resolve_text(tmp_path, "xml", text)
