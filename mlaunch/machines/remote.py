@@ -33,7 +33,7 @@ from mlaunch.errors import MlaunchError
 from mlaunch.machines import agent as agent_module
 from mlaunch.machines.spec import MachineSpec
 from mlaunch.machines.ssh import ConnectError, Connection
-from mlaunch.run.process import Process, Stream
+from mlaunch.run.process import Process
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -166,11 +166,7 @@ class RemoteProcess(Process):
         except OSError:
             pass  # the client is already gone: its exit says why
         os.set_blocking(self.control, False)
-        for name, pipe in (("stdout", self.popen.stdout), ("stderr", self.popen.stderr)):
-            assert pipe is not None
-            fd = pipe.fileno()
-            os.set_blocking(fd, False)
-            self.streams[fd] = Stream(name, fd, pipe)
+        self.watch_pipes()
 
     def read(self, fd: int) -> tuple[bytes, bool]:
         data, eof = super().read(fd)

@@ -245,6 +245,11 @@ class Process:
         )
         self.pid = self.popen.pid
         self.started_at = clock()
+        self.watch_pipes()
+
+    def watch_pipes(self) -> None:
+        """Take the child's stdout and stderr as non-blocking streams (subclasses' spawns too)."""
+        assert self.popen is not None
         for name, pipe in (("stdout", self.popen.stdout), ("stderr", self.popen.stderr)):
             assert pipe is not None
             fd = pipe.fileno()
