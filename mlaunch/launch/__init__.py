@@ -18,6 +18,7 @@ if TYPE_CHECKING:
     from mlaunch.launch.events import Event
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+    from mlaunch.launch.launch_service import LaunchService
     from mlaunch.launch.substitutions import (
         SomeSubstitutionsType,
         SomeSubstitutionsType_types_tuple,
@@ -32,6 +33,7 @@ _NAMES: dict[str, tuple[str, str]] = {
     "LaunchDescriptionEntity": ("mlaunch.launch.actions", "LaunchDescriptionEntity"),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
     "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
+    "LaunchService": ("mlaunch.launch.launch_service", "LaunchService"),
     "EventHandler": ("mlaunch.launch.event_handlers", "EventHandler"),
     "Event": ("mlaunch.launch.events", "Event"),
     "LaunchDescriptionSource": (
@@ -56,6 +58,7 @@ _SUBMODULES = (
     "events",
     "launch_context",
     "launch_description_sources",
+    "launch_service",
 )
 
 
@@ -79,6 +82,7 @@ __all__ = [
     "LaunchDescription",
     "LaunchDescriptionEntity",
     "LaunchDescriptionSource",
+    "LaunchService",
     "SomeSubstitutionsType",
     "SomeSubstitutionsType_types_tuple",
     "Substitution",

@@ -504,13 +504,17 @@ class EmitEvent(Action):
         super().__init__(**kwargs)
         self.event = event
 
-    def execute(self, resolver: Resolver) -> None:
+    def execute(self, resolver: Resolver) -> list[Any] | None:
+        from mlaunch.launch.events import IncludeLaunchDescription
         from mlaunch.launch.events import Shutdown as ShutdownEvent
 
         if isinstance(self.event, ShutdownEvent):
             resolver.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
+        elif isinstance(self.event, IncludeLaunchDescription):
+            return [self.event.launch_description]
         else:
             resolver.add(EmitEventStep(origin=self.origin, event=self.event))
+        return None
 
 
 class Shutdown(Action):
@@ -552,6 +556,10 @@ class ExecuteProcess(Action):
     10 s of starting multiplies the wait by ``respawn_backoff`` (default 2, so a crash loop cannot
     burn a core), up to ``respawn_max_delay`` (30 s). ``respawn_backoff=1`` restarts like ROS 2.
     """
+
+    # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
+    # (mlaunch.launch.launch_service fills it in; launch_testing looks processes up by it).
+    process_details: dict[str, Any] | None = None
 
     def __init__(
         self,

@@ -51,6 +51,15 @@ class ProcessEvent(Record, Event):
         self.env = env
         self.pid = pid
 
+    # ROS 2's names for the same fields (launch_testing reads these).
+    @property
+    def process_name(self) -> str:
+        return self.name
+
+    @property
+    def execute_process_action(self) -> Any:
+        return self.action
+
 
 class ProcessStarted(ProcessEvent):
     pass
@@ -91,6 +100,14 @@ class ProcessIO(ProcessEvent):
         self.text = text
         self.fd = fd
 
+    @property
+    def from_stdout(self) -> bool:
+        return self.fd == 1
+
+    @property
+    def from_stderr(self) -> bool:
+        return self.fd == 2
+
 
 class ProcessStdout(ProcessIO):
     pass
@@ -98,6 +115,15 @@ class ProcessStdout(ProcessIO):
 
 class ProcessStderr(ProcessIO):
     pass
+
+
+class IncludeLaunchDescription(Event):
+    """Include a description into the running launch (LaunchService, EmitEvent)."""
+
+    name = "launch.events.IncludeLaunchDescription"
+
+    def __init__(self, launch_description: Any) -> None:
+        self.launch_description = launch_description
 
 
 if TYPE_CHECKING:
@@ -150,6 +176,7 @@ process = sys.modules[__name__]
 
 __all__ = [
     "Event",
+    "IncludeLaunchDescription",
     "ProcessExited",
     "ProcessIO",
     "ProcessStarted",
