@@ -25,6 +25,9 @@ ROOTS: dict[str, str] = {
     "launch_xml": "mlaunch.launch.launch_description_sources",
     "launch_yaml": "mlaunch.launch.launch_description_sources",
     "ament_index_python": "mlaunch.ros.ament_index",
+    "launch_testing": "mlaunch.launch_testing",
+    "launch_testing_ros": "mlaunch.launch_testing_ros",
+    "launch_pytest": "mlaunch.launch_pytest",
 }
 
 # Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per

@@ -442,6 +442,13 @@ def main(args: Sequence[str]) -> int:
     from mlaunch import cli
 
     args = list(args)
+    from mlaunch.launch_testing.launch_test import is_launch_test_file
+
+    if any(is_launch_test_file(a) for a in args if not a.startswith("-")):
+        # A launch_testing file (it defines generate_test_description): launch_test runs it.
+        from mlaunch.launch_testing.launch_test import main as launch_test_main
+
+        return launch_test_main(args, prog="mlaunch test")
     debug = "--debug" in args or "-d" in args
     try:
         mine, rest = split_arguments(args)

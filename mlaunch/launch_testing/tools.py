@@ -1,0 +1,221 @@
+"""``launch_testing.tools``: start a process from inside a test, and match its output.
+
+``launch_process(launch_service, action, proc_info, proc_output)`` includes ``action`` into
+the running launch and yields a ProcessProxy to wait on it; leaving the block stops it if it
+still runs.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+
+from mlaunch.launch.actions import ExecuteProcess, LaunchDescription
+from mlaunch.launch.events import (
+    IncludeLaunchDescription,
+    ProcessExited,
+    ProcessStarted,
+    ShutdownProcess,
+    matches_action,
+)
+from mlaunch.launch_testing.text import (
+    build_line_match,
+    build_text_match,
+    remove_ansi_escape_sequences,
+)
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Callable
+    from typing import Any
+
+
+def basic_output_filter(
+    filtered_prefixes: list[str] | None = None, filtered_patterns: list[str] | None = None
+) -> Callable[[str], str]:
+    """A filter dropping lines that start with a prefix (``pid``, ``rc`` by default) or match."""
+    prefixes = ["pid", "rc"] if filtered_prefixes is None else list(filtered_prefixes)
+    patterns = [re.compile(p) for p in (filtered_patterns or [])]
+
+    def keep(line: str) -> bool:
+        return not line.startswith(tuple(prefixes)) and not any(p.match(line) for p in patterns)
+
+    def output_filter(output: str) -> str:
+        return "".join(line for line in output.splitlines(keepends=True) if keep(line))
+
+    return output_filter
+
+
+def expected_output_from_file(path: str, encoding: str | None = None) -> list[Any]:
+    """The lines of ``path.txt``, or the regexes of ``path.regex``."""
+    for suffix, make in ((".txt", str), (".regex", re.compile)):
+        if os.path.isfile(path + suffix):
+            with open(path + suffix, encoding=encoding) as f:
+                return [make(line) for line in f.read().splitlines()]
+    raise RuntimeError(f"could not find output check file: {path}.txt or {path}.regex")
+
+
+def expect_output(
+    text: str | None = None,
+    *,
+    lines: list[str] | None = None,
+    expected_text: Any = None,
+    expected_lines: Any = None,
+    strip_ansi_escape_sequences: bool = True,
+    strict: bool = False,
+) -> bool:
+    """Whether the text (or lines) given matches the text (or lines) expected."""
+    if (text is None) == (lines is None):
+        raise ValueError("Either lines or text, but not both, must be specified")
+    if (expected_text is None) == (expected_lines is None):
+        raise ValueError("Either expected lines or text, but not both, must be specified")
+    if expected_text is not None:
+        actual = text if text is not None else "\n".join(lines or [])
+        if strip_ansi_escape_sequences:
+            actual = remove_ansi_escape_sequences(actual)
+        return build_text_match(expected_text, strict=strict)(actual) is not None
+    actual_lines = lines if lines is not None else (text or "").splitlines()
+    if strip_ansi_escape_sequences:
+        actual_lines = [remove_ansi_escape_sequences(line) for line in actual_lines]
+    return build_line_match(expected_lines, strict=strict)(actual_lines) is not None
+
+
+class _Waited:
+    """A bool that also shows the output it was decided on (for assertion messages)."""
+
+    def __init__(self, result: bool, output: Any) -> None:
+        self._result = result
+        self._output = output
+
+    def __bool__(self) -> bool:
+        return self._result
+
+    def __repr__(self) -> str:
+        return f"<BoolWithText({self._result}): {self._output!r}>"
+
+
+class ProcessProxy:
+    """A process of the running launch seen through proc_info and proc_output."""
+
+    def __init__(
+        self,
+        process_action: Any,
+        proc_info: Any,
+        proc_output: Any,
+        *,
+        output_filter: Callable[[str], str] | None = None,
+    ) -> None:
+        if output_filter is not None and not callable(output_filter):
+            raise TypeError(f"Expected 'output_filter' to be callable but got {output_filter!r}")
+        self._process_action = process_action
+        self._proc_info = proc_info
+        self._proc_output = proc_output
+        self._output_filter = output_filter
+
+    @property
+    def target_process_action(self) -> Any:
+        return self._process_action
+
+    def _text(self, fd: int | None) -> str:
+        try:
+            events = self._proc_output[self._process_action]
+        except (KeyError, TypeError):
+            events = []  # not started, or nothing printed yet
+        text = "".join(
+            e.text.decode("utf-8", "replace") for e in events if fd is None or e.fd == fd
+        )
+        return self._output_filter(text) if self._output_filter is not None else text
+
+    @property
+    def stdout(self) -> str:
+        return self._text(1)
+
+    @property
+    def stderr(self) -> str:
+        return self._text(2)
+
+    @property
+    def output(self) -> str:
+        return self._text(None)
+
+    def _event(self) -> Any:
+        if self._process_action not in self._proc_info.processes():
+            return None
+        return self._proc_info[self._process_action]
+
+    @property
+    def running(self) -> bool:
+        return isinstance(self._event(), ProcessStarted)
+
+    @property
+    def terminated(self) -> bool:
+        return isinstance(self._event(), ProcessExited)
+
+    @property
+    def exit_code(self) -> int:
+        return int(self._proc_info[self._process_action].returncode)
+
+    def wait_for_shutdown(self, timeout: float | None = None) -> bool:
+        with self._proc_info.proc_event:
+            return bool(self._proc_info.proc_event.wait_for(lambda: self.terminated, timeout))
+
+    def wait_for_output(
+        self, condition: Callable[[str], bool] | None = None, timeout: float | None = None
+    ) -> _Waited:
+        """Wait until the output so far satisfies ``condition`` (any output when None)."""
+        if condition is None:
+
+            def condition(output: str) -> bool:
+                return True
+
+        if not callable(condition):
+            raise TypeError(f"Expected 'condition' to be callable but got {condition!r}")
+        seen = [""]
+
+        def satisfied() -> bool:
+            seen[0] = self.output
+            return self.running and condition(seen[0])
+
+        with self._proc_output.io_event:
+            result = self._proc_output.io_event.wait_for(satisfied, timeout)
+        return _Waited(bool(result), seen[0])
+
+
+class _LaunchedProcess:
+    """The context manager launch_process returns."""
+
+    def __init__(self, launch_service: Any, proxy: ProcessProxy) -> None:
+        self.launch_service = launch_service
+        self.proxy = proxy
+
+    def __enter__(self) -> ProcessProxy:
+        action = self.proxy.target_process_action
+        self.launch_service.emit_event(IncludeLaunchDescription(LaunchDescription([action])))
+        return self.proxy
+
+    def __exit__(self, *exc_info: object) -> None:
+        if not self.proxy.terminated:
+            action = self.proxy.target_process_action
+            self.launch_service.emit_event(ShutdownProcess(process_matcher=matches_action(action)))
+
+
+def launch_process(
+    launch_service: Any, process_action: Any, proc_info: Any, proc_output: Any, **kwargs: Any
+) -> _LaunchedProcess:
+    """Start ``process_action`` in the running launch; ``with`` it to get a ProcessProxy."""
+    if not isinstance(process_action, ExecuteProcess):
+        raise TypeError(
+            f"process_action must be an ExecuteProcess, not {type(process_action).__name__}"
+        )
+    return _LaunchedProcess(
+        launch_service, ProcessProxy(process_action, proc_info, proc_output, **kwargs)
+    )
+
+
+__all__ = [
+    "ProcessProxy",
+    "basic_output_filter",
+    "expect_output",
+    "expected_output_from_file",
+    "launch_process",
+]
