@@ -152,7 +152,8 @@ class LaunchService:
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
         from mlaunch import cli
         from mlaunch.run.guard import Guard, new_run_id
-        from mlaunch.run.output import Printer, make_run_log_dir, stdout_is_color_terminal
+        from mlaunch.run.logfiles import make_run_log_dir
+        from mlaunch.run.output import Printer, stdout_is_color_terminal
         from mlaunch.run.resolve import LabelCounter, ResolveOptions
         from mlaunch.run.supervisor import Supervisor
 
