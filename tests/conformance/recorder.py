@@ -1,0 +1,95 @@
+"""The conformance recorder: a program both launchers start, which writes down how it was started.
+
+Installed as ``lib/conf_pkg/recorder`` in a throw-away ament prefix, so ``Node(package='conf_pkg',
+executable='recorder')`` and ``ExecuteProcess(cmd=[...])`` both reach it. It appends one JSON line
+to ``$CONF_RECORD_DIR/records.jsonl`` (argv, cwd, the whole environment, the text of every
+``--params-file``, whether stdin/stdout are terminals), then behaves as its own options say:
+
+  --say TEXT     print TEXT on stdout (repeatable)
+  --err TEXT     print TEXT on stderr (repeatable)
+  --linger S     stay alive S seconds (ended early by SIGINT/SIGTERM, exit 0)
+  --exit N       exit with status N (default 0)
+
+Only the standard library: it must start the same under either launcher's interpreter.
+"""
+
+import json
+import os
+import signal
+import sys
+import time
+
+
+def _own_options(argv):
+    """The recorder's options: everything before --ros-args, leaving the ROS part alone."""
+    opts = {"say": [], "err": [], "linger": 0.0, "exit": 0}
+    args = argv[1:]
+    if "--ros-args" in args:
+        args = args[: args.index("--ros-args")]
+    i = 0
+    while i < len(args):
+        key = args[i]
+        value = args[i + 1] if i + 1 < len(args) else ""
+        if key == "--say":
+            opts["say"].append(value)
+        elif key == "--err":
+            opts["err"].append(value)
+        elif key == "--linger":
+            opts["linger"] = float(value)
+        elif key == "--exit":
+            opts["exit"] = int(value)
+        else:
+            i += 1
+            continue
+        i += 2
+    return opts
+
+
+def _params_files(argv):
+    texts = []
+    for i, arg in enumerate(argv[:-1]):
+        if arg == "--params-file":
+            try:
+                with open(argv[i + 1], encoding="utf-8") as f:
+                    texts.append(f.read())
+            except OSError as e:
+                texts.append(f"<unreadable: {e.strerror}>")
+    return texts
+
+
+def main():
+    record = {
+        "argv0": os.path.basename(sys.argv[0]),
+        "argv": sys.argv[1:],
+        "cwd": os.getcwd(),
+        "env": dict(os.environ),
+        "params_files": _params_files(sys.argv),
+        "stdin_tty": os.isatty(0),
+        "stdout_tty": os.isatty(1),
+        "stderr_tty": os.isatty(2),
+    }
+    line = (json.dumps(record, sort_keys=True) + "\n").encode()
+    fd = os.open(
+        os.path.join(os.environ["CONF_RECORD_DIR"], "records.jsonl"),
+        os.O_WRONLY | os.O_APPEND | os.O_CREAT,
+        0o644,
+    )
+    os.write(fd, line)
+    os.close(fd)
+    opts = _own_options(sys.argv)
+    for text in opts["say"]:
+        print(text, flush=True)
+    for text in opts["err"]:
+        print(text, file=sys.stderr, flush=True)
+    if opts["linger"] > 0:
+        stop = []
+        signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+        signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+        deadline = time.monotonic() + opts["linger"]
+        while not stop and time.monotonic() < deadline:
+            time.sleep(0.01)  # the recorder is the child under test, not a test: polling is fine
+    sys.exit(opts["exit"])
+
+
+if __name__ == "__main__":
+    main()
