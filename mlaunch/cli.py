@@ -47,6 +47,8 @@ class Options:
         self.target = target
         self.second = second
         self.arguments: dict[str, str] = {} if arguments is None else arguments
+        # The name:=value words as given, in order: what a launch file finds in sys.argv.
+        self.launch_argv: list[str] = []
         self.show_args = show_args
         self.print_plan = print_plan
         self.debug = debug
@@ -219,6 +221,7 @@ def parse_options(argv: Sequence[str]) -> Options:
                 f"malformed launch argument {item!r}, expected format '<name>:=<value>'"
             )
         opts.arguments[name] = value  # last one wins
+        opts.launch_argv.append(item)
     if ns.launch_prefix:
         opts.arguments["launch-prefix"] = ns.launch_prefix
     if ns.launch_prefix_filter:
@@ -300,6 +303,9 @@ def load_target(opts: Options) -> tuple[str, object]:
     path = find_launch_file(opts)
     configure_packages(opts, path)
     from mlaunch import frontends
+    from mlaunch.frontends.python import set_launch_argv
+
+    set_launch_argv(opts.target, opts.second, opts.launch_argv)
 
     return path, frontends.load(path)
 

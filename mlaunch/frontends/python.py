@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import sys
 import types
 
 from mlaunch.errors import LaunchFileError, MlaunchError
@@ -11,6 +12,20 @@ from mlaunch.origin import user_location
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
+
+
+def set_launch_argv(target: str, second: str | None, arguments: list[str]) -> None:
+    """Lay sys.argv out as ``ros2 launch`` does, for launch files that read it.
+
+    Some well-known packages parse ``sys.argv`` inside generate_launch_description(), assuming
+    ``ros2 launch [PKG] FILE name:=value ...``: the arguments from index 3 (FILE) or 4 (PKG FILE).
+    The program name stays mlaunch's own; the launch file sees this for the whole run, as under
+    ros2 launch, where it is simply the process's command line.
+    """
+    sys.argv = [sys.argv[0] if sys.argv else "mlaunch", "launch", target]
+    if second is not None:
+        sys.argv.append(second)
+    sys.argv.extend(arguments)
 
 
 def load(path: str) -> Any:
