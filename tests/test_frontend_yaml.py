@@ -372,7 +372,7 @@ def test_node_params_keep_their_yaml_types(ros_plan: Any) -> None:
     head = "/team/t:\n  ros__parameters:\n    "
     assert params_of(spec.argv) == [
         head + "i: 10\n",
-        head + "s: 10\n",  # a text value is read with YAML, as launch_ros does
+        head + "s: '10'\n",  # YAML text stays text (observed in Jazzy: conformance typed_values)
         head + "forced: '10'\n",
         head + "l:\n    - 1.0\n    - 2.5\n",
         head + "names:\n    - a\n    - me\n",

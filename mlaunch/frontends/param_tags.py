@@ -98,7 +98,10 @@ def parameter_value(p: Entity, *, typed: bool) -> Any:
     sep = p.literal("value-sep")
     attr = p.attr("value", required=True)
     assert attr is not None
-    value = _typed_value(p, attr, element, is_list, sep)
+    # A node param's YAML string (quoted, or text YAML reads as text) stays text in launch_ros;
+    # set_parameter's value is read as a substitution and typed as YAML.
+    keep_text = typed and not isinstance(attr.value, str)
+    value = _typed_value(p, attr, element, is_list, sep, keep_text=keep_text)
     if not typed:
         return value
     value_type: Any = None
@@ -110,7 +113,7 @@ def parameter_value(p: Entity, *, typed: bool) -> Any:
 
 
 def _typed_value(
-    p: Entity, attr: Attr, element: type | None, is_list: bool, sep: str | None
+    p: Entity, attr: Attr, element: type | None, is_list: bool, sep: str | None, *, keep_text: bool
 ) -> Any:
     node = attr.value
     kind = type(node).__name__
@@ -132,6 +135,8 @@ def _typed_value(
         return _uniform_list(p, attr, pieces)
     if "$(" in text:
         return p.template(attr, text)
+    if keep_text and element is None:
+        return text
     return _coerce(p, attr, text, element, is_list)
 
 

@@ -168,6 +168,8 @@ def coerce(text: str, value_type: Any) -> Any:
     """Performed text -> a value of ``value_type`` (launch's coerce_to_type)."""
     scalar, is_list = extract_type(value_type)
     if scalar is None:
+        if not text:
+            return text  # launch forwards empty text as is: YAML would read it as null
         loaded = _yaml(text, "a parameter value")
         if not _valid_plain(loaded) and loaded != []:
             raise SubstitutionFailure(
