@@ -27,6 +27,16 @@ def _as_entities(value: Any) -> tuple[list[Any], Callable[..., Any] | None]:
     return [value], None
 
 
+def returned_entities(result: Any) -> list[Any]:
+    """What a handler callable returned, as launch accepts it: None, one entity, or an iterable
+    of entities (Nones in it skipped)."""
+    if result is None:
+        return []
+    if isinstance(result, Iterable) and not isinstance(result, (str, bytes)):
+        return [entity for entity in result if entity is not None]
+    return [result]
+
+
 class EventHandler:
     """Base handler: ``kind`` names the event, ``target_action`` narrows it to one action."""
 
@@ -120,4 +130,5 @@ __all__ = [
     "OnProcessIO",
     "OnProcessStart",
     "OnShutdown",
+    "returned_entities",
 ]

@@ -8,6 +8,7 @@ code as the launch file) and the supervisor executes what they give.
 from __future__ import annotations
 
 from mlaunch.launch import events as ev
+from mlaunch.launch.event_handlers import returned_entities
 from mlaunch.run.plan import AddHandler, Deferred
 from mlaunch.run.process import Process
 
@@ -78,6 +79,7 @@ class LaunchHandlers:
                     f"{where}: OnProcessIO callback failed: {type(e).__name__}: {e}"
                 )
                 return
-            if result and handler.body is not None:
+            entities = returned_entities(result)
+            if entities and handler.body is not None:
                 body = handler.body
-                self.supervisor.fire(Deferred(list(result), body.context, body.origin), event)
+                self.supervisor.fire(Deferred(entities, body.context, body.origin), event)

@@ -240,8 +240,9 @@ def resolve_deferred(
     resolver = Resolver(context, plan, labels=labels, options=options)
     entities = deferred.entities
     if deferred.callback is not None:
-        result = resolver.call_user(deferred.callback, event, context)
-        entities = list(result) if result else []
+        from mlaunch.launch.event_handlers import returned_entities
+
+        entities = returned_entities(resolver.call_user(deferred.callback, event, context))
     resolver.visit_all(entities)
     return plan
 
