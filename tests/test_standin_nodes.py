@@ -237,7 +237,7 @@ def test_rsp_latches_description_for_a_late_subscriber(
         },
     )
     rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
-    wait_until(started(rsp, "/tf and /tf_static are not published"), 15, "rsp to start")
+    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
     # Subscribed only now, after the one publication: it still arrives (transient local).
     lines = probe(
         spawn,
@@ -262,7 +262,7 @@ def test_rsp_namespace_moves_the_topic(spawn: Callable[..., Proc], tmp_path: Pat
     params = params_file(tmp_path, {"robot_description": URDF})
     argv = standin("rsp", "--ros-args", "-r", "__ns:=/r1", "--params-file", params)
     rsp = spawn([*argv, "-p", "use_sim_time:=True"], "rsp")
-    wait_until(started(rsp, "not published"), 15, "rsp to start")
+    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
     lines = probe(
         spawn,
         {
@@ -280,7 +280,7 @@ def test_rsp_namespace_moves_the_topic(spawn: Callable[..., Proc], tmp_path: Pat
 def test_rsp_names_unknown_joints_once(spawn: Callable[..., Proc], tmp_path: Path) -> None:
     params = params_file(tmp_path, {"robot_description": URDF})
     rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
-    wait_until(started(rsp, "not published"), 15, "rsp to start")
+    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
     batches = [["left_wheel_joint", "mystery_joint"], ["sentinel_joint"]]
     probe(spawn, {"publish_joints": "/joint_states", "batches": batches})
     wait_until(lambda: "'sentinel_joint'" in rsp.stderr(), 10, "rsp to name the sentinel joint")

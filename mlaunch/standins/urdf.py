@@ -418,6 +418,11 @@ def _cycle_from(start: str, parent_joint: Mapping[str, str], joints: Mapping[str
 # ---------------------------------------------------------------- kinematics
 
 
+def joint_transform(joint: Joint, q: float) -> Matrix:
+    """The child's 4x4 pose in the parent frame at joint position q (origin, then motion)."""
+    return _matmul(_origin(joint.origin_xyz, joint.origin_rpy), _motion(joint, q))
+
+
 def _identity() -> Matrix:
     return tuple(tuple(1.0 if r == c else 0.0 for c in range(4)) for r in range(4))
 
