@@ -6,6 +6,7 @@ import importlib
 import os
 
 from mlaunch.errors import LaunchFileError
+from mlaunch.frontends.limits import allow_deep_trees
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -53,6 +54,7 @@ def load(path: str, hint: str | None = None) -> Any:
     if os.path.isdir(path):
         raise LaunchFileError(f"{path!r} is a directory, not a launch file")
     module_name = frontend_for(path, hint)
+    allow_deep_trees()
     try:
         module = importlib.import_module(module_name)
     except ModuleNotFoundError:

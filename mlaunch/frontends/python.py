@@ -7,6 +7,7 @@ import sys
 import types
 
 from mlaunch.errors import LaunchFileError, MlaunchError
+from mlaunch.frontends.encoding import not_utf8
 from mlaunch.origin import user_location
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -34,13 +35,16 @@ def load(path: str) -> Any:
 
     compat.install()
     try:
-        with open(path, encoding="utf-8") as f:
+        with open(path, "rb") as f:
             source = f.read()
-    except (OSError, UnicodeDecodeError) as e:
-        raise LaunchFileError(f"cannot read launch file: {e}", where=path)
+    except OSError as e:
+        raise LaunchFileError(f"cannot read launch file: {e.strerror}", where=path)
     try:
+        # Compiled from bytes, as Python imports it: a ``# coding:`` line is honoured.
         code = compile(source, path, "exec")
     except SyntaxError as e:
+        if "codec can't decode" in str(e.msg):
+            raise not_utf8(source, path) or LaunchFileError(e.msg, where=f"{path}:{e.lineno}")
         col = f":{e.offset}" if e.offset else ""
         raise LaunchFileError(f"Python syntax error: {e.msg}", where=f"{path}:{e.lineno}{col}")
     module = types.ModuleType("python_launch_file")
@@ -63,6 +67,8 @@ def run_user_code(path: str, call: Any, during: str) -> Any:
     """Run launch-file code; any exception becomes one located error line."""
     try:
         return call()
+    except SystemExit as e:  # the launch file's sys.exit() must not end mlaunch silently
+        raise exit_error(e, path, during) from e
     except MlaunchError as e:
         if e.where is None:
             e.where = user_location(e.__traceback__, os.path.abspath(path)) or path
@@ -70,3 +76,13 @@ def run_user_code(path: str, call: Any, during: str) -> Any:
     except Exception as e:
         where = user_location(e.__traceback__, os.path.abspath(path)) or path
         raise LaunchFileError(f"{type(e).__name__} {during}: {e}", where=where) from e
+
+
+def exit_error(e: SystemExit, path: str, during: str) -> LaunchFileError:
+    """The located error for a launch file that called ``sys.exit()`` (or raised SystemExit)."""
+    where = user_location(e.__traceback__, os.path.abspath(path)) or path
+    return LaunchFileError(
+        f"the launch file called sys.exit({e.code!r}) {during}; a launch file cannot end"
+        " mlaunch: raise an exception to report an error, or use a Shutdown action",
+        where=where,
+    )

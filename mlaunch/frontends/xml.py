@@ -12,7 +12,9 @@ from functools import partial
 from xml.parsers import expat
 
 from mlaunch.errors import LaunchFileError
+from mlaunch.frontends.encoding import not_utf8
 from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -56,15 +58,23 @@ class _TreeBuilder:
         try:
             self.parser.Parse(self.data, True)
         except expat.ExpatError as e:
-            where = f"{self.path}:{e.lineno}:{e.offset + 1}"
-            raise LaunchFileError(f"malformed XML: {expat.ErrorString(e.code)}", where=where)
+            if e.code == expat.errors.codes[expat.errors.XML_ERROR_INVALID_TOKEN]:
+                # expat says "invalid token" for bytes that are not in the file's encoding
+                raise not_utf8(self.data, self.path) or self.expat_error(e)
+            raise self.expat_error(e)
         if self.root is None:  # expat reports a missing root itself; kept for type safety
             raise LaunchFileError("no <launch> element", where=self.path)
         return self.root
 
+    def expat_error(self, e: expat.ExpatError) -> LaunchFileError:
+        where = f"{self.path}:{e.lineno}:{e.offset + 1}"
+        return LaunchFileError(f"malformed XML: {expat.ErrorString(e.code)}", where=where)
+
     def start(self, tag: str, attributes: dict[str, str]) -> None:
         p = self.parser
         line, col = p.CurrentLineNumber, p.CurrentColumnNumber + 1
+        if len(self.stack) >= DEPTH_LIMIT:
+            raise too_deep(f"{self.path}:{line}:{col}", "XML elements")
         e = Entity(tag=tag, path=self.path, line=line, col=col, fmt="xml")
         index = p.CurrentByteIndex
         for name, value in attributes.items():

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import yaml
 from yaml.constructor import SafeConstructor
+from yaml.events import CollectionEndEvent, CollectionStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mlaunch.errors import LaunchFileError
+from mlaunch.frontends.encoding import not_utf8
 from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -49,9 +52,13 @@ class _Reader:
 
     def description(self, data: bytes) -> Any:
         try:
+            if _bound_of_depth(data) > _NODE_DEPTH_LIMIT:
+                self.check_depth(data)
             root = yaml.compose(data, Loader=_Loader)
         except yaml.MarkedYAMLError as e:
             raise self._yaml_error(e)
+        except yaml.reader.ReaderError as e:  # a byte or character that is not YAML text
+            raise not_utf8(data, self.path) or self._reader_error(data, e)
         except yaml.YAMLError as e:
             raise LaunchFileError(f"malformed YAML: {e}", where=self.path)
         if root is None:
@@ -63,6 +70,23 @@ class _Reader:
         if tag != "launch":
             raise self.error(key, f"the root key must be 'launch', not {tag!r}")
         return build_description(self.entity(tag, key, value))
+
+    def check_depth(self, data: bytes) -> None:
+        """Stop a file nested deeper than the limit before composing it.
+
+        libyaml composes recursively in C: a file nested ~20,000 deep crashes the interpreter
+        (a segmentation fault, not an exception). Parsing events is flat.
+        """
+        depth = 0
+        for event in yaml.parse(data, Loader=_Loader):
+            if isinstance(event, CollectionStartEvent):
+                depth += 1
+                if depth > _NODE_DEPTH_LIMIT:
+                    raise too_deep(
+                        self.where(event.start_mark), "YAML maps and lists", _NODE_DEPTH_LIMIT
+                    )
+            elif isinstance(event, CollectionEndEvent):
+                depth -= 1
 
     # --- nodes to entities ----------------------------------------------------------------------
 
@@ -158,14 +182,37 @@ class _Reader:
     # --- errors ---------------------------------------------------------------------------------
 
     def error(self, node: Node, message: str) -> LaunchFileError:
-        mark = node.start_mark
-        return LaunchFileError(message, where=f"{self.path}:{mark.line + 1}:{mark.column + 1}")
+        return LaunchFileError(message, where=self.where(node.start_mark))
+
+    def where(self, mark: Any) -> str:
+        """``path:line:col`` of a mark (PyYAML's or libyaml's; None: the file)."""
+        if mark is None:
+            return self.path
+        return f"{self.path}:{mark.line + 1}:{mark.column + 1}"
+
+    def _reader_error(self, data: bytes, e: yaml.reader.ReaderError) -> LaunchFileError:
+        text = data.decode("utf-8", "replace")[: e.position]
+        line, col = text.count("\n") + 1, e.position - (text.rfind("\n") + 1) + 1
+        what = f"#x{e.character:04x}" if isinstance(e.character, int) else repr(e.character)
+        return LaunchFileError(
+            f"the character {what} is not allowed in YAML ({e.reason})",
+            where=f"{self.path}:{line}:{col}",
+        )
 
     def _yaml_error(self, e: yaml.MarkedYAMLError) -> LaunchFileError:
         mark = e.problem_mark or e.context_mark
         where = f"{self.path}:{mark.line + 1}:{mark.column + 1}" if mark else self.path
         problem = " ".join(p for p in (e.context, e.problem) if p)
         return LaunchFileError(f"malformed YAML: {problem}", where=where)
+
+
+# A nesting level of groups is two or three YAML levels (a map, its children list ...).
+_NODE_DEPTH_LIMIT = 3 * DEPTH_LIMIT
+
+
+def _bound_of_depth(data: bytes) -> int:
+    """An upper bound of the YAML nesting depth: each map or list needs one of these bytes."""
+    return data.count(b":") + data.count(b"-") + data.count(b"[") + data.count(b"{")
 
 
 def _shape(node: Node) -> str:

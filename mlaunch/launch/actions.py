@@ -378,7 +378,7 @@ class IncludeLaunchDescription(Action):
             if path is None:
                 resolver.visit(description)
             else:
-                with ctx.file_locals(path):
+                with resolver.includes.enter(path, self.origin, ctx), ctx.file_locals(path):
                     resolver.visit(description)
         finally:
             if self.scoped:

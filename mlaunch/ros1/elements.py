@@ -9,6 +9,8 @@ from typing import Any
 from xml.parsers import expat
 
 from mlaunch.errors import LaunchFileError, MlaunchError
+from mlaunch.frontends.encoding import not_utf8
+from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.ros1.eval import EvalCutter
 from mlaunch.ros1.model import (
     AnonRef,
@@ -54,6 +56,8 @@ def parse_xml(path: str) -> Element:
     roots: list[Element] = []
 
     def start(tag: str, attrs: dict[str, str]) -> None:
+        if len(stack) >= DEPTH_LIMIT:
+            raise too_deep(f"{path}:{parser.CurrentLineNumber}", "XML elements")
         element = Element(tag, dict(attrs), parser.CurrentLineNumber)
         (stack[-1].children if stack else roots).append(element)
         stack.append(element)
@@ -71,7 +75,8 @@ def parse_xml(path: str) -> Element:
     try:
         parser.Parse(data, True)
     except expat.ExpatError as e:
-        raise LaunchFileError(
+        invalid_token = e.code == expat.errors.codes[expat.errors.XML_ERROR_INVALID_TOKEN]
+        raise (invalid_token and not_utf8(data, path)) or LaunchFileError(
             f"malformed XML: {expat.ErrorString(e.code)}", where=f"{path}:{e.lineno}"
         )
     return roots[0]

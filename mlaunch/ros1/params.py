@@ -7,6 +7,7 @@ from typing import Any
 
 import yaml
 
+from mlaunch.frontends.encoding import not_utf8
 from mlaunch.ros1.elements import Element, ElementReader
 from mlaunch.ros1.model import (
     ArgRef,
@@ -198,10 +199,14 @@ class ParamReader(ElementReader):
                 " them), so give a fixed path ($(find pkg)/...); not loaded"
             )
         try:
-            with open(path, encoding="utf-8") as f:
-                return f.read()
+            with open(path, "rb") as f:
+                data = f.read()
         except OSError as e:
             raise self.error(el, f"cannot read rosparam file {path!r}: {e.strerror}")
+        problem = not_utf8(data, path)
+        if problem is not None:
+            raise self.error(el, f"rosparam file {problem.where}: {problem.message}")
+        return data.decode("utf-8")
 
     def substituted(
         self, entry: tuple[Value, PValue], el: Element, scope: Scope

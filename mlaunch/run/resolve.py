@@ -11,6 +11,7 @@ import itertools
 import os
 
 from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
+from mlaunch.frontends.limits import DEPTH_LIMIT, IncludeChain, allow_deep_trees, too_deep
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
 from mlaunch.origin import user_location
@@ -69,10 +70,22 @@ class Resolver:
         self.plan = plan
         self.labels = labels
         self.options = options
+        self.includes = IncludeChain()  # include cycles are errors, not a RecursionError
+        self.depth = 0
+        allow_deep_trees()
 
     # --- visiting -----------------------------------------------------------------------------
 
     def visit(self, entity: Any) -> None:
+        if self.depth >= DEPTH_LIMIT:
+            raise too_deep(getattr(entity, "origin", None), "launch actions (groups, includes)")
+        self.depth += 1
+        try:
+            self._visit(entity)
+        finally:
+            self.depth -= 1
+
+    def _visit(self, entity: Any) -> None:
         visit = getattr(entity, "visit", None)
         if visit is None:
             raise LaunchFileError(
@@ -101,6 +114,11 @@ class Resolver:
             return function(*args, **kwargs)
         except MlaunchError:
             raise
+        except SystemExit as e:  # sys.exit() in launch-file code must not end mlaunch silently
+            from mlaunch.frontends.python import exit_error
+
+            path = self.context.current_launch_file_path or ""
+            raise exit_error(e, path, "in a function of the launch file") from e
         except Exception as e:
             where = user_location(e.__traceback__, self.context.current_launch_file_path)
             raise MlaunchError(f"{type(e).__name__}: {e}", where=where) from e
@@ -250,17 +268,14 @@ def resolve_deferred(
 def undeclared_argument_warnings(
     given: Mapping[str, str], declared: Mapping[str, ArgumentInfo]
 ) -> list[str]:
-    out = []
-    for name in given:
-        if name in declared:
-            continue
-        import difflib
+    from mlaunch.frontends.suggest import Suggester
 
-        close = difflib.get_close_matches(name, list(declared), n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        known = f"; declared: {', '.join(sorted(declared))}" if declared and not close else ""
-        out.append(f"argument {name!r} is not declared by the launch file{hint}{known}")
-    return out
+    suggest = Suggester(declared)
+    return [
+        f"argument {name!r} is not declared by the launch file{suggest.hint(name)}"
+        for name in given
+        if name not in declared
+    ]
 
 
 # --- --show-args: a static walk ------------------------------------------------------------------
