@@ -19,6 +19,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import Any
 
+    from mlaunch.ros.search import PackageSearch
+
 SUBCOMMANDS = {
     "test": "mlaunch.smoke",
     "convert": "mlaunch.ros1.convert",
@@ -134,7 +136,11 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="print every process's output (output=both)",
     )
     parser.add_argument(
-        "--use-sim-time", action="store_true", default=None, help="set use_sim_time on every node"
+        "--use-sim-time",
+        action="store_true",
+        default=None,
+        help="set the parameter use_sim_time on every node (use_sim_time:=true is an ordinary"
+        " launch argument, as in ros2 launch)",
     )
     parser.add_argument(
         "--package-path",
@@ -230,15 +236,6 @@ def parse_options(argv: Sequence[str]) -> Options:
         opts.arguments["launch-prefix-filter"] = ns.launch_prefix_filter
     if ns.show_all_subprocesses_output:
         os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
-    if opts.use_sim_time is None and "use_sim_time" in opts.arguments:
-        from mlaunch.launch.substitutions import to_bool
-
-        try:
-            opts.use_sim_time = to_bool(opts.arguments["use_sim_time"], "use_sim_time")
-        except Exception:
-            raise UsageError(
-                f"use_sim_time is {opts.arguments['use_sim_time']!r}; valid: true, false"
-            )
     return opts
 
 
@@ -288,26 +285,29 @@ def report_error(error: BaseException, debug: bool) -> int:
     return 70
 
 
-def configure_packages(opts: Options, path: str | None) -> None:
-    """Tell the ROS layer where source packages are, before anything is resolved."""
-    from mlaunch import ros
+def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
+    """Where this run looks for ROS packages: --package-path, the launch file, the environment."""
+    from mlaunch.ros.search import PackageSearch
 
-    ros.configure_packages(search_paths=opts.package_path, launch_file=path, environ=os.environ)
+    return PackageSearch(opts.package_path, launch_file, os.environ)
 
 
 def load_target(opts: Options) -> tuple[str, object]:
     """The launch file the command line names (a path, or PKG FILE) and its description."""
-    # Search settings first: `mlaunch PKG FILE` looks the package up with them.
+    from mlaunch.ros.search import searching
+
+    # `mlaunch PKG FILE` looks the package up with the search settings, before there is a file.
     given = os.path.abspath(opts.target) if opts.second is None else None
-    configure_packages(opts, given if given and os.path.exists(given) else None)
-    path = find_launch_file(opts)
-    configure_packages(opts, path)
+    with searching(package_search(opts, given if given and os.path.exists(given) else None)):
+        path = find_launch_file(opts)
     from mlaunch import frontends
     from mlaunch.frontends.python import set_launch_argv
 
     set_launch_argv(opts.target, opts.second, opts.launch_argv)
 
-    return path, frontends.load(path)
+    # Launch-file code run while loading (get_package_share_directory) sees the same search.
+    with searching(package_search(opts, path)):
+        return path, frontends.load(path)
 
 
 def resolve_for_run(
@@ -317,11 +317,12 @@ def resolve_for_run(
     from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
     options = ResolveOptions(
-        standins=opts.standins,
-        use_sim_time=opts.use_sim_time,
-        package_path=tuple(opts.package_path),
-        temp_dir=temp_dir,
+        standins=opts.standins, packages=package_search(opts, path), temp_dir=temp_dir
     )
+    if opts.use_sim_time is not None:
+        from mlaunch.launch_ros.actions import with_use_sim_time
+
+        description = with_use_sim_time(description, opts.use_sim_time)  # type: ignore[arg-type]
     labels = LabelCounter()
     plan = resolve(
         description,
@@ -339,11 +340,13 @@ def run_cli(argv: Sequence[str]) -> int:
     opts = parse_options(argv)
     path, description = load_target(opts)
     if opts.show_args:
+        from mlaunch.ros.search import searching
         from mlaunch.run.resolve import collect_arguments
 
-        infos = collect_arguments(
-            description, path=path, arguments=opts.arguments, environ=os.environ
-        )
+        with searching(package_search(opts, path)):
+            infos = collect_arguments(
+                description, path=path, arguments=opts.arguments, environ=os.environ
+            )
         sys.stdout.write(format_arguments(infos))
         return 0
     return launch(opts, path, description)

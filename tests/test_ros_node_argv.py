@@ -29,8 +29,8 @@ from mlaunch.launch_ros.actions import (
     SetRemap,
     SetROSLogDir,
     SetUseSimTime,
-    apply_options,
     prefix_namespace,
+    with_use_sim_time,
 )
 from mlaunch.launch_ros.events import (
     ChangeState,
@@ -42,6 +42,7 @@ from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, 
 from mlaunch.launch_ros.substitutions import FindPackageShare
 from mlaunch.launch_ros.substitutions import Parameter as ParameterSubstitution
 from mlaunch.ros import packages
+from mlaunch.ros.search import PackageSearch
 from mlaunch.run.plan import Plan, ProcessSpec
 from mlaunch.run.resolve import ResolveOptions, resolve
 
@@ -50,9 +51,9 @@ THIS = os.path.abspath(__file__)
 
 @pytest.fixture(autouse=True)
 def _fresh_packages() -> Iterator[None]:
-    packages.reset()
+    packages.forget_scans()
     yield
-    packages.reset()
+    packages.forget_scans()
 
 
 def make_prefix(root: Path, contents: dict[str, list[str]]) -> Path:
@@ -551,16 +552,24 @@ def test_unscoped_group_forwards_ros_state(prefix: Path, temp_dir: str) -> None:
     ]
 
 
-def test_use_sim_time_option_is_the_first_global(prefix: Path, temp_dir: str) -> None:
-    from mlaunch.launch.launch_context import LaunchContext
+def test_use_sim_time_option_is_an_action_before_the_description(
+    prefix: Path, temp_dir: str
+) -> None:
+    """--use-sim-time: a SetParameter placed before the file, so it is the first global."""
+    description = LaunchDescription(
+        [SetParameter("x", 1), Node(package="demo", executable="talker")]
+    )
+    plan = run([with_use_sim_time(description, True)], prefix, temp_dir)
+    assert ros_part(only(plan)) == ["--ros-args", "-p", "use_sim_time:=True", "-p", "x:=1"]
+    assert ros_part(only(run([description], prefix, temp_dir))) == ["--ros-args", "-p", "x:=1"]
 
-    ctx = LaunchContext(environment={})
-    ctx.launch_configurations["global_params"] = (("x", 1),)
-    apply_options(ctx, ResolveOptions(use_sim_time=True))
-    assert ctx.launch_configurations["global_params"] == (("use_sim_time", True), ("x", 1))
-    untouched = LaunchContext(environment={})
-    apply_options(untouched, ResolveOptions())
-    assert "global_params" not in untouched.launch_configurations
+
+def test_use_sim_time_argument_is_an_ordinary_launch_argument(prefix: Path, temp_dir: str) -> None:
+    """As in ros2 launch: use_sim_time:=true reaches only what the file does with it."""
+    node = Node(package="demo", executable="talker")
+    plan = run([node], prefix, temp_dir, args={"use_sim_time": "true"})
+    assert ros_part(only(plan)) == ["--ros-args"]
+    assert any("'use_sim_time' is not declared" in w for w in plan.warnings)
 
 
 def test_set_use_sim_time_warns_that_nodes_are_not_affected(prefix: Path, temp_dir: str) -> None:
@@ -824,7 +833,7 @@ def test_source_only_package_executable_is_not_built(
     with pytest.raises(
         PackageNotFoundError, match=r"'my_robot' is only a source package at .* \(not built\)"
     ):
-        run([node], prefix, temp_dir, package_path=(str(tmp_path / "src"),))
+        run([node], prefix, temp_dir, packages=PackageSearch([str(tmp_path / "src")]))
 
 
 def test_find_package_share_joins_with_slash(prefix: Path, temp_dir: str) -> None:

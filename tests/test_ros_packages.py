@@ -21,6 +21,7 @@ from mlaunch.launch.substitutions import perform
 from mlaunch.launch_ros.substitutions import FindPackagePrefix, FindPackageShare
 from mlaunch.ros import ament_index, packages
 from mlaunch.ros.packages import PackageNotFoundError
+from mlaunch.ros.search import PackageSearch, searching
 from mlaunch.run.plan import Log
 from mlaunch.run.resolve import ResolveOptions, resolve
 
@@ -29,9 +30,9 @@ REPO = Path(__file__).resolve().parent.parent
 
 @pytest.fixture(autouse=True)
 def _fresh_packages() -> Iterator[None]:
-    packages.reset()
+    packages.forget_scans()
     yield
-    packages.reset()
+    packages.forget_scans()
 
 
 def installed(prefix: Path, *names: str) -> Path:
@@ -99,13 +100,12 @@ def test_explicit_paths_package_folders_and_env_in_order(tmp_path: Path) -> None
     a = source(tmp_path / "a" / "dup", "dup")
     b = source(tmp_path / "b" / "dup", "dup")
     direct = source(tmp_path / "direct", "direct_pkg")
-    packages.configure(search_paths=[str(tmp_path / "a")])
+    search = PackageSearch([str(tmp_path / "a")])
     environ = {"MLAUNCH_PACKAGE_PATH": os.pathsep.join([str(direct), str(tmp_path / "b")])}
-    index = packages.index(environ=environ)
+    index = packages.index(search=search, environ=environ)
     assert index.get("dup").share_directory == str(a)
     assert index.get("direct_pkg").share_directory == str(direct)
     assert index.source_paths()[:3] == [str(tmp_path / "a"), str(direct), str(tmp_path / "b")]
-    packages.reset()  # forget the configured search path
     only_env = packages.index(environ={"MLAUNCH_PACKAGE_PATH": str(tmp_path / "b")})
     assert only_env.get("dup").share_directory == str(b)
 
@@ -186,17 +186,17 @@ def test_find_launch_file_walks_the_share_directory(tmp_path: Path) -> None:
     (share / "launch" / "a.launch.xml").write_text("")
     (share / "config").mkdir()
     (share / "config" / "a.launch.xml").write_text("")
-    packages.configure(environ=env(prefix))
-    assert packages.find_launch_file("bringup", "robot.launch.py") == str(
-        share / "launch" / "deep" / "robot.launch.py"
-    )
-    with pytest.raises(LaunchFileError, match="'nope.launch.py' was not found in the share"):
-        packages.find_launch_file("bringup", "nope.launch.py")
-    with pytest.raises(LaunchFileError, match="found more than once") as err:
-        packages.find_launch_file("bringup", "a.launch.xml")
-    assert str(share / "config" / "a.launch.xml") in str(err.value)
-    with pytest.raises(PackageNotFoundError, match="package 'nobody' not found"):
-        packages.find_launch_file("nobody", "x.launch.py")
+    with searching(PackageSearch(environ=env(prefix))):
+        assert packages.find_launch_file("bringup", "robot.launch.py") == str(
+            share / "launch" / "deep" / "robot.launch.py"
+        )
+        with pytest.raises(LaunchFileError, match="'nope.launch.py' was not found in the share"):
+            packages.find_launch_file("bringup", "nope.launch.py")
+        with pytest.raises(LaunchFileError, match="found more than once") as err:
+            packages.find_launch_file("bringup", "a.launch.xml")
+        assert str(share / "config" / "a.launch.xml") in str(err.value)
+        with pytest.raises(PackageNotFoundError, match="package 'nobody' not found"):
+            packages.find_launch_file("nobody", "x.launch.py")
 
 
 def test_find_launch_file_in_a_source_package(tmp_path: Path) -> None:
@@ -205,10 +205,10 @@ def test_find_launch_file_in_a_source_package(tmp_path: Path) -> None:
     (pkg / "launch" / "demo.launch.yaml").write_text("")
     (pkg / "build" / "launch").mkdir(parents=True)
     (pkg / "build" / "launch" / "demo.launch.yaml").write_text("")  # a build tree is not searched
-    packages.configure(search_paths=[str(tmp_path / "src")], environ={})
-    assert packages.find_launch_file("demo_bringup", "demo.launch.yaml") == str(
-        pkg / "launch" / "demo.launch.yaml"
-    )
+    with searching(PackageSearch([str(tmp_path / "src")], environ={})):
+        assert packages.find_launch_file("demo_bringup", "demo.launch.yaml") == str(
+            pkg / "launch" / "demo.launch.yaml"
+        )
 
 
 # --- ament_index_python and the substitutions ----------------------------------------------------
@@ -217,31 +217,33 @@ def test_find_launch_file_in_a_source_package(tmp_path: Path) -> None:
 def test_ament_index_names_answer_installed_and_source_packages(tmp_path: Path) -> None:
     prefix = installed(tmp_path / "install", "inst")
     src = source(tmp_path / "src" / "srcpkg", "srcpkg")
-    packages.configure(search_paths=[str(tmp_path / "src")], environ=env(prefix))
-    assert ament_index.get_package_share_directory("inst") == str(prefix / "share" / "inst")
-    assert ament_index.get_package_prefix("inst") == str(prefix)
-    assert ament_index.get_package_share_directory("srcpkg") == str(src)
-    assert ament_index.get_package_share_path("srcpkg") == src
-    assert ament_index.get_package_prefix("srcpkg") == str(src)
-    with_prefixes = ament_index.get_packages_with_prefixes()
-    assert with_prefixes["inst"] == str(prefix) and with_prefixes["srcpkg"] == str(src)
-    assert ament_index.get_resource("packages", "inst") == ("", str(prefix))
-    assert ament_index.get_resource("packages", "srcpkg") == ("", str(src))
-    assert ament_index.has_resource("packages", "missing_one") is False
-    assert ament_index.get_search_paths() == [str(prefix)]
-    with pytest.raises(ament_index.PackageNotFoundError):
-        ament_index.get_package_share_directory("missing_one")
-    with pytest.raises(KeyError):
-        ament_index.get_package_prefix("missing_one")
-    with pytest.raises(ValueError, match="not a valid package name"):
-        ament_index.get_package_share_directory("bad/name")
-    with pytest.raises(LookupError):
-        ament_index.get_resource("messages", "x")
+    with searching(PackageSearch([str(tmp_path / "src")], environ=env(prefix))):
+        assert ament_index.get_package_share_directory("inst") == str(prefix / "share" / "inst")
+        assert ament_index.get_package_prefix("inst") == str(prefix)
+        assert ament_index.get_package_share_directory("srcpkg") == str(src)
+        assert ament_index.get_package_share_path("srcpkg") == src
+        assert ament_index.get_package_prefix("srcpkg") == str(src)
+        with_prefixes = ament_index.get_packages_with_prefixes()
+        assert with_prefixes["inst"] == str(prefix) and with_prefixes["srcpkg"] == str(src)
+        assert ament_index.get_resource("packages", "inst") == ("", str(prefix))
+        assert ament_index.get_resource("packages", "srcpkg") == ("", str(src))
+        assert ament_index.has_resource("packages", "missing_one") is False
+        assert ament_index.get_search_paths() == [str(prefix)]
+        with pytest.raises(ament_index.PackageNotFoundError):
+            ament_index.get_package_share_directory("missing_one")
+        with pytest.raises(KeyError):
+            ament_index.get_package_prefix("missing_one")
+        with pytest.raises(ValueError, match="not a valid package name"):
+            ament_index.get_package_share_directory("bad/name")
+        with pytest.raises(LookupError):
+            ament_index.get_resource("messages", "x")
 
 
 def test_ament_index_search_paths_need_the_variable() -> None:
-    packages.configure(environ={})
-    with pytest.raises(OSError, match="AMENT_PREFIX_PATH' is not set or empty"):
+    with (
+        searching(PackageSearch(environ={})),
+        pytest.raises(OSError, match="AMENT_PREFIX_PATH' is not set or empty"),
+    ):
         ament_index.get_search_paths()
 
 
@@ -291,15 +293,21 @@ def test_a_launch_file_finds_a_package_next_to_it_while_loading(tmp_path: Path) 
     assert [s.message for s in plan.steps if isinstance(s, Log)] == [str(desc), str(desc)]
 
 
-def test_configured_launch_file_tree_serves_plain_lookups(tmp_path: Path) -> None:
+def test_the_runs_search_is_an_explicit_input(tmp_path: Path) -> None:
+    """The search the pipeline runs with: active for ament_index calls, given to resolve."""
     repo = tmp_path / "repo"
     (repo / ".git").mkdir(parents=True)
     desc = source(repo / "pkgs" / "conf_desc", "conf_desc")
-    packages.configure(launch_file=str(repo / "a.launch.py"), environ={})
-    assert ament_index.get_package_share_directory("conf_desc") == str(desc)
+    search = PackageSearch(launch_file=str(repo / "a.launch.py"), environ={})
+    with searching(search):
+        assert ament_index.get_package_share_directory("conf_desc") == str(desc)
+    with pytest.raises(PackageNotFoundError):
+        ament_index.get_package_share_directory("conf_desc")  # no longer active
     ld = LaunchDescription([LogInfo(msg=FindPackageShare("conf_desc"))])
-    plan = resolve(ld, path=None, arguments={}, environ={}, options=ResolveOptions())
+    plan = resolve(ld, path=None, arguments={}, environ={}, options=ResolveOptions(packages=search))
     assert [s.message for s in plan.steps if isinstance(s, Log)] == [str(desc)]
+    with pytest.raises(PackageNotFoundError):
+        resolve(ld, path=None, arguments={}, environ={}, options=ResolveOptions())
 
 
 def test_symlinked_packages_are_found_and_loops_do_not_hang(tmp_path: Path) -> None:

@@ -44,9 +44,9 @@ JTBOT = Path(__file__).resolve().parent.parent / "robots/jtbot_description/urdf/
 
 @pytest.fixture(autouse=True)
 def _fresh_packages() -> Iterator[None]:
-    packages.reset()
+    packages.forget_scans()
     yield
-    packages.reset()
+    packages.forget_scans()
 
 
 def fake_prefix(root: Path) -> Path:

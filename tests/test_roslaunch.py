@@ -37,9 +37,9 @@ _ANON = re.compile(r"_[A-Za-z0-9_]+_\d+_\d+$")
 def fresh_packages(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Package lookups see this test's files and environment only."""
     monkeypatch.setenv("AMENT_PREFIX_PATH", str(PREFIX))
-    packages.reset()
+    packages.forget_scans()
     yield
-    packages.reset()
+    packages.forget_scans()
 
 
 def write(folder: Path, name: str, body: str) -> str:
@@ -621,7 +621,7 @@ def test_static_transforms_become_tf2_ros_options_where_tf2_ros_runs(
 ) -> None:
     prefixes = _fake_tf2_ros(tmp_path)
     monkeypatch.setenv("AMENT_PREFIX_PATH", prefixes)
-    packages.reset()
+    packages.forget_scans()
     path = write(tmp_path, "tf.launch", STATIC_TF)
     plan = plan_of(path, AMENT_PREFIX_PATH=prefixes)
     euler, quat = plan.processes()

@@ -15,6 +15,7 @@ from procutil import Running, clean_env
 from test_roslaunch import params, plan_of, summarize
 
 from mlaunch.ros import packages
+from mlaunch.ros.search import PackageSearch, searching
 from mlaunch.ros1 import convert
 
 REPO = Path(__file__).resolve().parent.parent
@@ -28,10 +29,10 @@ pytestmark = requires_rclpy  # the ROS programs are stand-ins, which need rclpy
 @pytest.fixture(autouse=True)
 def robots_found() -> Iterator[None]:
     """smartcar_description is a source package of this repository (also for files in tmp)."""
-    packages.reset()
-    packages.configure(search_paths=[str(ROBOTS)])
-    yield
-    packages.reset()
+    packages.forget_scans()
+    with searching(PackageSearch([str(ROBOTS)])):
+        yield
+    packages.forget_scans()
 
 
 def test_print_shows_the_ros2_plan_without_error() -> None:

@@ -52,9 +52,9 @@ pytestmark = pytest.mark.skipif(not PROGRAM.exists(), reason=f"no xacro program 
 
 @pytest.fixture(autouse=True)
 def _fresh_packages() -> Iterator[None]:
-    packages.reset()
+    packages.forget_scans()
     yield
-    packages.reset()
+    packages.forget_scans()
 
 
 @pytest.fixture

@@ -41,6 +41,7 @@ if TYPE_CHECKING:
     from mlaunch.launch.conditions import Condition
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.run.plan import NodeInfo
     from mlaunch.run.resolve import Resolver
 
 
@@ -621,39 +622,52 @@ class ExecuteProcess(Action):
         self.required = required
         # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
         self.machine = None if machine is None else normalize(machine)
-        # The machine of the spec being built, for the command hooks (None: this computer).
-        self.remote_machine: Any = None
 
-    # The ROS layer (Node) overrides these three to build a node's command line.
     def command(self, resolver: Resolver) -> list[str]:
         """The argv before any prefix: each cmd item performed to one element."""
         return [perform_substitutions(resolver.context, item) for item in self.cmd]
-
-    def label_base(self, resolver: Resolver, argv: list[str]) -> str:
-        if self.name is not None:
-            return perform_substitutions(resolver.context, self.name)
-        return os.path.basename(argv[0]) if argv else "process"
-
-    def node_info(self, resolver: Resolver) -> Any:
-        return None
 
     def execute(self, resolver: Resolver) -> None:
         resolver.spawn(self.build_spec(resolver))
 
     def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        ctx = resolver.context
         machine = self._machine(resolver)
-        self.remote_machine = machine if machine is not None and not machine.local else None
-        argv = self.command(resolver)
+        return self.process_spec(resolver, self.command(resolver), machine=machine)
+
+    def process_spec(
+        self,
+        resolver: Resolver,
+        argv: list[str],
+        *,
+        node: NodeInfo | None = None,
+        replaced_label: str | None = None,
+        standin: str | None = None,
+        temp_files: tuple[str, ...] = (),
+        machine: Any = None,
+    ) -> ProcessSpec:
+        """The ProcessSpec for ``argv`` (before any prefix), with what the ROS layer adds.
+
+        ``replaced_label`` labels a process whose argv is already a stand-in's (a Node whose
+        package is not installed) as the program it replaces, unless a name or prefix leads;
+        ``standin`` names what it replaces, ``temp_files`` what to remove after it;
+        ``machine`` is the MachineSpec it runs on (None: no machine given or pushed).
+        """
+        ctx = resolver.context
+        remote = machine is not None and not machine.local
         if not argv or not argv[0]:
             raise SubstitutionFailure("the command is empty", where=self.origin)
         named = argv
-        standin = None
-        if self.remote_machine is None:  # another computer's programs are found there
-            argv, standin = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
+        located = None
+        if not remote:  # another computer's programs are found there
+            argv, located = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
         prefix = self._prefix(ctx, named)
         # The label comes from the program the launch file named, not from its stand-in.
-        base = self.label_base(resolver, prefix + named if prefix else named)
+        if self.name is not None:
+            base = perform_substitutions(ctx, self.name)
+        elif replaced_label is not None and not prefix:
+            base = replaced_label
+        else:
+            base = os.path.basename((prefix or named)[0])
         env = self._environment(ctx)
         on_exit, required = self._exit_policy(resolver)
         spec = ProcessSpec(
@@ -671,11 +685,13 @@ class ExecuteProcess(Action):
             on_exit=on_exit,
             origin=self.origin,
             action=self,
-            node=self.node_info(resolver),
-            standin=standin,
+            node=node,
+            standin=standin if standin is not None else located,
             machine=machine,
         )
-        if self.remote_machine is None and spec.cwd is not None and not os.path.isdir(spec.cwd):
+        if temp_files:
+            spec.temp_files = (*spec.temp_files, *temp_files)
+        if not remote and spec.cwd is not None and not os.path.isdir(spec.cwd):
             raise MlaunchError(
                 f"working directory {spec.cwd!r} does not exist", where=self.origin, what=base
             )

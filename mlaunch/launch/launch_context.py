@@ -16,22 +16,30 @@ if TYPE_CHECKING:
 
 
 class Locals:
-    """Attribute access to the context locals (``context.locals.event``), as ROS 2 offers."""
+    """Attribute access to the context locals (``context.locals.event``), as ROS 2 offers.
 
-    def __init__(self, values: dict[str, Any]) -> None:
+    A local shadows a global of the same name, as in launch.
+    """
+
+    def __init__(self, values: dict[str, Any], globals_: dict[str, Any] | None = None) -> None:
         object.__setattr__(self, "_values", values)
+        object.__setattr__(self, "_globals", {} if globals_ is None else globals_)
 
     def __getattr__(self, name: str) -> Any:
-        try:
+        if name in self._values:
             return self._values[name]
+        try:
+            return self._globals[name]
         except KeyError:
             raise AttributeError(name) from None
 
     def __contains__(self, name: str) -> bool:
-        return name in self._values
+        return name in self._values or name in self._globals
 
     def get(self, name: str, default: Any = None) -> Any:
-        return self._values.get(name, default)
+        if name in self._values:
+            return self._values[name]
+        return self._globals.get(name, default)
 
 
 class LaunchContext:
@@ -51,6 +59,9 @@ class LaunchContext:
         self.argv = argv
         self.log_dir = log_dir
         self._locals: dict[str, Any] = {}
+        # One run's globals: shared (not copied) by every snapshot, so what a deferred action
+        # adds (launch_ros's count of node names) is seen by the whole run.
+        self._globals: dict[str, Any] = {}
         self._scopes: list[tuple[dict[str, Any], dict[str, str]]] = []
         self._warn = warn
 
@@ -58,13 +69,17 @@ class LaunchContext:
 
     @property
     def locals(self) -> Locals:
-        return Locals(self._locals)
+        return Locals(self._locals, self._globals)
 
     def get_locals_as_dict(self) -> dict[str, Any]:
-        return dict(self._locals)
+        return {**self._globals, **self._locals}
 
     def extend_locals(self, values: Mapping[str, Any]) -> None:
         self._locals.update(values)
+
+    def extend_globals(self, values: Mapping[str, Any]) -> None:
+        """Names visible through ``locals`` everywhere in this run, as launch's globals."""
+        self._globals.update(values)
 
     def perform_substitution(self, substitution: Any) -> str:
         from mlaunch.launch.substitutions import perform
@@ -112,6 +127,7 @@ class LaunchContext:
         copy.initial_environment = self.initial_environment
         copy.launch_configurations = dict(self.launch_configurations)
         copy._locals = dict(self._locals)
+        copy._globals = self._globals
         return copy
 
 

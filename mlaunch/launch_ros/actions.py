@@ -27,7 +27,7 @@ from collections.abc import Iterable, Mapping
 
 from mlaunch import standins
 from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
-from mlaunch.launch.actions import Action, ExecuteProcess
+from mlaunch.launch.actions import Action, ExecuteProcess, LaunchDescription
 from mlaunch.launch.substitutions import (
     SomeSubstitutionsType,
     Substitution,
@@ -47,12 +47,15 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.actions import LaunchDescriptionEntity
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.run.resolve import ResolveOptions, Resolver
+    from mlaunch.run.resolve import Resolver
 
 _xacro.register()
 
 Subs = tuple[Substitution, ...]
+# launch_ros's key for the count of full node names in the context globals.
+NODE_NAMES_KEY = "unique_ros_node_names"
 
 
 # --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
@@ -129,17 +132,16 @@ def _ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
     return tuple(context.launch_configurations.get("ros_remaps") or ())
 
 
-def apply_options(context: LaunchContext, options: ResolveOptions) -> None:
-    """What the CLI decided for every node: ``--use-sim-time`` / ``use_sim_time:=`` as a global.
+def with_use_sim_time(description: LaunchDescriptionEntity, value: bool) -> LaunchDescription:
+    """``mlaunch --use-sim-time``: the description opened by ``SetParameter('use_sim_time', ...)``.
 
-    Called by resolve() before the description is visited: ``use_sim_time`` becomes the first
-    global parameter, as if a SetParameter opened the launch file (a node's own parameters can
-    still override it, as they override any SetParameter).
+    An explicit action placed before the description, so ``use_sim_time`` is the first global
+    parameter of every node (a node's own parameters can still override it, as they override
+    any SetParameter).
     """
-    if options.use_sim_time is None:
-        return
-    entry = ("use_sim_time", bool(options.use_sim_time))
-    context.launch_configurations["global_params"] = (entry, *_global_params(context))
+    first = SetParameter("use_sim_time", bool(value))
+    first.origin = "--use-sim-time"
+    return LaunchDescription([first, description])
 
 
 class PushROSNamespace(Action):
@@ -302,10 +304,10 @@ class NodeNames(Record):
         return "/**"
 
 
-class _Resolved(Record):
-    """What one resolution of a Node found, for the spec hooks that run after command()."""
+class NodeCommand(Record):
+    """What one resolution of a Node found: its names, what runs, its command line."""
 
-    _fields = ("names", "package", "executable", "exe_argv", "standin", "temp_files")
+    _fields = ("names", "package", "executable", "exe_argv", "standin", "argv", "temp_files")
     __slots__ = _fields
 
     def __init__(
@@ -315,14 +317,16 @@ class _Resolved(Record):
         executable: str,
         exe_argv: list[str],
         standin: str | None,
+        argv: list[str],
         temp_files: tuple[str, ...],
     ) -> None:
         self.names = names
         self.package = package
         self.executable = executable
-        self.exe_argv = exe_argv
-        self.standin = standin
-        self.temp_files = temp_files
+        self.exe_argv = exe_argv  # the argv items that run the executable (or its stand-in)
+        self.standin = standin  # what a stand-in replaces, or None
+        self.argv = argv
+        self.temp_files = temp_files  # params files to remove with the process
 
 
 class Node(ExecuteProcess):
@@ -358,16 +362,18 @@ class Node(ExecuteProcess):
             None if ros_arguments is None else _items(ros_arguments, "ros_arguments")
         )
         self.arguments = [] if arguments is None else _items(arguments, "arguments")
-        self._resolved: _Resolved | None = None
+        # launch_ros's node_name and friends: the names of the last resolution (for launch-file
+        # code that reads them after the node was visited; resolving itself never reads them).
+        self.resolved_names: NodeNames | None = None
 
     # --- what launch_ros exposes ------------------------------------------------------------
 
     @property
     def node_name(self) -> str:
         """The full node name once resolved (with launch_ros's placeholders for unknown parts)."""
-        if self._resolved is None:
+        names = self.resolved_names
+        if names is None:
             raise RuntimeError("cannot access 'node_name' before executing action")
-        names = self._resolved.names
         return (
             prefix_namespace(
                 names.namespace or self.UNSPECIFIED_NODE_NAMESPACE,
@@ -377,21 +383,27 @@ class Node(ExecuteProcess):
         )
 
     def is_node_name_fully_specified(self) -> bool:
-        names = self._resolved.names if self._resolved else None
+        names = self.resolved_names
         return names is not None and names.name is not None and names.namespace is not None
 
     @property
     def expanded_node_namespace(self) -> str:
-        if self._resolved is None or self._resolved.names.namespace is None:
+        names = self.resolved_names
+        if names is None or names.namespace is None:
             return self.UNSPECIFIED_NODE_NAMESPACE
-        return self._resolved.names.namespace
+        return names.namespace
 
-    # --- the ExecuteProcess hooks ---------------------------------------------------------------
+    # --- resolving ------------------------------------------------------------------------------
 
-    def command(self, resolver: Resolver) -> list[str]:
+    def node_command(self, resolver: Resolver, *, remote: bool = False) -> NodeCommand:
+        """The node's names and launch_ros's command line for it, in the resolver's context.
+
+        ``remote``: the node runs on another computer (mlaunch.machines), which finds the
+        package's executable itself.
+        """
         ctx = resolver.context
         names = self._names(ctx)
-        package, executable, exe_argv, standin = self._executable(resolver)
+        package, executable, exe_argv, standin = self._executable(resolver, remote)
         argv = [*exe_argv, *(perform_substitutions(ctx, a) for a in self.arguments)]
         if self.ros_arguments is not None:
             argv += ["--ros-args", *(perform_substitutions(ctx, a) for a in self.ros_arguments)]
@@ -405,43 +417,34 @@ class Node(ExecuteProcess):
         argv += own
         for src, dst in self._remap_arguments(ctx):
             argv += ["-r", f"{src}:={dst}"]
-        self._resolved = _Resolved(names, package, executable, exe_argv, standin, temp_files)
-        return argv
+        return NodeCommand(names, package, executable, exe_argv, standin, argv, temp_files)
 
-    def label_base(self, resolver: Resolver, argv: list[str]) -> str:
-        resolved = self._resolved
-        # A stand-in is labelled as the program it replaces (unless a launch prefix leads).
-        if (
-            self.name is None
-            and resolved is not None
-            and resolved.standin is not None
-            and argv[: len(resolved.exe_argv)] == resolved.exe_argv
-        ):
-            return os.path.basename(resolved.executable)
-        return super().label_base(resolver, argv)
+    def command(self, resolver: Resolver) -> list[str]:
+        return self.node_command(resolver).argv
 
-    def node_info(self, resolver: Resolver) -> NodeInfo | None:
-        resolved = self._resolved
-        if resolved is None:
-            return None
-        return NodeInfo(
-            name=resolved.names.name,
-            namespace=resolved.names.namespace or "/",
-            package=resolved.package,
-            executable=resolved.executable,
+    def build_spec(self, resolver: Resolver) -> ProcessSpec:
+        machine = self._machine(resolver)
+        found = self.node_command(resolver, remote=machine is not None and not machine.local)
+        info = NodeInfo(
+            name=found.names.name,
+            namespace=found.names.namespace or "/",
+            package=found.package,
+            executable=found.executable,
             lifecycle=self.is_lifecycle,
             autostart=bool(getattr(self, "autostart", False)),
         )
-
-    def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        spec = super().build_spec(resolver)
-        resolved = self._resolved
-        assert resolved is not None
-        if resolved.standin is not None:
-            spec.standin = resolved.standin
-        if resolved.temp_files:
-            spec.temp_files = (*spec.temp_files, *resolved.temp_files)
-        self._track_name(resolver, resolved.names)
+        spec = self.process_spec(
+            resolver,
+            found.argv,
+            node=info,
+            # A stand-in is labelled as the program it replaces (unless a launch prefix leads).
+            replaced_label=None if found.standin is None else os.path.basename(found.executable),
+            standin=found.standin,
+            temp_files=found.temp_files,
+            machine=machine,
+        )
+        self._track_name(resolver.context, found.names)
+        self.resolved_names = found.names
         return spec
 
     # --- pieces -------------------------------------------------------------------------------
@@ -465,15 +468,17 @@ class Node(ExecuteProcess):
                 raise MlaunchError(f"node namespace {namespace!r} ({detail}) is invalid: {problem}")
         return NodeNames(name, namespace)
 
-    def _executable(self, resolver: Resolver) -> tuple[str | None, str, list[str], str | None]:
+    def _executable(
+        self, resolver: Resolver, remote: bool
+    ) -> tuple[str | None, str, list[str], str | None]:
         """(package, executable, argv items that run it, what a stand-in replaces)."""
         ctx = resolver.context
         executable = perform_substitutions(ctx, self.node_executable)
         if self.node_package is None:
             return None, executable, [executable], None
         package = perform_substitutions(ctx, self.node_package)
-        index = packages.for_context(ctx, resolver.options.package_path)
-        if self.remote_machine is not None:
+        index = packages.for_context(ctx)
+        if remote:
             # Found on that computer (mlaunch.machines.agent looks the package up there); this
             # computer's path is only a hint, and there are no stand-ins on other computers.
             return package, executable, [remote_executable(index, package, executable)], None
@@ -533,19 +538,23 @@ class Node(ExecuteProcess):
         ]
         return [*_ros_remaps(ctx), *own]
 
-    def _track_name(self, resolver: Resolver, names: NodeNames) -> None:
+    def _track_name(self, ctx: LaunchContext, names: NodeNames) -> None:
         """Warn when a second node gets the same full name (launch_ros's per-launch count).
 
-        Counted for every named node (namespace '/' when none is given); launch_ros only counts
-        nodes whose namespace is given too.
+        The count lives in the run's context globals, as launch_ros keeps it. Counted for every
+        named node (namespace '/' when none is given); launch_ros only counts nodes whose
+        namespace is given too.
         """
         fqn = names.fully_qualified
         if fqn is None:
             return
-        counts = _node_name_counts(resolver)
+        counts: dict[str, int] | None = ctx.locals.get(NODE_NAMES_KEY)
+        if counts is None:
+            counts = {}
+            ctx.extend_globals({NODE_NAMES_KEY: counts})
         counts[fqn] = counts.get(fqn, 0) + 1
         if counts[fqn] > 1:
-            resolver.warn(
+            ctx.warn(
                 f"{self.origin}: there are now at least {counts[fqn]} nodes with the name {fqn}"
                 " created within this launch context"
             )
@@ -588,16 +597,6 @@ def remote_executable(index: Any, package: str, executable: str) -> str:
         except MlaunchError:
             pass
     return f"{package}/{executable}"
-
-
-def _node_name_counts(resolver: Resolver) -> dict[str, int]:
-    # One count per launch: the label counter is the object every resolution of a run shares.
-    holder = resolver.labels
-    counts: dict[str, int] | None = getattr(holder, "ros_node_names", None)
-    if counts is None:
-        counts = {}
-        holder.ros_node_names = counts  # type: ignore[attr-defined]
-    return counts
 
 
 def _writes_files(entries: Iterable[Any]) -> bool:
@@ -665,9 +664,9 @@ __all__ = [
     "SetROSLogDir",
     "SetRemap",
     "SetUseSimTime",
-    "apply_options",
     "make_namespace_absolute",
     "namespace_problem",
     "node_name_problem",
     "prefix_namespace",
+    "with_use_sim_time",
 ]

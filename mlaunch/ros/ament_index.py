@@ -8,7 +8,8 @@ Installed packages (the ament index of ``AMENT_PREFIX_PATH``) always win.
 For a source package, "prefix" is its folder: ``get_package_prefix`` returns it and
 ``get_package_share_directory`` returns the same folder (not ``<prefix>/share/<pkg>``).
 
-The environment is the one the CLI configured (``packages.configure``), else ``os.environ``.
+The search (explicit folders, the launch file, the environment) is the one the running load or
+resolve made active (mlaunch.ros.search), else the default one on ``os.environ``.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import warnings
 # Not bound as ``packages``: compat serves ``ament_index_python.packages`` with this very module
 # and the import system then sets ``<this module>.packages`` to the module itself.
 from mlaunch.ros import packages as _packages
+from mlaunch.ros import search as _search
 from mlaunch.ros.packages import PackageNotFoundError
 
 RESOURCE_INDEX_SUBFOLDER = "share/ament_index/resource_index"
@@ -41,7 +43,7 @@ def _index() -> _packages.PackageIndex:
 
 def get_search_paths() -> list[str]:
     """The existing prefixes of AMENT_PREFIX_PATH (an OSError when it is unset, as in ROS 2)."""
-    environ = _packages.configured_environ()
+    environ = _search.active().environment()
     if not environ.get(AMENT_PREFIX_PATH_ENV_VAR):
         raise OSError(f"Environment variable '{AMENT_PREFIX_PATH_ENV_VAR}' is not set or empty")
     return _index().ament_prefixes()

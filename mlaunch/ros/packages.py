@@ -10,9 +10,9 @@ share directory is that folder itself, so ``$(find pkg)`` and ``FindPackageShare
 fresh checkout (a robot description, a config folder) without colcon. Source packages come from,
 in this order of precedence:
 
-1. explicit paths: ``configure(search_paths=...)`` (the CLI's ``--package-path``), the
-   resolver's ``ResolveOptions.package_path`` and ``MLAUNCH_PACKAGE_PATH`` (``os.pathsep``
-   separated); each is a package folder or a folder searched for package folders;
+1. explicit paths: the run's ``PackageSearch`` (mlaunch.ros.search: the CLI's
+   ``--package-path``) and ``MLAUNCH_PACKAGE_PATH`` (``os.pathsep`` separated); each is a
+   package folder or a folder searched for package folders;
 2. the source tree of each launch file in play (the CLI's launch file, the one being resolved,
    Python launch files running on the stack): from the file's folder up to the nearest folder
    holding ``.git``, ``pyproject.toml`` or ``COLCON_IGNORE`` (or, failing that, the folder above
@@ -32,6 +32,7 @@ import sys
 
 from mlaunch import errors
 from mlaunch.record import Record
+from mlaunch.ros.search import CONTEXT_KEY, PackageSearch, active
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -77,41 +78,14 @@ class Package(Record):
         return os.path.join(self.prefix, "lib", self.name)
 
 
-# --- configuration (the CLI calls configure() before loading and resolving) --------------------
-
-
-class _Settings:
-    def __init__(self) -> None:
-        self.search_paths: tuple[str, ...] = ()
-        self.launch_file: str | None = None
-        self.environ: Mapping[str, str] | None = None
-
-
-_settings = _Settings()
 _scan_cache: dict[str, dict[str, str]] = {}
 _root_cache: dict[str, str | None] = {}
 
 
-def configure(
-    search_paths: Sequence[str] = (),
-    launch_file: str | None = None,
-    environ: Mapping[str, str] | None = None,
-) -> None:
-    """Set the explicit source paths, the top launch file and the environment lookups use."""
-    _settings.search_paths = tuple(os.path.abspath(p) for p in search_paths if p)
-    _settings.launch_file = os.path.abspath(launch_file) if launch_file else None
-    _settings.environ = dict(environ) if environ is not None else None
-
-
-def reset() -> None:
-    """Forget the configuration and every cached scan (tests; a long-lived process)."""
-    configure()
+def forget_scans() -> None:
+    """Forget every cached scan of source folders (tests; a long-lived process)."""
     _scan_cache.clear()
     _root_cache.clear()
-
-
-def configured_environ() -> Mapping[str, str]:
-    return _settings.environ if _settings.environ is not None else os.environ
 
 
 # --- the index ------------------------------------------------------------------------------
@@ -266,21 +240,23 @@ def _is_program(path: str) -> bool:
 
 def index(
     *,
+    search: PackageSearch | None = None,
     environ: Mapping[str, str] | None = None,
     launch_files: Iterable[str | None] = (),
     extra_paths: Sequence[str] = (),
     from_callers: bool = False,
     from_cwd: bool = False,
 ) -> PackageIndex:
-    """The index for one lookup: the configuration plus what the caller knows.
+    """The index for one lookup: a search (the active one by default) plus what the caller knows.
 
     ``launch_files`` are the launch files in play (the one being resolved); ``from_callers``
     adds the launch files whose code is on the Python stack, for lookups that have no context
     (``get_package_share_directory`` called while a launch file loads); ``from_cwd`` adds the
     source tree of the working directory (``mlaunch PKG FILE`` has no launch file yet).
     """
+    search = active() if search is None else search
     starts: list[str] = []
-    candidates: list[str | None] = [*launch_files, _settings.launch_file]
+    candidates: list[str | None] = [*launch_files, search.launch_file]
     if from_callers:
         candidates.extend(_launch_files_on_stack())
     if from_cwd:
@@ -288,20 +264,21 @@ def index(
     for item in candidates:
         if item and item not in starts:
             starts.append(item)
-    explicit = (*_settings.search_paths, *(os.path.abspath(p) for p in extra_paths if p))
+    explicit = (*search.paths, *(os.path.abspath(p) for p in extra_paths if p))
     return PackageIndex(
-        environ=configured_environ() if environ is None else environ,
+        environ=search.environment() if environ is None else environ,
         explicit_paths=explicit,
         trees_from=tuple(starts),
     )
 
 
-def for_context(context: Any, extra_paths: Sequence[str] = ()) -> PackageIndex:
-    """The index while resolving: the context's environment and its current launch file."""
+def for_context(context: Any) -> PackageIndex:
+    """The index while resolving: the run's search, the context's environment and launch file."""
+    search = context.locals.get(CONTEXT_KEY)
     return index(
+        search=search if isinstance(search, PackageSearch) else None,
         environ=context.environment,
         launch_files=[context.current_launch_file_path],
-        extra_paths=extra_paths,
     )
 
 
@@ -470,23 +447,11 @@ __all__ = [
     "PackageIndex",
     "PackageNotFoundError",
     "check_name",
-    "configure",
     "find_launch_file",
     "for_context",
+    "forget_scans",
     "index",
     "package_name",
-    "reset",
     "scan",
     "source_root",
 ]
-
-
-def _apply_pending_settings() -> None:
-    """Settings the CLI recorded before this module was needed (see mlaunch.ros)."""
-    import mlaunch.ros
-
-    if mlaunch.ros.package_settings is not None:
-        configure(**mlaunch.ros.package_settings)
-
-
-_apply_pending_settings()

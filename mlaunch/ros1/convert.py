@@ -89,11 +89,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         path = os.path.abspath(opts.file)
         if not os.path.isfile(path):
             raise LaunchFileError(f"launch file {opts.file!r} does not exist")
-        from mlaunch.ros import packages
+        from mlaunch.ros.search import PackageSearch, searching
 
-        packages.configure(search_paths=opts.package_path, launch_file=path, environ=os.environ)
         output = None if opts.output in (None, "-") else opts.output
-        result = convert(path, _format_for(opts), output)
+        with searching(PackageSearch(opts.package_path, path, os.environ)):
+            result = convert(path, _format_for(opts), output)
         if output is None:
             sys.stdout.write(result)
         else:

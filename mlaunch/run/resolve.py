@@ -23,6 +23,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Mapping
     from typing import Any
 
+    from mlaunch.ros.search import PackageSearch, searching
+
 
 class LabelCounter:
     """ROS 2's global ``name-N`` counter, shared by everything resolved in one run."""
@@ -35,24 +37,24 @@ class LabelCounter:
 
 
 class ResolveOptions(Record):
-    """What the CLI decides about resolution."""
+    """What the caller decides about resolution, besides the description and its arguments.
 
-    _fields = ("standins", "use_sim_time", "package_path", "temp_dir", "extra")
+    ``packages`` is where ROS packages are looked for (a mlaunch.ros.search.PackageSearch,
+    None for the default search); ``temp_dir`` is where params files are written.
+    """
+
+    _fields = ("standins", "packages", "temp_dir")
     __slots__ = _fields
 
     def __init__(
         self,
         standins: bool = True,
-        use_sim_time: bool | None = None,
-        package_path: tuple[str, ...] = (),
+        packages: PackageSearch | None = None,
         temp_dir: str | None = None,
-        extra: dict[str, Any] | None = None,
     ) -> None:
         self.standins = standins
-        self.use_sim_time = use_sim_time
-        self.package_path = package_path
+        self.packages = packages
         self.temp_dir = temp_dir
-        self.extra: dict[str, Any] = {} if extra is None else extra
 
 
 class Resolver:
@@ -228,16 +230,13 @@ def resolve(
         warn=plan.warnings.append,
     )
     context.launch_configurations.update(arguments)
-    if options.use_sim_time is not None:
-        from mlaunch.launch_ros.actions import apply_options
-
-        apply_options(context, options)
     resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
-    if path is None:
-        resolver.visit(description)
-    else:
-        with context.file_locals(path):
+    with _package_search(options, context):
+        if path is None:
             resolver.visit(description)
+        else:
+            with context.file_locals(path):
+                resolver.visit(description)
     plan.warnings.extend(undeclared_argument_warnings(arguments, plan.arguments))
     return plan
 
@@ -256,13 +255,34 @@ def resolve_deferred(
     if event is not None:
         context.extend_locals({"event": event})
     resolver = Resolver(context, plan, labels=labels, options=options)
-    entities = deferred.entities
-    if deferred.callback is not None:
-        from mlaunch.launch.event_handlers import returned_entities
+    with _package_search(options, context):
+        entities = deferred.entities
+        if deferred.callback is not None:
+            from mlaunch.launch.event_handlers import returned_entities
 
-        entities = returned_entities(resolver.call_user(deferred.callback, event, context))
-    resolver.visit_all(entities)
+            entities = returned_entities(resolver.call_user(deferred.callback, event, context))
+        resolver.visit_all(entities)
     return plan
+
+
+class _NoSearch:
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc_info: object) -> None:
+        return None
+
+
+def _package_search(options: ResolveOptions, context: LaunchContext) -> _NoSearch | searching:
+    """The run's package search: in the context for Node and the ROS substitutions, and active
+    for ament_index_python calls of the launch-file code that resolving runs (included files
+    being loaded, OpaqueFunctions)."""
+    if options.packages is None:
+        return _NoSearch()
+    from mlaunch.ros.search import CONTEXT_KEY, searching
+
+    context.extend_globals({CONTEXT_KEY: options.packages})
+    return searching(options.packages)
 
 
 def undeclared_argument_warnings(

@@ -488,7 +488,10 @@ def run(opts: Any, settings: Settings) -> int:
             temp_dir=temp_dir,
             log_dir=log_dir,
         )
-        expectations = build_expectations(plan, settings, collector, bool(opts.use_sim_time))
+        # use_sim_time:=true is an ordinary launch argument; a file that declares it is
+        # expected to run on simulated time, as --use-sim-time is.
+        sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
+        expectations = build_expectations(plan, settings, collector, sim_time)
         return supervise(opts, settings, plan, options, labels, log_dir, path, expectations)
     finally:
         cli.remove_private_dir(temp_dir)
