@@ -21,7 +21,7 @@ import xacro
 from conftest import requires_rclpy
 from procutil import Running
 
-from mlaunch.launch.actions import GroupAction, LaunchDescription, OpaqueFunction
+from mlaunch.launch.actions import GroupAction, LaunchDescription
 from mlaunch.launch.substitutions import Command, LaunchConfiguration
 from mlaunch.launch_ros.actions import (
     Node,
@@ -29,7 +29,7 @@ from mlaunch.launch_ros.actions import (
     SetParameter,
     SetParametersFromFile,
     SetRemap,
-    apply_options,
+    with_use_sim_time,
 )
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterValue
 from mlaunch.ros import packages
@@ -103,11 +103,8 @@ def description(tmp_path: Path) -> LaunchDescription:
         remappings=[("chatter", "talk"), ("~/private", "secret")],
     )
     anonymous = Node(package="probe_pkg", executable="introspect", parameters=[{"only_mine": "x"}])
-    return LaunchDescription(
+    body = LaunchDescription(
         [
-            OpaqueFunction(
-                function=lambda ctx: apply_options(ctx, ResolveOptions(use_sim_time=True))
-            ),
             SetParameter("global_flag", True),
             SetParameter("global_rate", 2.5),
             SetParameter("global_list", [1, 2.5]),  # -p global_list:=[1.0, 2.5]
@@ -123,6 +120,7 @@ def description(tmp_path: Path) -> LaunchDescription:
             ),
         ]
     )
+    return with_use_sim_time(body, True)  # as mlaunch --use-sim-time runs it
 
 
 def start(spec: ProcessSpec) -> Running:
