@@ -24,6 +24,7 @@ if TYPE_CHECKING:
 SUBCOMMANDS = {
     "test": "mlaunch.smoke",
     "convert": "mlaunch.ros1.convert",
+    "export": "mlaunch.export",
 }
 
 
