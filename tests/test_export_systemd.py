@@ -118,7 +118,7 @@ def test_systemd_analyze_verify_accepts_the_units(tmp_path: Path) -> None:
 
 
 def test_bad_requests_are_clear_errors(tmp_path: Path) -> None:
-    done, out = export(tmp_path)
+    done, _ = export(tmp_path)
     assert done.returncode == 0
     again, _ = export(tmp_path)
     assert again.returncode == 2 and "is not empty" in again.stderr
