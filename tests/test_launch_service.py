@@ -169,3 +169,39 @@ def test_importable_as_launch_launch_service() -> None:
     module = importlib.import_module("launch")
     assert module.LaunchService is LaunchService
     assert importlib.import_module("launch.launch_service").LaunchService is LaunchService
+
+
+def test_run_async_leaves_the_event_loop_free() -> None:
+    import asyncio
+
+    screen = Screen()
+    service = LaunchService(screen=screen)
+    service.include_launch_description(LaunchDescription([python(SLEEPER)]))
+
+    async def main() -> tuple[int, bool]:
+        task = asyncio.ensure_future(service.run_async())
+        # This coroutine runs while the launch does: the loop is not blocked.
+        seen = await asyncio.to_thread(screen.wait_for, "up")
+        assert service.event_loop is asyncio.get_running_loop()
+        service.shutdown()
+        return await asyncio.wait_for(task, DEADLINE), seen
+
+    code, seen = asyncio.run(main())
+    assert (code, seen) == (0, True)
+    assert service.event_loop is None
+    assert b"process stopped by SIGINT" in screen.data
+
+
+def test_run_in_thread_notices_exits_without_signals() -> None:
+    screen = Screen()
+    service = LaunchService(screen=screen)
+    one_shot = python("print('once')", name="once")
+    service.include_launch_description(LaunchDescription([one_shot]))
+    thread = service.run_in_thread(shutdown_when_idle=False)
+    assert screen.wait_for("process has finished cleanly")
+    assert one_shot.return_code == 0
+    assert service._is_idle()
+    service.shutdown()
+    thread.join(DEADLINE)
+    assert not thread.is_alive()
+    assert service.return_code == 0

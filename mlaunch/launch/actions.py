@@ -561,6 +561,8 @@ class ExecuteProcess(Action):
     # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
     # (mlaunch.launch.launch_service fills it in; launch_testing looks processes up by it).
     process_details: dict[str, Any] | None = None
+    # The exit status of its last run (negative: killed by that signal); None until it exits.
+    return_code: int | None = None
 
     def __init__(
         self,
@@ -613,6 +615,8 @@ class ExecuteProcess(Action):
         self.emulate_tty = emulate_tty
         self.output = output
         self.log_cmd = log_cmd
+        # Kept for launch_pytest.tools, which reads output only of processes that cache it.
+        self.cached_output = cached_output
         self.on_exit = on_exit
         self.respawn = respawn
         self.respawn_delay = respawn_delay

@@ -75,6 +75,8 @@ class LaunchService:
         self._wake_w = -1
         self._running = False
         self._error = False
+        self._event_loop: Any = None
+        self.return_code: int | None = None
         # Called from the loop thread with ("started" | "exited", Process) for every process.
         self.listeners: list[Callable[[str, Process], None]] = []
 
@@ -125,8 +127,11 @@ class LaunchService:
         """
         if threading.current_thread() is not threading.main_thread():
             raise RuntimeError("LaunchService can only be run in the main thread")
+        return self._run_checked(shutdown_when_idle)
+
+    def _run_checked(self, shutdown_when_idle: bool, *, claimed: bool = False) -> int:
         with self._lock:
-            if self._running:
+            if self._running and not claimed:
                 raise RuntimeError("LaunchService.run() is already running")
             self._running = True
             pending, self._pending = self._pending, []
@@ -141,11 +146,48 @@ class LaunchService:
     async def run_async(self, *, shutdown_when_idle: bool = True) -> int:
         """``run()`` for callers inside a coroutine, as ROS 2's run_async.
 
-        mlaunch's supervisor owns the main thread's signals and its own selector loop, so the
-        launch runs to its end on this thread: other coroutines of the same asyncio loop wait
-        until it returns. Code that must run meanwhile belongs in another thread (tests do that).
+        The launch runs on a worker thread, so the asyncio loop keeps serving its other
+        coroutines meanwhile. mlaunch then installs no signal handlers (the caller's own loop
+        owns Ctrl-C: call ``shutdown()`` from it) and notices exits by polling every 50 ms.
         """
-        return self.run(shutdown_when_idle=shutdown_when_idle)
+        import asyncio
+
+        loop = asyncio.get_running_loop()
+        self._event_loop = loop
+        try:
+            return await loop.run_in_executor(None, self._run_checked, shutdown_when_idle)
+        finally:
+            self._event_loop = None
+
+    def run_in_thread(self, *, shutdown_when_idle: bool = True) -> threading.Thread:
+        """Start the launch on a thread of its own and return it (an mlaunch extension).
+
+        As with ``run_async``, no signal handlers are installed; ``shutdown()`` ends it.
+        ``return_code`` holds what ``run()`` would have returned once the thread has ended.
+        """
+        with self._lock:
+            if self._running:
+                raise RuntimeError("LaunchService.run() is already running")
+            self._running = True  # now, so a shutdown() right after this call is not lost
+
+        def target() -> None:
+            self.return_code = self._run_checked(shutdown_when_idle, claimed=True)
+
+        thread = threading.Thread(target=target, name="LaunchService", daemon=True)
+        thread.start()
+        return thread
+
+    @property
+    def event_loop(self) -> Any:
+        """The asyncio loop awaiting ``run_async()``; None when the service does not run so."""
+        return self._event_loop
+
+    def _is_idle(self) -> bool:
+        """Nothing runs and nothing is queued (always true when the service does not run)."""
+        supervisor = self._supervisor
+        if supervisor is None:
+            return True
+        return not self._calls and not any(p.running for p in supervisor.processes)
 
     # --- running --------------------------------------------------------------------------------
 
@@ -241,6 +283,8 @@ class LaunchService:
                 "env": dict(spec.env),
                 "pid": process.pid,
             }
+        elif what == "exited" and action is not None:
+            action.return_code = process.returncode
         for listener in self.listeners:
             listener(what, process)
 

@@ -24,6 +24,9 @@ class SignalWatch:
     def __init__(self, *, install: bool = True) -> None:
         self.install = install
         self.pending: list[int] = []
+        # Off the main thread Python delivers no signals to us: no handlers, no SIGCHLD, so the
+        # loop polls for exited children instead (a LaunchService run from a worker thread).
+        self.polling = False
         self._wake_r = self._wake_w = -1
         self._old_wakeup = -1
         self._old_handlers: dict[int, Any] = {}
@@ -33,9 +36,14 @@ class SignalWatch:
         self._wake_r, self._wake_w = os.pipe()
         os.set_blocking(self._wake_r, False)
         os.set_blocking(self._wake_w, False)
+        try:
+            # What was there before is put back at the end (an embedder may have its own).
+            self._old_wakeup = signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
+        except ValueError:  # not the main thread (threading costs start-up time to ask)
+            self.polling = True
+            self._close_pipe()
+            return
         selector.register(self._wake_r, selectors.EVENT_READ, self._drain_wakeup)
-        # What was there before is put back at the end (an embedder may have its own).
-        self._old_wakeup = signal.set_wakeup_fd(self._wake_w, warn_on_full_buffer=False)
         ours = (*STOP_SIGNALS, signal.SIGCHLD) if self.install else (signal.SIGCHLD,)
         self._old_handlers = {sig: signal.signal(sig, self._record) for sig in ours}
 
@@ -51,9 +59,14 @@ class SignalWatch:
 
     def stop(self) -> None:
         """Put back the handlers and wake-up fd that were there before ``start``."""
+        if self.polling:
+            return
         for sig, handler in self._old_handlers.items():
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
         signal.set_wakeup_fd(self._old_wakeup)
+        self._close_pipe()
+
+    def _close_pipe(self) -> None:
         for fd in (self._wake_r, self._wake_w):
             try:
                 os.close(fd)

@@ -171,7 +171,7 @@ class Supervisor:
             self.printer.flush()
         if self.guard is not None and self.guard.pending:
             self.guard.flush()  # this turn's +pgid/-pgid lines, in one write
-        if self.pipes.before_wait():
+        if self.pipes.before_wait() or self.signals.polling:
             timeout = POLL if timeout is None else min(timeout, POLL)
         ready = self.selector.select(timeout)
         for key, _ in ready:
