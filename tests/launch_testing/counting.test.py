@@ -9,10 +9,12 @@ import launch.actions
 import launch_testing
 import launch_testing.actions
 import launch_testing.asserts
+import pytest
 
 CHATTER = os.path.join(os.path.dirname(__file__), "chatter.py")
 
 
+@pytest.mark.launch_test
 def generate_test_description():
     chatter = launch.actions.ExecuteProcess(
         cmd=[sys.executable, CHATTER, "--count", "4", "world"], name="chatter", output="screen"

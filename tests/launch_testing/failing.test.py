@@ -10,10 +10,12 @@ import launch_testing
 import launch_testing.actions
 import launch_testing.asserts
 import launch_testing.markers
+import pytest
 
 CHATTER = os.path.join(os.path.dirname(__file__), "chatter.py")
 
 
+@pytest.mark.launch_test
 @launch_testing.markers.keep_alive
 def generate_test_description():
     quitter = launch.actions.ExecuteProcess(
