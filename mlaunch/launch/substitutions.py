@@ -294,6 +294,22 @@ class PathJoinSubstitution(Substitution):
         return "PathJoin(" + ", ".join(describe(p) for p in self.substitutions) + ")"
 
 
+class PathSubstitution(Substitution):
+    """A path that ``/`` extends into a PathJoinSubstitution (Jazzy's ``PathSubstitution``)."""
+
+    def __init__(self, path: SomeSubstitutionsType) -> None:
+        self.path = normalize(path)
+
+    def perform(self, context: LaunchContext) -> str:
+        return perform_substitutions(context, self.path)
+
+    def __truediv__(self, other: SomeSubstitutionsType) -> PathJoinSubstitution:
+        return PathJoinSubstitution([self, other])
+
+    def describe(self) -> str:
+        return f"Path({describe(self.path)})"
+
+
 class FindExecutable(Substitution):
     """The full path of a program on PATH (``$(find-exec name)``)."""
 
@@ -606,6 +622,7 @@ __all__ = [
     "EqualsSubstitution",
     "FileContent",
     "FindExecutable",
+    "PathSubstitution",
     "IfElseSubstitution",
     "LaunchConfiguration",
     "LaunchLogDir",
