@@ -249,6 +249,22 @@ def test_what_yaml_and_xml_cannot_write_is_a_clear_error(tmp_path: Path) -> None
     assert 'EnvironmentVariable("NOPE", default_value="a b")' in convert.convert(path, "py")
 
 
+def test_deep_nesting_converts_to_xml_and_yaml_and_is_refused_for_python(tmp_path: Path) -> None:
+    # 300 nested groups: past Python's default recursion limit (a RecursionError before).
+    body = '<node pkg="mlaunch_demo" type="talker" name="t"/>'
+    for _ in range(300):
+        body = f"<group>{body}</group>"
+    source = Path(write(tmp_path, "deep.launch", f"<launch>{body}</launch>\n"))
+    ros1 = plan_of(str(source), temp=tmp_path / "ros1")
+    for fmt in ("xml", "yaml"):
+        ros2 = plan_of(str(converted(source, fmt)), temp=tmp_path / fmt)
+        assert summarize(ros2) == summarize(ros1), fmt
+    # One Python expression cannot nest 300 calls (~200 parentheses): said, not written.
+    with pytest.raises(convert.ConversionError, match=r"would not compile .*\(--to xml") as err:
+        convert.convert(str(source), "py")
+    assert err.value.where == str(source)
+
+
 def test_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = write(tmp_path, "c.launch", '<launch>\n  <arg name="x" default="1"/>\n</launch>\n')
     assert convert.main([path]) == 0  # Python on standard output by default

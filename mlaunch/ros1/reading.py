@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 
+from mlaunch.frontends.limits import allow_deep_trees
 from mlaunch.ros1.elements import Element, parse_xml
 from mlaunch.ros1.mapping import NodeMapper, lower_gui
 from mlaunch.ros1.model import (
@@ -400,4 +401,5 @@ def _wrap(item: Item, conds: tuple[Cond, ...]) -> Item:
 
 def read(path: str) -> list[Item]:
     """The ROS 2 description (as the model) a roslaunch file maps to."""
+    allow_deep_trees()  # reading, building and converting the model are recursive walks
     return Reader(path).read()

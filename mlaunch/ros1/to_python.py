@@ -33,7 +33,15 @@ from mlaunch.ros1.model import (
     Value,
     Warn,
 )
-from mlaunch.ros1.writing import WIDTH, Source, comments, eval_pieces, file_header, wrap
+from mlaunch.ros1.writing import (
+    WIDTH,
+    ConversionError,
+    Source,
+    comments,
+    eval_pieces,
+    file_header,
+    wrap,
+)
 
 
 @dataclass
@@ -172,11 +180,13 @@ class PythonWriter:
         body = render(self.use("LaunchDescription", self.items(items)), 4, len("return "))
         header = file_header(self.source, '"""', '"""')
         imports = _imports(self.used)
-        return (
+        text = (
             f"{header}\n\n{imports}\n\n\n"
             "def generate_launch_description() -> LaunchDescription:\n"
             f"    return {body}\n"
         )
+        _check_compiles(text, self.source.path)
+        return text
 
     def items(self, items: list[Item]) -> Py:
         out: list[Any] = []
@@ -356,6 +366,19 @@ class PythonWriter:
         if isinstance(part, FileRef):
             return self.use("FileContent", self.value(part.path))
         raise TypeError(f"unknown substitution {part!r}")
+
+
+def _check_compiles(text: str, path: str) -> None:
+    """A converted file Python cannot read is an error here, not when it is launched."""
+    try:
+        compile(text, "<converted>", "exec")
+    except SyntaxError as e:
+        raise ConversionError(
+            f"the converted Python would not compile ({e.msg}, line {e.lineno}): the ROS 1 file"
+            " nests deeper than one Python expression can (~200 levels); write it as XML or"
+            " YAML (--to xml, --to yaml)",
+            where=path,
+        ) from e
 
 
 def pyliteral(value: Any) -> str:
