@@ -117,7 +117,8 @@ def test_a_cycle_that_changes_an_argument_each_time_stops_at_the_depth_limit(
         '    <arg name="n" value="$(var n)x"/>\n  </include>\n</launch>\n'
     )
     error = fails(path, env)
-    assert f"nest deeper than {DEPTH_LIMIT} levels" in error
+    assert f"nest deeper than {DEPTH_LIMIT} levels, mlaunch's limit (" in error
+    assert "includes deep, the innermost of grow.launch.xml at grow.launch.xml:3)" in error
     assert f"{path}:" in error
 
 

@@ -32,10 +32,19 @@ def allow_deep_trees() -> None:
         sys.setrecursionlimit(_RECURSION_LIMIT)
 
 
-def too_deep(where: str | None, what: str, limit: int = DEPTH_LIMIT) -> LaunchFileError:
-    """The error for a tree nested past ``limit`` levels at ``where``."""
+def too_deep(
+    where: str | None, what: str, limit: int = DEPTH_LIMIT, includes: IncludeChain | None = None
+) -> LaunchFileError:
+    """The error for a tree nested past ``limit`` levels at ``where`` (inside ``includes``)."""
+    inside = ""
+    if includes is not None and includes.entries:
+        path, origin, _, _ = includes.entries[-1]
+        inside = (
+            f" ({len(includes.entries)} includes deep, the innermost of {_name(path)}"
+            f" at {_name(origin)})"
+        )
     return LaunchFileError(
-        f"{what} nest deeper than {limit} levels, mlaunch's limit; flatten the launch"
+        f"{what} nest deeper than {limit} levels, mlaunch's limit{inside}; flatten the launch"
         " file (an include or group inside itself, or generated nesting?)",
         where=where,
     )

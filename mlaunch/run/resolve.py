@@ -80,7 +80,8 @@ class Resolver:
 
     def visit(self, entity: Any) -> None:
         if self.depth >= DEPTH_LIMIT:
-            raise too_deep(getattr(entity, "origin", None), "launch actions (groups, includes)")
+            origin = getattr(entity, "origin", None)
+            raise too_deep(origin, "launch actions (groups, includes)", includes=self.includes)
         self.depth += 1
         try:
             self._visit(entity)
