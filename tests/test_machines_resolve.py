@@ -16,6 +16,8 @@ from mlaunch.errors import MlaunchError
 from mlaunch.run.plan import Plan
 from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
+EXAMPLES_PREFIX = Path(__file__).resolve().parent.parent / "launches" / "examples" / "prefix"
+
 PY = """
 from launch import LaunchDescription
 from launch.actions import ExecuteProcess, GroupAction
@@ -134,3 +136,60 @@ def test_xml_machine_attribute_of_an_undeclared_machine_names_the_line(tmp_path:
     text = '<launch>\n  <executable cmd="a" machine="nowhere"/>\n</launch>\n'
     with pytest.raises(MlaunchError, match=r"m\.launch\.xml:2.*'nowhere' is not declared"):
         resolve_text(tmp_path, "xml", text)
+
+
+ROS1 = """<launch>
+  <arg name="host" default="robot-alias"/>
+  <machine name="robot" address="$(arg host)" user="ros" ssh-port="2200"
+           env-loader="/opt/env.sh" timeout="3" password="secret"/>
+  <machine name="gpu" address="gpu-alias" default="true"/>
+  <node pkg="mlaunch_demo" type="talker" name="a"/>
+  <node pkg="mlaunch_demo" type="talker" name="b" machine="robot"/>
+</launch>
+"""
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "py", "yaml", "xml"])
+def test_ros1_machines_run_and_convert_alike(tmp_path: Path, fmt: str) -> None:
+    from mlaunch.ros1.convert import convert
+
+    source = tmp_path / "m.launch"
+    source.write_text(ROS1)
+    path = source
+    if fmt != "ros1":
+        path = tmp_path / f"converted.launch.{fmt}"
+        path.write_text(convert(str(source), fmt, str(path)))
+    plan = resolve(
+        frontends.load(str(path)),
+        path=str(path),
+        arguments={},
+        environ={"PATH": os.environ["PATH"], "AMENT_PREFIX_PATH": str(EXAMPLES_PREFIX)},
+        options=ResolveOptions(temp_dir=str(tmp_path)),
+        labels=LabelCounter(),
+    )
+    machines = {
+        (s.node.name if s.node else s.label): s.machine and s.machine.describe()
+        for s in plan.processes()
+    }
+    assert machines == {
+        "a": "gpu (ssh gpu-alias)",
+        "b": "robot (ssh ros@robot-alias:2200, env-loader /opt/env.sh)",
+    }
+    if fmt == "ros1":
+        assert any("<machine password> is ignored" in w for w in plan.warnings)
+
+
+def test_ros1_node_on_an_undeclared_machine_is_a_located_error(tmp_path: Path) -> None:
+    path = tmp_path / "m.launch"
+    path.write_text(
+        '<launch>\n  <node pkg="mlaunch_demo" type="talker" name="t" machine="far"/>\n</launch>\n'
+    )
+    with pytest.raises(MlaunchError, match=r"m\.launch:2.*machine 'far' is not declared"):
+        resolve(
+            frontends.load(str(path)),
+            path=str(path),
+            arguments={},
+            environ={"PATH": os.environ["PATH"], "AMENT_PREFIX_PATH": str(EXAMPLES_PREFIX)},
+            options=ResolveOptions(temp_dir=str(tmp_path)),
+            labels=LabelCounter(),
+        )

@@ -256,7 +256,6 @@ def test_eval_types_arguments_as_roslaunch_does(tmp_path: Path) -> None:
         ('if="true" unless="false"', "cannot set both 'if' and 'unless'"),
         ('respawn="true" required="true"', "respawn and required cannot both be set"),
         ('output="loud"', "output='loud' is not valid; valid: log, screen"),
-        ('machine="far"', "machine='far' is not supported"),
     ],
 )
 def test_bad_node_attributes_are_located_errors(
@@ -273,10 +272,8 @@ def test_bad_node_attributes_are_located_errors(
     assert message in str(caught.value)
 
 
-def test_machine_tag_and_malformed_xml_are_errors(tmp_path: Path) -> None:
-    machine = write(tmp_path, "m.launch", '<launch>\n  <machine name="a" address="b"/>\n</launch>')
-    with pytest.raises(MlaunchError, match=r"m\.launch:2: <machine>: <machine> is not supported"):
-        frontends.load(machine)
+def test_malformed_xml_is_an_error(tmp_path: Path) -> None:
+    # <machine> and machine= are mlaunch.machines': tests/test_machines_resolve.py.
     broken = write(tmp_path, "x.launch", "<launch>\n  <node name='a'>\n</launch>\n")
     with pytest.raises(MlaunchError, match=r"x\.launch:3: malformed XML"):
         frontends.load(broken)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 from mlaunch.launch.actions import Action, SetLaunchConfiguration
 from mlaunch.ros1.eval import RoslaunchEval
 from mlaunch.ros1.model import (
+    MACHINE_FIELDS,
     AnonRef,
     ArgRef,
     CommandRef,
@@ -21,6 +22,7 @@ from mlaunch.ros1.model import (
     Group,
     Include,
     Item,
+    MachineItem,
     NodeItem,
     Part,
     Process,
@@ -121,6 +123,11 @@ def _action(item: Item) -> Any:
         source = AnyLaunchDescriptionSource(subs(item.path))
         arguments = [(name, subs(value)) for name, value in item.arguments]
         return core.IncludeLaunchDescription(source, launch_arguments=arguments)
+    if isinstance(item, MachineItem):
+        from mlaunch.machines.actions import Machine
+
+        optional = {k: subs(getattr(item, k)) for k, _ in MACHINE_FIELDS if getattr(item, k)}
+        return Machine(name=subs(item.name), address=subs(item.address), **optional)
     if isinstance(item, NodeItem):
         return ros.Node(**node_keywords(item))
     if isinstance(item, ProcessItem):
@@ -166,6 +173,8 @@ def process_keywords(item: Process) -> dict[str, Any]:
         kwargs["prefix"] = subs(item.prefix)
     if item.env:
         kwargs["additional_env"] = {_key(k): subs(v) for k, v in item.env}
+    if item.machine is not None:
+        kwargs["machine"] = subs(item.machine)
     return kwargs
 
 

@@ -177,6 +177,7 @@ class NodeMapper(ElementReader):
             required=node.required,
             prefix=node.prefix,
             env=node.env,
+            machine=node.machine,
         )
         spawn = NodeItem(
             origin=node.origin,

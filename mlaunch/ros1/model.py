@@ -189,6 +189,29 @@ class Include(Item):
 
 
 @dataclass(kw_only=True)
+class MachineItem(Item):
+    """``<machine>``: a computer nodes can run on (mlaunch.machines' Machine action)."""
+
+    name: Value
+    address: Value
+    user: Value | None = None
+    ssh_port: Value | None = None
+    env_loader: Value | None = None
+    default: Value | None = None
+    timeout: Value | None = None
+
+
+# MachineItem's optional fields and their roslaunch attribute names.
+MACHINE_FIELDS = (
+    ("user", "user"),
+    ("ssh_port", "ssh-port"),
+    ("env_loader", "env-loader"),
+    ("default", "default"),
+    ("timeout", "timeout"),
+)
+
+
+@dataclass(kw_only=True)
 class Process(Item):
     """Fields a node and a plain process share."""
 
@@ -198,6 +221,7 @@ class Process(Item):
     required: bool | Value = False
     prefix: Value | None = None
     env: list[tuple[Value, Value]] = field(default_factory=list)
+    machine: Value | None = None
 
 
 @dataclass(kw_only=True)

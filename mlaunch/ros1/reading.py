@@ -14,11 +14,13 @@ from mlaunch.frontends.limits import allow_deep_trees
 from mlaunch.ros1.elements import Element, parse_xml
 from mlaunch.ros1.mapping import NodeMapper, lower_gui
 from mlaunch.ros1.model import (
+    MACHINE_FIELDS,
     Cond,
     DeclareArg,
     Group,
     Include,
     Item,
+    MachineItem,
     NodeItem,
     Process,
     SetArg,
@@ -268,12 +270,22 @@ class Reader(ParamReader, NodeMapper):
         )
 
     def tag_machine(self, el: Element, scope: Scope, out: Out) -> None:
-        raise self.error(
-            el,
-            "<machine> is not supported: mlaunch starts every node on this computer (ROS 1's"
-            " remote machines over SSH have no ROS 2 launch equivalent; run one launch per"
-            " machine)",
+        item = MachineItem(
+            origin=self.origin(el),
+            condition=self.condition(el, scope),
+            name=self.attr(el, "name", scope, required=True) or (),
+            address=self.attr(el, "address", scope, required=True) or (),
         )
+        for field_name, attr_name in MACHINE_FIELDS:
+            setattr(item, field_name, self.attr(el, attr_name, scope))
+        if "password" in el.attrs:
+            item.warnings.append(
+                "<machine password> is ignored: mlaunch's ssh never prompts (BatchMode); use a key"
+            )
+        for old in ("ros-root", "ros-package-path", "ros-ip", "ros-host-name"):
+            if old in el.attrs:
+                item.warnings.append(f"<machine {old}> is ignored: use env-loader")
+        out.body.append(item)
 
     def tag_master(self, el: Element, scope: Scope, out: Out) -> None:
         out.body.append(
@@ -283,12 +295,6 @@ class Reader(ParamReader, NodeMapper):
     # --- nodes --------------------------------------------------------------------------------
 
     def tag_node(self, el: Element, scope: Scope, out: Out) -> None:
-        if "machine" in el.attrs:
-            raise self.error(
-                el,
-                f"machine={el.attrs['machine']!r} is not supported: mlaunch starts every node on"
-                " this computer",
-            )
         cond = self.condition(el, scope)
         node = NodeItem(
             origin=self.origin(el),
@@ -299,6 +305,7 @@ class Reader(ParamReader, NodeMapper):
             namespace=self.attr(el, "ns", scope),
             output=self.output(el, scope),
             prefix=self.attr(el, "launch-prefix", scope),
+            machine=self.attr(el, "machine", scope),
         )
         args = self.attr(el, "args", scope)
         node.arguments = split_arguments(args) if args is not None else []

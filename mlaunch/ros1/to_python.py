@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from mlaunch.ros1.model import (
+    MACHINE_FIELDS,
     AnonRef,
     ArgRef,
     CommandRef,
@@ -21,6 +22,7 @@ from mlaunch.ros1.model import (
     Group,
     Include,
     Item,
+    MachineItem,
     NodeItem,
     Part,
     Process,
@@ -142,6 +144,7 @@ IMPORTS = {
     "SetRemap": "launch_ros.actions",
     "ParameterValue": "launch_ros.parameter_descriptions",
     "FindPackageShare": "launch_ros.substitutions",
+    "Machine": "mlaunch.actions",
 }
 for _name in (
     "DeclareLaunchArgument",
@@ -245,6 +248,17 @@ class PythonWriter:
             return self.group(item, condition)
         if isinstance(item, Include):
             return self.include(item, condition)
+        if isinstance(item, MachineItem):
+            optional = {
+                k: self.value(getattr(item, k)) for k, _ in MACHINE_FIELDS if getattr(item, k)
+            }
+            return self.use(
+                "Machine",
+                name=self.value(item.name),
+                address=self.value(item.address),
+                **optional,
+                condition=condition,
+            )
         if isinstance(item, NodeItem):
             return self.node(item)
         if isinstance(item, ProcessItem):
@@ -316,6 +330,8 @@ class PythonWriter:
             keywords["additional_env"] = Py(
                 "dict", items=[(self.key(k), self.value(v)) for k, v in item.env]
             )
+        if item.machine is not None:
+            keywords["machine"] = self.value(item.machine)
         keywords["condition"] = self.condition(item.condition)
         return keywords
 

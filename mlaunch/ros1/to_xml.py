@@ -6,11 +6,13 @@ import re
 from xml.sax.saxutils import escape
 
 from mlaunch.ros1.model import (
+    MACHINE_FIELDS,
     DeclareArg,
     Dropped,
     Group,
     Include,
     Item,
+    MachineItem,
     NodeItem,
     Process,
     ProcessItem,
@@ -84,6 +86,7 @@ class XmlWriter:
             Include: "include",
             NodeItem: "node",
             ProcessItem: "executable",
+            MachineItem: "machine",
         }
         return names[type(item)]
 
@@ -121,6 +124,9 @@ class XmlWriter:
         elif isinstance(item, ProcessItem):
             attrs.append(("cmd", self.command_line(item.cmd)))
             attrs += self.process(item)
+        elif isinstance(item, MachineItem):
+            attrs += [("name", v(item.name)), ("address", v(item.address))]
+            attrs += [(a, v(getattr(item, k))) for k, a in MACHINE_FIELDS if getattr(item, k)]
         if item.condition is not None:
             key = "unless" if item.condition.unless else "if"
             attrs.append((key, v(item.condition.value)))
@@ -142,6 +148,8 @@ class XmlWriter:
             attrs.append(("required", v(item.required)))
         if item.prefix is not None:
             attrs.append(("launch-prefix", v(item.prefix)))
+        if item.machine is not None:
+            attrs.append(("machine", v(item.machine)))
         return attrs
 
     def children(self, item: Item, depth: int) -> list[str]:
