@@ -256,3 +256,17 @@ def test_the_agent_reaches_the_remote_through_env_loader(
     )  # fmt: skip
     done = run_mlaunch(str(path), env=env_for(sshd, token))
     assert "[sh-1] loader=yes" in done.stdout + done.stderr, done.stdout + done.stderr
+
+
+def test_mlaunch_test_works_across_machines(sshd: Server, tmp_path: Path, token: str) -> None:
+    path = write_launch(
+        tmp_path,
+        token,
+        ["ExecuteProcess(cmd=['sleep', '30'])", remote("echo remote-ready; exec sleep 30")],
+    )
+    done = run_mlaunch(
+        "test", str(path), "--hold", "0.2", "--expect-output", "sh-2:remote-ready",
+        env=env_for(sshd, token), timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert_nothing_left(token)
