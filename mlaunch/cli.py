@@ -458,6 +458,8 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
 
 def _spawner(plan: object, labels: object, run_id: str) -> Any:
     """The remote-process spawner when the launch declared other machines, else None."""
+    if not getattr(labels, "machines", None):
+        return None  # no Machine in the launch: mlaunch.machines is never imported
     from mlaunch.machines.spec import remote_machines
 
     if not remote_machines(labels):

@@ -193,3 +193,26 @@ def test_ros1_node_on_an_undeclared_machine_is_a_located_error(tmp_path: Path) -
             options=ResolveOptions(temp_dir=str(tmp_path)),
             labels=LabelCounter(),
         )
+
+
+def test_a_launch_without_machines_never_imports_them(tmp_path: Path) -> None:
+    import subprocess
+    import sys
+
+    path = tmp_path / "plain.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([ExecuteProcess(cmd=['true'])])\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-X", "importtime", "-m", "mlaunch", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "| mlaunch.run.supervisor" in done.stderr  # the run really happened
+    assert "mlaunch.machines" not in done.stderr

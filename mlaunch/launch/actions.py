@@ -45,6 +45,11 @@ if TYPE_CHECKING:
     from mlaunch.run.resolve import Resolver
 
 
+# The launch configuration PushMachine (or a default Machine) sets for the rest of its scope
+# (mlaunch.machines); here so that a launch without machines never imports that package.
+PUSHED_MACHINE = "mlaunch.machine"
+
+
 class LaunchDescriptionEntity:
     """Anything that can appear in a launch description."""
 
@@ -703,9 +708,8 @@ class ExecuteProcess(Action):
 
     def _machine(self, resolver: Resolver) -> Any:
         """The MachineSpec this process runs on, or None (no machine given or pushed)."""
-        from mlaunch.machines.spec import PUSHED
-
-        if self.machine is None and not resolver.context.launch_configurations.get(PUSHED):
+        pushed = resolver.context.launch_configurations.get(PUSHED_MACHINE)
+        if self.machine is None and not pushed:
             return None  # the common case: nothing of mlaunch.machines is imported
         from mlaunch.machines.actions import machine_for
 

@@ -11,9 +11,10 @@ launch configuration, so a scoped GroupAction keeps it inside.
 from __future__ import annotations
 
 from mlaunch.errors import LaunchFileError
+from mlaunch.launch.actions import PUSHED_MACHINE as PUSHED
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
-from mlaunch.machines.spec import DEFAULT_TIMEOUT, PUSHED, MachineSpec, check_name, declared
+from mlaunch.machines.spec import DEFAULT_TIMEOUT, MachineSpec, check_name, declared
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

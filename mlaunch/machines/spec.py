@@ -11,8 +11,6 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-# The launch configuration a PushMachine (or a default machine) sets for the rest of its scope.
-PUSHED = "mlaunch.machine"
 # ROS 1's default for <machine timeout>: seconds to wait for the connection.
 DEFAULT_TIMEOUT = 10.0
 
