@@ -17,44 +17,37 @@ rclpy and the message packages are imported inside main() only.
 from __future__ import annotations
 
 import argparse
-import array
 import json
 import math
 import os
 import sys
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from mlaunch.standins.common import StopFlag, install_stop_flag
 from mlaunch.standins.diffdrive import (
-    DiffDrive,
-    ImuParams,
-    LidarParams,
     ModelError,
-    ModelSpec,
     Pose2D,
     describe_model,
 )
-from mlaunch.standins.world import (
-    RESOURCE_PATH_VARS,
-    Disc,
-    NoiseSampler,
-    RayCaster,
-    Shape,
-    World,
-    WorldError,
-    clearance,
-    load_world,
-    seeded_rng,
+from mlaunch.standins.sim_topics import (
+    PROG,
+    Output,
+    make_outputs,
+    make_publisher,
+    make_subscription,
+    say,
+    tf_support,
+    warn,
 )
+from mlaunch.standins.simulation import STEP_NS, Schedule, Simulation
+from mlaunch.standins.world import RESOURCE_PATH_VARS, World, WorldError, load_world
 
-PROG = "mlaunch sim"
 SPAWN_TOPIC = "/mlaunch_sim/spawn"
 SPAWNED_TOPIC = "/mlaunch_sim/spawned"
-STEP_NS = 10_000_000  # fixed physics step: 10 ms of sim time
 CLOCK_RATE = 100.0  # /clock messages per second of sim time
 # Falling further behind real time than this (a suspended process, a slow machine) is not
 # caught up in a burst: the simulation just runs slower than asked, as Gazebo does.
@@ -67,16 +60,6 @@ STEPS_BETWEEN_SPINS = 10  # at most this many steps back to back before serving 
 
 class SimUsageError(Exception):
     """A command line the simulator cannot run with."""
-
-
-def say(message: str) -> None:
-    """One plain line on stdout (start-up and spawn notes)."""
-    print(f"{PROG}: {message}", flush=True)
-
-
-def warn(message: str) -> None:
-    """One plain line on stderr."""
-    print(f"{PROG}: warning: {message}", file=sys.stderr, flush=True)
 
 
 # ---------------------------------------------------------------- command line
@@ -238,159 +221,6 @@ def open_world(options: SimOptions, environ: Mapping[str, str]) -> World:
             where=options.world,
         )
     return load_world(found, environ)
-
-
-# ---------------------------------------------------------------- simulation state (no ROS)
-
-
-@dataclass
-class Schedule:
-    """Fires at a fixed rate of sim time (every step when the rate is 0, as in Gazebo)."""
-
-    period_ns: int
-    next_ns: int = 0
-
-    @staticmethod
-    def every(rate: float, start_ns: int) -> Schedule:
-        """A schedule at ``rate`` Hz whose first firing is at ``start_ns``."""
-        return Schedule(0 if rate <= 0 else max(1, round(1e9 / rate)), start_ns)
-
-    def due(self, now_ns: int) -> bool:
-        """True (and advance) when ``now_ns`` has reached the next firing."""
-        if now_ns < self.next_ns:
-            return False
-        self.next_ns += self.period_ns
-        if self.next_ns <= now_ns:  # skipped firings are dropped, keeping the phase
-            missed = (now_ns - self.next_ns) // self.period_ns + 1 if self.period_ns else 0
-            self.next_ns += missed * self.period_ns
-        return True
-
-
-@dataclass
-class SimRobot:
-    """One spawned model's moving state, noise streams and collision surroundings."""
-
-    spec: ModelSpec
-    spawn: Pose2D
-    z: float
-    drive: DiffDrive | None
-    obstacles: list[Shape]
-    lidar_noise: dict[str, NoiseSampler] = field(default_factory=dict)
-    imu_noise: dict[str, list[NoiseSampler]] = field(default_factory=dict)
-    forward_accel: float = 0.0
-
-    @property
-    def pose(self) -> Pose2D:
-        """Where the root link is now."""
-        return self.drive.pose if self.drive else self.spawn
-
-    def disc(self) -> Disc:
-        """The robot as an obstacle for the others' lidars and bumpers."""
-        p = self.pose
-        zmin, zmax = self.spec.height
-        return Disc(self.spec.name, p.x, p.y, self.spec.radius, self.z + zmin, self.z + zmax)
-
-
-class Simulation:
-    """The world, the robots, and a fixed-step clock; knows nothing about ROS."""
-
-    def __init__(self, world: World, seed: int, step_ns: int = STEP_NS):
-        self.world = world
-        self.seed = seed
-        self.step_ns = step_ns
-        self.now_ns = 0
-        self.caster = RayCaster(world.shapes)
-        self.robots: dict[str, SimRobot] = {}
-
-    def add_robot(self, spec: ModelSpec, spawn: Pose2D) -> SimRobot:
-        """Place a described model at its spawn pose, resting on the ground.
-
-        Gazebo drops a model spawned at any height onto the ground plane; the stand-in puts it
-        there at once, its lowest collision point at z = 0.
-        """
-        z = -spec.height[0]
-        drive = None
-        if spec.drive:
-            drive = DiffDrive(
-                separation=spec.drive.wheel_separation,
-                wheel_radius=spec.drive.wheel_diameter / 2,
-                max_wheel_acceleration=spec.drive.max_wheel_acceleration,
-                pivot=spec.axle,
-                pose=spawn,
-            )
-        zmin, zmax = spec.height
-        # A small floor margin: kerbs and floor tiles lower than 2 cm do not stop the robot.
-        near = [s for s in self.world.shapes if s.zmax > z + max(zmin, 0.02) and s.zmin < z + zmax]
-        robot = SimRobot(spec, spawn, z, drive, near)
-        for lidar in spec.lidars:
-            robot.lidar_noise[lidar.name] = lidar.noise.sampler(
-                seeded_rng(self.seed, spec.name, lidar.name)
-            )
-        for imu in spec.imus:
-            rng = seeded_rng(self.seed, spec.name, imu.name)
-            robot.imu_noise[imu.name] = [
-                n.sampler(rng) for n in (*imu.angular_velocity, *imu.linear_acceleration)
-            ]
-        self.robots[spec.name] = robot
-        return robot
-
-    def step(self) -> None:
-        """Advance one fixed step: every drive moves unless it would hit something."""
-        dt = self.step_ns / 1e9
-        for robot in self.robots.values():
-            if robot.drive is None:
-                continue
-            before = robot.drive.linear
-            robot.drive.step(dt, self._blocker(robot))
-            robot.forward_accel = (robot.drive.linear - before) / dt
-        self.now_ns += self.step_ns
-
-    def _blocker(self, robot: SimRobot) -> Callable[[Pose2D], bool]:
-        others = [r.disc() for r in self.robots.values() if r is not robot]
-        shapes: list[Shape] = [*robot.obstacles, *others]
-        zmin, zmax = robot.z + robot.spec.height[0], robot.z + robot.spec.height[1]
-        radius = robot.spec.radius
-
-        def blocked(candidate: Pose2D) -> bool:
-            after = clearance(shapes, candidate.x, candidate.y, radius, zmin, zmax)
-            if after >= 0:
-                return False
-            # Already touching (spawned inside something): moves that free the robot are allowed.
-            now = robot.pose
-            return after < clearance(shapes, now.x, now.y, radius, zmin, zmax)
-
-        return blocked
-
-    def scan(self, robot: SimRobot, lidar: LidarParams) -> list[float]:
-        """One noisy scan: exact ray casts, then Gazebo's noise clamped to the range limits."""
-        p = robot.pose
-        m = lidar.mount
-        c, s = math.cos(p.yaw), math.sin(p.yaw)
-        x, y = p.x + c * m.x - s * m.y, p.y + s * m.x + c * m.y
-        others = [r.disc() for r in self.robots.values() if r is not robot]
-        ranges = self.caster.scan(
-            x, y, robot.z + m.z, p.yaw + m.yaw, lidar.scan, others, m.upside_down
-        )
-        noise = robot.lidar_noise[lidar.name]
-        if noise.noise.is_zero:
-            return ranges
-        lo, hi = lidar.scan.range_min, lidar.scan.range_max
-        return [r if r == math.inf else min(hi, max(lo, noise.apply(r))) for r in ranges]
-
-    def imu(self, robot: SimRobot, imu: ImuParams) -> tuple[float, list[float]]:
-        """(yaw, [wx, wy, wz, ax, ay, az]) in the sensor frame, noise applied."""
-        drive = robot.drive
-        v = drive.linear if drive else 0.0
-        w = drive.angular if drive else 0.0
-        # Body-frame specific force: forward acceleration, centripetal v*w, and gravity's reaction.
-        ax, ay = robot.forward_accel, v * w
-        c, s = math.cos(-imu.mount.yaw), math.sin(-imu.mount.yaw)
-        raw = [0.0, 0.0, w, c * ax - s * ay, s * ax + c * ay, -self.world.gravity[2]]
-        values = [n.apply(value) for n, value in zip(robot.imu_noise[imu.name], raw, strict=True)]
-        yaw = robot.pose.yaw + imu.mount.yaw
-        if imu.initial_orientation_as_reference:
-            yaw -= robot.spawn.yaw + imu.mount.yaw
-        return yaw, values
 
 
 # ---------------------------------------------------------------- spawn requests
@@ -609,26 +439,6 @@ def _loop(sim: Simulation, bridge: RosBridge, executor: Any, rtf: float, stop: S
         unserved = 0
 
 
-def _publisher(node: Any, msg_type: Any, topic: str, qos: Any) -> Any:
-    """A publisher without rclpy's default QoS-event handlers.
-
-    Each default handler joins every wait set, and rclpy rebuilds the wait set on each spin:
-    with a dozen topics that was most of the simulator's CPU time at 100 steps per second.
-    """
-    from rclpy.event_handler import PublisherEventCallbacks
-
-    callbacks = PublisherEventCallbacks(use_default_callbacks=False)
-    return node.create_publisher(msg_type, topic, qos, event_callbacks=callbacks)
-
-
-def _subscription(node: Any, msg_type: Any, topic: str, callback: Any, qos: Any) -> Any:
-    """A subscription without rclpy's default QoS-event handlers (see _publisher)."""
-    from rclpy.event_handler import SubscriptionEventCallbacks
-
-    callbacks = SubscriptionEventCallbacks(use_default_callbacks=False)
-    return node.create_subscription(msg_type, topic, callback, qos, event_callbacks=callbacks)
-
-
 class RosBridge:
     """Publishers, subscriptions and reused messages around one Simulation."""
 
@@ -646,14 +456,14 @@ class RosBridge:
             durability=DurabilityPolicy.TRANSIENT_LOCAL,
         )
         self.clock_msg = Clock()
-        self.clock_pub = _publisher(node, Clock, "/clock", self.sensor_qos)
+        self.clock_pub = make_publisher(node, Clock, "/clock", self.sensor_qos)
         self.clock_schedule = Schedule.every(clock_rate, 0)
         self.String = String
-        self.spawned_pub = _publisher(node, String, SPAWNED_TOPIC, latched)
-        _subscription(node, String, SPAWN_TOPIC, self.on_spawn, latched)
+        self.spawned_pub = make_publisher(node, String, SPAWNED_TOPIC, latched)
+        make_subscription(node, String, SPAWN_TOPIC, self.on_spawn, latched)
         self.outputs: list[Output] = []
         self.answered: dict[str, str] = {}  # request id -> reply
-        self.tf = _tf_support()
+        self.tf = tf_support()
 
     # -- spawning
 
@@ -730,239 +540,6 @@ class RosBridge:
         for output in self.outputs:
             if output.schedule.due(now):
                 output.publish(sec, nanosec)
-
-
-@dataclass
-class Output:
-    """One periodic publication: when (sim-time schedule) and how (a closure over a message)."""
-
-    schedule: Schedule
-    publish: Callable[[int, int], None]
-
-
-def _tf_support() -> Any:
-    """tf2_msgs' TFMessage when installed (it is not in the PyPI ROS wheels), else None."""
-    try:
-        from tf2_msgs.msg import TFMessage
-    except ImportError:
-        return None
-    return TFMessage
-
-
-def make_outputs(node: Any, sim: Simulation, robot: SimRobot, qos: Any, tf: Any) -> list[Output]:
-    """Publishers and closures for every topic a spawned robot serves."""
-    spec = robot.spec
-    outputs: list[Output] = []
-    start = sim.now_ns
-    if spec.drive and robot.drive:
-        drive = robot.drive
-        _subscribe_cmd_vel(node, spec, drive)
-        if spec.drive.publish_odom:
-            outputs.append(
-                Output(
-                    Schedule.every(spec.drive.update_rate, start), _odom_publisher(node, robot, qos)
-                )
-            )
-        if tf is not None and spec.drive.publish_odom_tf:
-            outputs.append(
-                Output(
-                    Schedule.every(spec.drive.update_rate, start), _tf_publisher(node, robot, tf)
-                )
-            )
-    if spec.joint_states:
-        outputs.append(
-            Output(
-                Schedule.every(spec.joint_states.update_rate, start),
-                _joint_state_publisher(node, robot, qos),
-            )
-        )
-    for lidar in spec.lidars:
-        outputs.append(
-            Output(
-                Schedule.every(lidar.update_rate, start),
-                _scan_publisher(node, sim, robot, lidar, qos),
-            )
-        )
-    for imu in spec.imus:
-        outputs.append(
-            Output(
-                Schedule.every(imu.update_rate, start), _imu_publisher(node, sim, robot, imu, qos)
-            )
-        )
-    return outputs
-
-
-def _subscribe_cmd_vel(node: Any, spec: ModelSpec, drive: DiffDrive) -> None:
-    from geometry_msgs.msg import Twist
-
-    warned = [False]
-
-    def on_twist(msg: Any) -> None:
-        linear, angular = msg.linear.x, msg.angular.z
-        if not (math.isfinite(linear) and math.isfinite(angular)):
-            if not warned[0]:
-                warn(f"model {spec.name!r}: ignoring non-finite cmd_vel ({linear}, {angular})")
-                warned[0] = True
-            return
-        drive.command(linear, angular)
-
-    assert spec.drive is not None
-    _subscription(node, Twist, spec.drive.cmd_topic, on_twist, 10)
-
-
-def _quaternion(msg: Any, yaw: float) -> None:
-    msg.x = 0.0
-    msg.y = 0.0
-    msg.z = math.sin(yaw / 2)
-    msg.w = math.cos(yaw / 2)
-
-
-def _odom_publisher(node: Any, robot: SimRobot, qos: Any) -> Callable[[int, int], None]:
-    from nav_msgs.msg import Odometry
-
-    params = robot.spec.drive
-    drive = robot.drive
-    assert params is not None and drive is not None
-    msg = Odometry()
-    msg.header.frame_id = params.odometry_frame
-    msg.child_frame_id = params.robot_base_frame
-    cx, cy, cyaw = params.covariance
-    covariance = [0.0] * 36
-    covariance[0], covariance[7], covariance[35] = cx, cy, cyaw
-    covariance[14] = covariance[21] = covariance[28] = 1e12  # z, roll, pitch are not estimated
-    msg.pose.covariance = covariance
-    msg.twist.covariance = covariance
-    msg.pose.pose.position.z = robot.z
-    publisher = _publisher(node, Odometry, params.odom_topic, qos)
-    spawn = robot.spawn
-
-    def publish(sec: int, nanosec: int) -> None:
-        pose = drive.pose
-        if params.odometry_source == 0:  # encoder odometry starts at zero where it was spawned
-            dx, dy = pose.x - spawn.x, pose.y - spawn.y
-            c, s = math.cos(-spawn.yaw), math.sin(-spawn.yaw)
-            pose = Pose2D(c * dx - s * dy, s * dx + c * dy, pose.yaw - spawn.yaw)
-        msg.header.stamp.sec = sec
-        msg.header.stamp.nanosec = nanosec
-        msg.pose.pose.position.x = pose.x
-        msg.pose.pose.position.y = pose.y
-        _quaternion(msg.pose.pose.orientation, pose.yaw)
-        msg.twist.twist.linear.x = drive.linear
-        msg.twist.twist.angular.z = drive.angular
-        publisher.publish(msg)
-
-    return publish
-
-
-def _tf_publisher(node: Any, robot: SimRobot, tf_type: Any) -> Callable[[int, int], None]:
-    from geometry_msgs.msg import TransformStamped
-
-    params = robot.spec.drive
-    drive = robot.drive
-    assert params is not None and drive is not None
-    transform = TransformStamped()
-    transform.header.frame_id = params.odometry_frame
-    transform.child_frame_id = params.robot_base_frame
-    transform.transform.translation.z = robot.z
-    msg = tf_type()
-    publisher = _publisher(node, tf_type, "/tf", 100)
-
-    def publish(sec: int, nanosec: int) -> None:
-        transform.header.stamp.sec = sec
-        transform.header.stamp.nanosec = nanosec
-        transform.transform.translation.x = drive.pose.x
-        transform.transform.translation.y = drive.pose.y
-        _quaternion(transform.transform.rotation, drive.pose.yaw)
-        msg.transforms = [transform]
-        publisher.publish(msg)
-
-    return publish
-
-
-def _joint_state_publisher(node: Any, robot: SimRobot, qos: Any) -> Callable[[int, int], None]:
-    from sensor_msgs.msg import JointState
-
-    spec = robot.spec
-    assert spec.joint_states is not None
-    names = list(spec.joint_states.joints) or [j.name for j in spec.robot.movable_joints()]
-    left = set(spec.drive.left_joints) if spec.drive else set()
-    right = set(spec.drive.right_joints) if spec.drive else set()
-    msg = JointState()
-    msg.name = names
-    publisher = _publisher(node, JointState, spec.joint_states.topic, qos)
-    drive = robot.drive
-
-    def publish(sec: int, nanosec: int) -> None:
-        positions = [0.0] * len(names)
-        velocities = [0.0] * len(names)
-        if drive is not None:
-            radius = drive.wheel_radius
-            for i, joint in enumerate(names):
-                if joint in left:
-                    positions[i], velocities[i] = drive.left_angle, drive.left_speed / radius
-                elif joint in right:
-                    positions[i], velocities[i] = drive.right_angle, drive.right_speed / radius
-        msg.header.stamp.sec = sec
-        msg.header.stamp.nanosec = nanosec
-        msg.position = array.array("d", positions)
-        msg.velocity = array.array("d", velocities)
-        publisher.publish(msg)
-
-    return publish
-
-
-def _scan_publisher(
-    node: Any, sim: Simulation, robot: SimRobot, lidar: LidarParams, qos: Any
-) -> Callable[[int, int], None]:
-    from sensor_msgs.msg import LaserScan
-
-    msg = LaserScan()
-    msg.header.frame_id = lidar.frame_id
-    msg.angle_min = lidar.scan.angle_min
-    msg.angle_max = lidar.scan.angle_max
-    msg.angle_increment = lidar.scan.increment
-    msg.time_increment = 0.0
-    msg.scan_time = 0.0 if lidar.update_rate <= 0 else 1.0 / lidar.update_rate
-    msg.range_min = lidar.scan.range_min
-    msg.range_max = lidar.scan.range_max
-    msg.intensities = array.array("f", [0.0] * lidar.scan.samples)
-    publisher = _publisher(node, LaserScan, lidar.topic, qos)
-
-    def publish(sec: int, nanosec: int) -> None:
-        msg.header.stamp.sec = sec
-        msg.header.stamp.nanosec = nanosec
-        msg.ranges = array.array("f", sim.scan(robot, lidar))
-        publisher.publish(msg)
-
-    return publish
-
-
-def _imu_publisher(
-    node: Any, sim: Simulation, robot: SimRobot, imu: ImuParams, qos: Any
-) -> Callable[[int, int], None]:
-    from sensor_msgs.msg import Imu
-
-    msg = Imu()
-    msg.header.frame_id = imu.frame_id
-    gyro = [0.0] * 9
-    accel = [0.0] * 9
-    for i in range(3):
-        gyro[4 * i] = imu.angular_velocity[i].stddev ** 2
-        accel[4 * i] = imu.linear_acceleration[i].stddev ** 2
-    msg.angular_velocity_covariance = gyro
-    msg.linear_acceleration_covariance = accel
-    publisher = _publisher(node, Imu, imu.topic, qos)
-
-    def publish(sec: int, nanosec: int) -> None:
-        yaw, (wx, wy, wz, ax, ay, az) = sim.imu(robot, imu)
-        msg.header.stamp.sec = sec
-        msg.header.stamp.nanosec = nanosec
-        _quaternion(msg.orientation, yaw)
-        msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = wx, wy, wz
-        msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, az
-        publisher.publish(msg)
-
-    return publish
 
 
 if __name__ == "__main__":
