@@ -14,153 +14,38 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+from mlaunch.standins.plugins import (
+    CLASSIC_DIFF_DRIVE,
+    CLASSIC_JOINT_STATES,
+    DEFAULT_JOINT_STATE_RATE,
+    GZ_DIFF_DRIVE,
+    GZ_JOINT_STATES,
+    IMU_TYPES,
+    LIDAR_TYPES,
+    ModelError,
+    expand_topic,
+    parse_ros_block,
+    plugin_kind,
+    positive,
+    read_bool,
+    read_float,
+    read_int,
+    read_text,
+    where_of,
+)
+from mlaunch.standins.plugins import (
+    RosNames as RosNames,  # re-exported: tests and callers know it from here
+)
+from mlaunch.standins.sensors import ImuParams, LidarParams, Mount, parse_imu, parse_lidar
 from mlaunch.standins.urdf import Geometry, Robot
 from mlaunch.standins.world import (
     Disc,
-    GaussianNoise,
     Pose3,
-    ScanGeometry,
     Shape,
     box_shape,
     cylinder_shape,
     sphere_shape,
 )
-
-# Plugin file names, with and without the lib prefix / .so suffix (gz accepts both spellings).
-CLASSIC_DIFF_DRIVE = "gazebo_ros_diff_drive"
-CLASSIC_JOINT_STATES = "gazebo_ros_joint_state_publisher"
-CLASSIC_RAY = "gazebo_ros_ray_sensor"
-CLASSIC_IMU = "gazebo_ros_imu_sensor"
-GZ_DIFF_DRIVE = ("gz-sim-diff-drive-system", "ignition-gazebo-diff-drive-system")
-GZ_JOINT_STATES = (
-    "gz-sim-joint-state-publisher-system",
-    "ignition-gazebo-joint-state-publisher-system",
-)
-LIDAR_TYPES = ("ray", "gpu_ray", "lidar", "gpu_lidar")
-IMU_TYPES = ("imu",)
-# Joint states are published at this rate when no joint state plugin says otherwise.
-DEFAULT_JOINT_STATE_RATE = 50.0
-
-
-class ModelError(ValueError):
-    """A plugin or sensor block the simulator cannot use; the message names it and the value."""
-
-
-def plugin_kind(filename: str) -> str:
-    """The plugin's library name without ``lib`` prefix and ``.so`` suffix."""
-    name = filename.strip().rsplit("/", 1)[-1]
-    name = name.removesuffix(".so")
-    return name.removeprefix("lib")
-
-
-# ---------------------------------------------------------------- ROS names
-
-
-def expand_topic(name: str, namespace: str, node: str) -> str:
-    """A topic name made absolute the ROS 2 way: ``~`` is the node, relative joins the namespace."""
-    ns = "/" + namespace.strip("/") if namespace.strip("/") else ""
-    if name == "~" or name.startswith("~/"):
-        return f"{ns}/{node}{name[1:]}"
-    if name.startswith("/"):
-        return name
-    return f"{ns}/{name}"
-
-
-@dataclass(frozen=True)
-class RosNames:
-    """A gazebo_ros plugin's node: its namespace, name and remappings, for resolving topics."""
-
-    namespace: str = "/"
-    node: str = "gazebo_plugin"
-    remaps: tuple[tuple[str, str], ...] = ()
-
-    def resolve(self, name: str) -> str:
-        """The absolute topic ``name`` ends up on, after the first matching remapping."""
-        full = expand_topic(name, self.namespace, self.node)
-        for source, target in self.remaps:
-            if expand_topic(source, self.namespace, self.node) == full:
-                return expand_topic(target, self.namespace, self.node)
-        return full
-
-
-def parse_ros_block(plugin: ET.Element, robot_namespace: str = "") -> RosNames:
-    """Read ``<ros><namespace>/<remapping>/<argument>`` of a gazebo_ros plugin.
-
-    ``robot_namespace`` (spawn_entity's -robot_namespace) replaces every plugin's namespace, as
-    spawn_entity.py rewrites the ``<namespace>`` elements before handing the model to Gazebo.
-    """
-    ros = plugin.find("ros")
-    namespace = ""
-    remaps: list[tuple[str, str]] = []
-    if ros is not None:
-        namespace = (ros.findtext("namespace") or "").strip()
-        rules = [(e.text or "").strip() for e in ros.findall("remapping")]
-        rules += [(e.text or "").strip() for e in ros.findall("argument")]
-        for rule in rules:
-            if ":=" not in rule:
-                continue  # e.g. "--ros-args" or "-r" in the older <argument> spelling
-            source, target = (part.strip() for part in rule.split(":=", 1))
-            if source == "__ns":
-                namespace = target
-            elif source and target and not source.startswith("__"):
-                remaps.append((source, target))
-    if robot_namespace:
-        namespace = robot_namespace
-    node = plugin.get("name") or plugin_kind(plugin.get("filename", "plugin"))
-    return RosNames("/" + namespace.strip("/"), node, tuple(remaps))
-
-
-# ---------------------------------------------------------------- element values
-
-
-def _where(plugin: ET.Element) -> str:
-    return f"plugin {plugin.get('name', '?')!r} ({plugin.get('filename', '?')})"
-
-
-def _float(holder: ET.Element, tag: str, default: float, where: str) -> float:
-    text = holder.findtext(tag)
-    if text is None or not text.strip():
-        return default
-    try:
-        value = float(text)
-    except ValueError:
-        raise ModelError(f"{where}: <{tag}> is {text.strip()!r}, not a number") from None
-    if not math.isfinite(value):
-        raise ModelError(f"{where}: <{tag}> is {text.strip()!r}, not a finite number")
-    return value
-
-
-def _int(holder: ET.Element, tag: str, default: int, where: str) -> int:
-    value = _float(holder, tag, float(default), where)
-    if value != int(value) or value < 0:
-        raise ModelError(
-            f"{where}: <{tag}> is {holder.findtext(tag)!r}, expected a whole number >= 0"
-        )
-    return int(value)
-
-
-def _bool(holder: ET.Element, tag: str, default: bool, where: str) -> bool:
-    text = holder.findtext(tag)
-    if text is None or not text.strip():
-        return default
-    value = text.strip().lower()
-    if value in ("true", "1"):
-        return True
-    if value in ("false", "0"):
-        return False
-    raise ModelError(f"{where}: <{tag}> is {text.strip()!r}; expected true or false")
-
-
-def _text(holder: ET.Element, tag: str, default: str) -> str:
-    text = holder.findtext(tag)
-    return text.strip() if text is not None and text.strip() else default
-
-
-def _positive(value: float, what: str, where: str) -> float:
-    if value <= 0:
-        raise ModelError(f"{where}: {what} is {value!r}; it must be positive")
-    return value
-
 
 # ---------------------------------------------------------------- diff drive
 
@@ -191,12 +76,12 @@ class DiffDriveParams:
 
 def parse_classic_diff_drive(plugin: ET.Element, robot_namespace: str = "") -> DiffDriveParams:
     """libgazebo_ros_diff_drive.so: topics ``cmd_vel``/``odom`` in the plugin's namespace."""
-    where = _where(plugin)
+    where = where_of(plugin)
     names = parse_ros_block(plugin, robot_namespace)
     left = tuple(_joint_names(plugin, "left_joint"))
     right = tuple(_joint_names(plugin, "right_joint"))
     _need_wheels(left, right, where)
-    source = _int(plugin, "odometry_source", 1, where)
+    source = read_int(plugin, "odometry_source", 1, where)
     if source not in (0, 1):
         raise ModelError(
             f"{where}: <odometry_source> is {source}; expected 0 (encoder) or 1 (world)"
@@ -205,25 +90,25 @@ def parse_classic_diff_drive(plugin: ET.Element, robot_namespace: str = "") -> D
         plugin=plugin.get("name", "diff_drive"),
         left_joints=left,
         right_joints=right,
-        wheel_separation=_positive(
-            _float(plugin, "wheel_separation", 0.34, where), "wheel_separation", where
+        wheel_separation=positive(
+            read_float(plugin, "wheel_separation", 0.34, where), "wheel_separation", where
         ),
-        wheel_diameter=_positive(
-            _float(plugin, "wheel_diameter", 0.15, where), "wheel_diameter", where
+        wheel_diameter=positive(
+            read_float(plugin, "wheel_diameter", 0.15, where), "wheel_diameter", where
         ),
-        max_wheel_acceleration=abs(_float(plugin, "max_wheel_acceleration", 0.0, where)),
-        max_wheel_torque=_float(plugin, "max_wheel_torque", 5.0, where),
-        update_rate=_float(plugin, "update_rate", 100.0, where),
-        publish_odom=_bool(plugin, "publish_odom", False, where),
-        publish_odom_tf=_bool(plugin, "publish_odom_tf", False, where),
-        publish_wheel_tf=_bool(plugin, "publish_wheel_tf", False, where),
-        odometry_frame=_text(plugin, "odometry_frame", "odom"),
-        robot_base_frame=_text(plugin, "robot_base_frame", "base_footprint"),
+        max_wheel_acceleration=abs(read_float(plugin, "max_wheel_acceleration", 0.0, where)),
+        max_wheel_torque=read_float(plugin, "max_wheel_torque", 5.0, where),
+        update_rate=read_float(plugin, "update_rate", 100.0, where),
+        publish_odom=read_bool(plugin, "publish_odom", False, where),
+        publish_odom_tf=read_bool(plugin, "publish_odom_tf", False, where),
+        publish_wheel_tf=read_bool(plugin, "publish_wheel_tf", False, where),
+        odometry_frame=read_text(plugin, "odometry_frame", "odom"),
+        robot_base_frame=read_text(plugin, "robot_base_frame", "base_footprint"),
         odometry_source=source,
         covariance=(
-            _float(plugin, "covariance_x", 0.00001, where),
-            _float(plugin, "covariance_y", 0.00001, where),
-            _float(plugin, "covariance_yaw", 0.001, where),
+            read_float(plugin, "covariance_x", 0.00001, where),
+            read_float(plugin, "covariance_y", 0.00001, where),
+            read_float(plugin, "covariance_yaw", 0.001, where),
         ),
         cmd_topic=names.resolve("cmd_vel"),
         odom_topic=names.resolve("odom"),
@@ -233,26 +118,26 @@ def parse_classic_diff_drive(plugin: ET.Element, robot_namespace: str = "") -> D
 
 def parse_gz_diff_drive(plugin: ET.Element, model: str, root_link: str) -> DiffDriveParams:
     """gz-sim DiffDrive system: its gz topics are served on ROS directly, as if bridged."""
-    where = _where(plugin)
+    where = where_of(plugin)
     left = tuple(_joint_names(plugin, "left_joint"))
     right = tuple(_joint_names(plugin, "right_joint"))
     _need_wheels(left, right, where)
-    radius = _positive(_float(plugin, "wheel_radius", 0.2, where), "wheel_radius", where)
-    cmd = _text(plugin, "topic", f"/model/{model}/cmd_vel")
-    odom = _text(plugin, "odom_topic", f"/model/{model}/odometry")
+    radius = positive(read_float(plugin, "wheel_radius", 0.2, where), "wheel_radius", where)
+    cmd = read_text(plugin, "topic", f"/model/{model}/cmd_vel")
+    odom = read_text(plugin, "odom_topic", f"/model/{model}/odometry")
     return DiffDriveParams(
         plugin=plugin.get("name", "DiffDrive"),
         left_joints=left,
         right_joints=right,
-        wheel_separation=_positive(
-            _float(plugin, "wheel_separation", 1.0, where), "wheel_separation", where
+        wheel_separation=positive(
+            read_float(plugin, "wheel_separation", 1.0, where), "wheel_separation", where
         ),
         wheel_diameter=2 * radius,
-        max_wheel_acceleration=abs(_float(plugin, "max_linear_acceleration", 0.0, where)),
-        update_rate=_float(plugin, "odom_publish_frequency", 50.0, where),
+        max_wheel_acceleration=abs(read_float(plugin, "max_linear_acceleration", 0.0, where)),
+        update_rate=read_float(plugin, "odom_publish_frequency", 50.0, where),
         publish_odom=True,
-        odometry_frame=_text(plugin, "frame_id", f"{model}/odom"),
-        robot_base_frame=_text(plugin, "child_frame_id", f"{model}/{root_link}"),
+        odometry_frame=read_text(plugin, "frame_id", f"{model}/odom"),
+        robot_base_frame=read_text(plugin, "child_frame_id", f"{model}/{root_link}"),
         cmd_topic=expand_topic(cmd, "/", model),
         odom_topic=expand_topic(odom, "/", model),
     )
@@ -267,49 +152,6 @@ def _need_wheels(left: Sequence[str], right: Sequence[str], where: str) -> None:
         raise ModelError(f"{where}: needs <left_joint> and <right_joint> naming the wheel joints")
 
 
-# ---------------------------------------------------------------- sensors
-
-
-@dataclass(frozen=True)
-class Mount:
-    """Where a sensor sits in the robot's root frame (seen from above), and its height."""
-
-    x: float = 0.0
-    y: float = 0.0
-    z: float = 0.0
-    yaw: float = 0.0
-    upside_down: bool = False
-
-
-@dataclass(frozen=True)
-class LidarParams:
-    """A ray sensor published as sensor_msgs/LaserScan."""
-
-    name: str
-    link: str
-    mount: Mount
-    update_rate: float
-    scan: ScanGeometry
-    noise: GaussianNoise
-    topic: str
-    frame_id: str
-
-
-@dataclass(frozen=True)
-class ImuParams:
-    """An IMU sensor published as sensor_msgs/Imu."""
-
-    name: str
-    link: str
-    mount: Mount
-    update_rate: float
-    angular_velocity: tuple[GaussianNoise, GaussianNoise, GaussianNoise]
-    linear_acceleration: tuple[GaussianNoise, GaussianNoise, GaussianNoise]
-    topic: str
-    frame_id: str
-    initial_orientation_as_reference: bool = False
-
-
 @dataclass(frozen=True)
 class JointStateParams:
     """Which joints to publish on which topic and how often."""
@@ -317,114 +159,6 @@ class JointStateParams:
     topic: str
     joints: tuple[str, ...]
     update_rate: float = DEFAULT_JOINT_STATE_RATE
-
-
-def parse_noise(element: ET.Element | None, where: str) -> GaussianNoise:
-    """``<noise type="gaussian"><mean><stddev><bias_mean><bias_stddev>`` (or ``<type>`` child)."""
-    if element is None:
-        return GaussianNoise()
-    kind = (element.get("type") or element.findtext("type") or "gaussian").strip()
-    if kind == "none":
-        return GaussianNoise()
-    if kind not in ("gaussian", "gaussian_quantized"):
-        raise ModelError(f"{where}: noise type {kind!r} is not supported; use gaussian or none")
-    return GaussianNoise(
-        _float(element, "mean", 0.0, where),
-        abs(_float(element, "stddev", 0.0, where)),
-        _float(element, "bias_mean", 0.0, where),
-        abs(_float(element, "bias_stddev", 0.0, where)),
-    )
-
-
-def parse_lidar(sensor: ET.Element, link: str, mount: Mount, robot_namespace: str) -> LidarParams:
-    """A ``<sensor type="ray|gpu_ray|lidar|gpu_lidar">`` and its gazebo_ros plugin (or gz topic)."""
-    name = sensor.get("name", "lidar")
-    where = f"sensor {name!r} on link {link!r}"
-    ray = sensor.find("ray")
-    if ray is None:
-        ray = sensor.find("lidar")
-    if ray is None:
-        raise ModelError(f"{where}: has no <ray> (or <lidar>) element with the scan settings")
-    horizontal = ray.find("scan/horizontal")
-    if horizontal is None:
-        raise ModelError(f"{where}: has no <scan><horizontal> element")
-    samples = _int(horizontal, "samples", 640, where)
-    if samples < 1:
-        raise ModelError(f"{where}: <samples> is {samples}; a scan needs at least one ray")
-    scan = ScanGeometry(
-        angle_min=_float(horizontal, "min_angle", 0.0, where),
-        angle_max=_float(horizontal, "max_angle", 0.0, where),
-        samples=samples,
-        range_min=_float(ray, "range/min", 0.0, where),
-        range_max=_float(ray, "range/max", 0.0, where),
-    )
-    if scan.range_max <= scan.range_min or scan.range_min < 0:
-        raise ModelError(
-            f"{where}: range min {scan.range_min} / max {scan.range_max}; need 0 <= min < max"
-        )
-    plugin = _sensor_plugin(sensor, CLASSIC_RAY)
-    if plugin is not None:
-        output = _text(plugin, "output_type", "sensor_msgs/LaserScan")
-        if output.replace("/msg/", "/") != "sensor_msgs/LaserScan":
-            raise ModelError(
-                f"{where}: <output_type> {output!r} is not simulated; only sensor_msgs/LaserScan"
-            )
-        topic = parse_ros_block(plugin, robot_namespace).resolve("~/out")
-        frame = _text(plugin, "frame_name", link)
-    else:
-        topic = expand_topic(_text(sensor, "topic", "scan"), robot_namespace or "/", name)
-        frame = _text(sensor, "gz_frame_id", _text(sensor, "frame_id", link))
-    return LidarParams(
-        name=name,
-        link=link,
-        mount=mount,
-        update_rate=_float(sensor, "update_rate", 0.0, where),
-        scan=scan,
-        noise=parse_noise(ray.find("noise"), where),
-        topic=topic,
-        frame_id=frame,
-    )
-
-
-def parse_imu(sensor: ET.Element, link: str, mount: Mount, robot_namespace: str) -> ImuParams:
-    """A ``<sensor type="imu">`` with per-axis noise, and its gazebo_ros plugin (or gz topic)."""
-    name = sensor.get("name", "imu")
-    where = f"sensor {name!r} on link {link!r}"
-    imu = sensor.find("imu")
-
-    def axes(kind: str) -> tuple[GaussianNoise, GaussianNoise, GaussianNoise]:
-        block = None if imu is None else imu.find(kind)
-        found = [None if block is None else block.find(f"{axis}/noise") for axis in "xyz"]
-        x, y, z = (parse_noise(e, f"{where} {kind}") for e in found)
-        return (x, y, z)
-
-    plugin = _sensor_plugin(sensor, CLASSIC_IMU)
-    reference = False
-    if plugin is not None:
-        topic = parse_ros_block(plugin, robot_namespace).resolve("~/out")
-        frame = _text(plugin, "frame_name", link)
-        reference = _bool(plugin, "initial_orientation_as_reference", False, where)
-    else:
-        topic = expand_topic(_text(sensor, "topic", "imu"), robot_namespace or "/", name)
-        frame = _text(sensor, "gz_frame_id", _text(sensor, "frame_id", link))
-    return ImuParams(
-        name=name,
-        link=link,
-        mount=mount,
-        update_rate=_float(sensor, "update_rate", 0.0, where),
-        angular_velocity=axes("angular_velocity"),
-        linear_acceleration=axes("linear_acceleration"),
-        topic=topic,
-        frame_id=frame,
-        initial_orientation_as_reference=reference,
-    )
-
-
-def _sensor_plugin(sensor: ET.Element, kind: str) -> ET.Element | None:
-    for plugin in sensor.findall("plugin"):
-        if plugin_kind(plugin.get("filename", "")) == kind:
-            return plugin
-    return None
 
 
 # ---------------------------------------------------------------- the whole model
@@ -481,7 +215,7 @@ def describe_model(
             elif kind == CLASSIC_JOINT_STATES:
                 js_plugin = _classic_joint_states(plugin, robot_namespace)
             elif kind in GZ_JOINT_STATES:
-                topic = _text(plugin, "topic", f"/world/{world}/model/{name}/joint_state")
+                topic = read_text(plugin, "topic", f"/world/{world}/model/{name}/joint_state")
                 joints = tuple(_joint_names(plugin, "joint_name"))
                 js_plugin = JointStateParams(expand_topic(topic, "/", name), joints)
             else:
@@ -506,9 +240,9 @@ def _set_drive(spec: ModelSpec, drive: DiffDriveParams) -> None:
 
 
 def _classic_joint_states(plugin: ET.Element, robot_namespace: str) -> JointStateParams:
-    where = _where(plugin)
+    where = where_of(plugin)
     names = parse_ros_block(plugin, robot_namespace)
-    rate = _float(plugin, "update_rate", 100.0, where)
+    rate = read_float(plugin, "update_rate", 100.0, where)
     return JointStateParams(
         names.resolve("joint_states"), tuple(_joint_names(plugin, "joint_name")), rate
     )
