@@ -1,9 +1,9 @@
-"""SDF worlds for the simulator stand-in: static shapes seen from above, 2D ray casting, noise.
+"""SDF worlds for the simulator stand-in: the static shapes of a world, seen from above.
 
 Gazebo is never installed here, yet robot stacks need a lidar that sees the world's walls and a
 robot that stops at them. This module reads an SDF world (boxes, cylinders, spheres, capsules;
 ground planes are skipped), turns every collision shape into a top-down disc or convex polygon
-with its height span, and casts horizontal rays against them exactly. It is pure Python and
+with its height span (shapes.py); raycast.py casts rays against them. It is pure Python and
 never imports rclpy.
 """
 
@@ -11,17 +11,29 @@ from __future__ import annotations
 
 import math
 import os
-import random
 import xml.etree.ElementTree as ET
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
 
 from mlaunch.errors import MlaunchError
 
-Point = tuple[float, float]
-Rotation = tuple[tuple[float, float, float], ...]  # 3x3, row-major
+# Re-exported: the simulator, its tests and its callers know these from here.
+from mlaunch.standins.raycast import GaussianNoise as GaussianNoise
+from mlaunch.standins.raycast import NoiseSampler as NoiseSampler
+from mlaunch.standins.raycast import RayCaster as RayCaster
+from mlaunch.standins.raycast import ScanGeometry as ScanGeometry
+from mlaunch.standins.raycast import clearance as clearance
+from mlaunch.standins.raycast import seeded_rng as seeded_rng
+from mlaunch.standins.shapes import Disc as Disc
+from mlaunch.standins.shapes import Polygon as Polygon
+from mlaunch.standins.shapes import Pose3 as Pose3
+from mlaunch.standins.shapes import Shape as Shape
+from mlaunch.standins.shapes import box_shape as box_shape
+from mlaunch.standins.shapes import convex_hull as convex_hull
+from mlaunch.standins.shapes import cylinder_shape as cylinder_shape
+from mlaunch.standins.shapes import sphere_shape as sphere_shape
 
 # Models that every Gazebo world includes and that never block anything.
 _HARMLESS_INCLUDES = ("ground_plane", "sun")
@@ -78,190 +90,6 @@ def parse_xml(text: str, filename: str) -> XmlDoc:
             where=f"{filename}:{exc.lineno}",
         ) from None
     return XmlDoc(builder.close(), filename, lines)
-
-
-# ---------------------------------------------------------------- 3D poses
-
-
-@dataclass(frozen=True)
-class Pose3:
-    """A rigid transform: rotation matrix and translation (SDF ``<pose>`` or a composition)."""
-
-    rot: Rotation = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
-
-    @staticmethod
-    def from_xyz_rpy(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> Pose3:
-        """The SDF/URDF convention: fixed-axis roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll)."""
-        cr, sr = math.cos(roll), math.sin(roll)
-        cp, sp = math.cos(pitch), math.sin(pitch)
-        cy, sy = math.cos(yaw), math.sin(yaw)
-        rot = (
-            (cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
-            (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
-            (-sp, cp * sr, cp * cr),
-        )
-        return Pose3(rot, (x, y, z))
-
-    def apply(self, p: Sequence[float]) -> tuple[float, float, float]:
-        """The point ``p`` (child frame) expressed in the parent frame."""
-        r, t = self.rot, self.xyz
-        return (
-            r[0][0] * p[0] + r[0][1] * p[1] + r[0][2] * p[2] + t[0],
-            r[1][0] * p[0] + r[1][1] * p[1] + r[1][2] * p[2] + t[1],
-            r[2][0] * p[0] + r[2][1] * p[1] + r[2][2] * p[2] + t[2],
-        )
-
-    def compose(self, child: Pose3) -> Pose3:
-        """``self * child``: the child's pose expressed in self's parent frame."""
-        a, b = self.rot, child.rot
-        rot = tuple(
-            tuple(sum(a[r][k] * b[k][c] for k in range(3)) for c in range(3)) for r in range(3)
-        )
-        return Pose3(rot, self.apply(child.xyz))  # type: ignore[arg-type]
-
-    @property
-    def yaw(self) -> float:
-        """Heading of the x axis seen from above."""
-        return math.atan2(self.rot[1][0], self.rot[0][0])
-
-
-# ---------------------------------------------------------------- shapes
-
-
-@dataclass(frozen=True)
-class Disc:
-    """An upright cylinder (or a sphere, or a vertical capsule) seen from above."""
-
-    model: str
-    x: float
-    y: float
-    radius: float
-    zmin: float
-    zmax: float
-    sphere_z: float | None = None  # a sphere's centre height: its cross-section shrinks off-centre
-
-    def radius_at(self, z: float) -> float:
-        """Radius of the horizontal cross-section at height ``z`` (0 when it misses)."""
-        if z < self.zmin or z > self.zmax:
-            return 0.0
-        if self.sphere_z is None:
-            return self.radius
-        return math.sqrt(max(0.0, self.radius**2 - (z - self.sphere_z) ** 2))
-
-    @property
-    def bound(self) -> tuple[float, float, float]:
-        """Bounding circle (x, y, r) used to skip rays that cannot reach the shape."""
-        return (self.x, self.y, self.radius)
-
-    def clearance(self, x: float, y: float) -> float:
-        """Distance from (x, y) to the outline; negative inside."""
-        return math.hypot(x - self.x, y - self.y) - self.radius
-
-
-@dataclass(frozen=True)
-class Polygon:
-    """A convex outline seen from above (a box, a lying cylinder), counter-clockwise."""
-
-    model: str
-    points: tuple[Point, ...]
-    zmin: float
-    zmax: float
-
-    @property
-    def bound(self) -> tuple[float, float, float]:
-        """Bounding circle (x, y, r) around the vertices' centroid."""
-        cx = sum(p[0] for p in self.points) / len(self.points)
-        cy = sum(p[1] for p in self.points) / len(self.points)
-        return (cx, cy, max(math.hypot(p[0] - cx, p[1] - cy) for p in self.points))
-
-    def edges(self) -> list[tuple[Point, Point]]:
-        """Consecutive vertex pairs, closing the loop."""
-        pts = self.points
-        return [(pts[i], pts[(i + 1) % len(pts)]) for i in range(len(pts))]
-
-    def clearance(self, x: float, y: float) -> float:
-        """Distance from (x, y) to the outline; negative (minus the depth) inside."""
-        inside = True
-        best = math.inf
-        for (ax, ay), (bx, by) in self.edges():
-            ex, ey = bx - ax, by - ay
-            if ex * (y - ay) - ey * (x - ax) < 0:
-                inside = False
-            length2 = ex * ex + ey * ey
-            s = (
-                0.0
-                if length2 == 0
-                else max(0.0, min(1.0, ((x - ax) * ex + (y - ay) * ey) / length2))
-            )
-            best = min(best, math.hypot(x - ax - s * ex, y - ay - s * ey))
-        return -best if inside else best
-
-
-Shape = Disc | Polygon
-
-
-def convex_hull(points: Iterable[Point]) -> tuple[Point, ...]:
-    """Counter-clockwise convex hull (Andrew's monotone chain)."""
-    pts = sorted(set(points))
-    if len(pts) <= 2:
-        return tuple(pts)
-
-    def cross(o: Point, a: Point, b: Point) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    lower: list[Point] = []
-    upper: list[Point] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 1e-12:
-            lower.pop()
-        lower.append(p)
-    for p in reversed(pts):
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 1e-12:
-            upper.pop()
-        upper.append(p)
-    return tuple(lower[:-1] + upper[:-1])
-
-
-def box_shape(model: str, pose: Pose3, size: Sequence[float]) -> Shape:
-    """A box of ``size`` (x, y, z) at ``pose``: its top-down hull and height span."""
-    hx, hy, hz = (s / 2 for s in size)
-    corners = [
-        pose.apply((sx * hx, sy * hy, sz * hz))
-        for sx in (-1, 1)
-        for sy in (-1, 1)
-        for sz in (-1, 1)
-    ]
-    return _hull_shape(model, corners)
-
-
-def cylinder_shape(model: str, pose: Pose3, radius: float, length: float) -> Shape:
-    """A cylinder along its local z: a disc when upright, else the hull of its end rings."""
-    zs = [pose.apply((0.0, 0.0, s * length / 2))[2] for s in (-1, 1)]
-    if abs(pose.rot[2][2]) > 1 - 1e-9:
-        x, y, _ = pose.xyz
-        return Disc(model, x, y, radius, min(zs), max(zs))
-    ring = [
-        pose.apply((radius * math.cos(a), radius * math.sin(a), s * length / 2))
-        for a in (i * math.pi / 16 for i in range(32))
-        for s in (-1, 1)
-    ]
-    return _hull_shape(model, ring)
-
-
-def sphere_shape(model: str, pose: Pose3, radius: float) -> Shape:
-    """A sphere: a disc whose cross-section depends on the ray height."""
-    x, y, z = pose.xyz
-    return Disc(model, x, y, radius, z - radius, z + radius, sphere_z=z)
-
-
-def _hull_shape(model: str, points: list[tuple[float, float, float]]) -> Polygon:
-    return Polygon(
-        model,
-        convex_hull((p[0], p[1]) for p in points),
-        min(p[2] for p in points),
-        max(p[2] for p in points),
-    )
 
 
 # ---------------------------------------------------------------- the world
@@ -564,200 +392,3 @@ def find_model_sdf(uri: str, environ: Mapping[str, str]) -> Path | None:
             if (candidate / name).is_file():
                 return candidate / name
     return None
-
-
-# ---------------------------------------------------------------- ray casting
-
-
-@dataclass(frozen=True)
-class ScanGeometry:
-    """The angles of one horizontal scan, in the sensor frame (as the ray sensor's SDF says)."""
-
-    angle_min: float
-    angle_max: float
-    samples: int
-    range_min: float
-    range_max: float
-
-    @property
-    def increment(self) -> float:
-        """Angle between rays; Gazebo spreads ``samples`` rays over [min, max] inclusive."""
-        return 0.0 if self.samples <= 1 else (self.angle_max - self.angle_min) / (self.samples - 1)
-
-
-class RayCaster:
-    """Casts horizontal rays against fixed shapes; precomputes what does not change per scan."""
-
-    def __init__(self, shapes: Iterable[Shape]):
-        self.shapes = list(shapes)
-        self._edges = [s.edges() if isinstance(s, Polygon) else [] for s in self.shapes]
-        self._bounds = [s.bound for s in self.shapes]
-
-    def cast(
-        self, x: float, y: float, z: float, angle: float, range_min: float, range_max: float
-    ) -> float:
-        """Distance along one ray from (x, y) at height z to the first surface, inf if none."""
-        scan = ScanGeometry(angle, angle, 1, range_min, range_max)
-        return self.scan(x, y, z, 0.0, scan)[0]
-
-    def scan(
-        self,
-        x: float,
-        y: float,
-        z: float,
-        yaw: float,
-        geometry: ScanGeometry,
-        extra: Sequence[Disc] = (),
-        mirrored: bool = False,
-    ) -> list[float]:
-        """Ranges of every ray of ``geometry`` from a sensor at (x, y, z) heading ``yaw``.
-
-        Rays start at range_min (as Gazebo's do) and report inf when nothing lies within
-        range_max. ``extra`` are moving discs (other robots); ``mirrored`` flips the sweep for
-        a sensor mounted upside down.
-        """
-        n = geometry.samples
-        sign = -1.0 if mirrored else 1.0
-        inc = geometry.increment
-        angles = [yaw + sign * (geometry.angle_min + i * inc) for i in range(n)]
-        cos_a = [math.cos(a) for a in angles]
-        sin_a = [math.sin(a) for a in angles]
-        ranges = [math.inf] * n
-        rmin, rmax = geometry.range_min, geometry.range_max
-        shapes: list[tuple[Shape, list[tuple[Point, Point]], tuple[float, float, float]]] = [
-            (s, e, b) for s, e, b in zip(self.shapes, self._edges, self._bounds, strict=True)
-        ]
-        shapes.extend((d, [], d.bound) for d in extra)
-        for shape, edges, (bx, by, br) in shapes:
-            if shape.zmin > z or shape.zmax < z:
-                continue  # the scan plane passes above or below it
-            dist = math.hypot(bx - x, by - y)
-            if dist - br > rmax:
-                continue
-            for i in _window(dist, br, math.atan2(by - y, bx - x), yaw, sign, geometry):
-                if edges:
-                    t = _hit_polygon(x, y, cos_a[i], sin_a[i], edges, rmin)
-                else:
-                    assert isinstance(shape, Disc)
-                    t = _hit_disc(
-                        x, y, cos_a[i], sin_a[i], shape.x, shape.y, shape.radius_at(z), rmin
-                    )
-                if t < ranges[i]:
-                    ranges[i] = t
-        return [r if r <= rmax else math.inf for r in ranges]
-
-
-def _window(
-    dist: float, radius: float, bearing: float, yaw: float, sign: float, g: ScanGeometry
-) -> Iterable[int]:
-    """Indices of the rays that can touch a bounding circle seen at ``bearing``."""
-    n = g.samples
-    inc = g.increment
-    if dist <= radius or n <= 1 or inc == 0:
-        return range(n)
-    half = math.asin(radius / dist) + 1e-9
-    centre = sign * (bearing - yaw) - g.angle_min  # the bearing in scan-angle terms
-    step = abs(inc)
-    indices: set[int] = set()
-    for turn in (-2 * math.pi, 0.0, 2 * math.pi, 4 * math.pi):
-        lo_angle, hi_angle = centre + turn - half, centre + turn + half
-        if inc < 0:
-            lo_angle, hi_angle = -hi_angle, -lo_angle
-        lo = max(0, math.ceil(lo_angle / step - 1e-9))
-        hi = min(n - 1, math.floor(hi_angle / step + 1e-9))
-        if lo <= hi:
-            indices.update(range(lo, hi + 1))
-    return sorted(indices)
-
-
-def _hit_disc(
-    x: float, y: float, c: float, s: float, cx: float, cy: float, r: float, rmin: float
-) -> float:
-    if r <= 0:
-        return math.inf
-    fx, fy = x - cx, y - cy
-    b = fx * c + fy * s
-    disc = b * b - (fx * fx + fy * fy - r * r)
-    if disc < 0:
-        return math.inf
-    root = math.sqrt(disc)
-    near, far = -b - root, -b + root
-    if near >= rmin:
-        return near
-    return far if far >= rmin else math.inf
-
-
-def _hit_polygon(
-    x: float, y: float, c: float, s: float, edges: list[tuple[Point, Point]], rmin: float
-) -> float:
-    best = math.inf
-    for (ax, ay), (bx, by) in edges:
-        ex, ey = bx - ax, by - ay
-        denom = c * ey - s * ex
-        if abs(denom) < 1e-15:
-            continue  # parallel to this edge
-        wx, wy = ax - x, ay - y
-        t = (wx * ey - wy * ex) / denom
-        u = (wx * s - wy * c) / denom
-        if -1e-12 <= u <= 1 + 1e-12 and rmin <= t < best:
-            best = t
-    return best
-
-
-def clearance(
-    shapes: Iterable[Shape], x: float, y: float, radius: float, zmin: float, zmax: float
-) -> float:
-    """How far a robot disc at (x, y) is from touching any shape overlapping [zmin, zmax]."""
-    best = math.inf
-    for shape in shapes:
-        if shape.zmax <= zmin or shape.zmin >= zmax:
-            continue
-        best = min(best, shape.clearance(x, y) - radius)
-    return best
-
-
-# ---------------------------------------------------------------- noise
-
-
-@dataclass(frozen=True)
-class GaussianNoise:
-    """Gazebo's gaussian sensor noise: per-sample N(mean, stddev) plus a bias drawn once."""
-
-    mean: float = 0.0
-    stddev: float = 0.0
-    bias_mean: float = 0.0
-    bias_stddev: float = 0.0
-
-    @property
-    def is_zero(self) -> bool:
-        """True when applying it changes nothing (saves a random draw per value)."""
-        return not (self.mean or self.stddev or self.bias_mean or self.bias_stddev)
-
-    def sampler(self, rng: random.Random) -> NoiseSampler:
-        """A noise stream from ``rng``; the bias is drawn now, its sign at random as in Gazebo."""
-        bias = 0.0
-        if self.bias_mean or self.bias_stddev:
-            bias = rng.gauss(self.bias_mean, self.bias_stddev)
-            if rng.random() < 0.5:
-                bias = -bias
-        return NoiseSampler(self, rng, bias)
-
-
-@dataclass
-class NoiseSampler:
-    """One sensor axis' noise: deterministic for a given seeded ``rng``."""
-
-    noise: GaussianNoise
-    rng: random.Random
-    bias: float
-
-    def apply(self, value: float) -> float:
-        """``value`` with noise added."""
-        if self.noise.is_zero:
-            return value
-        return value + self.bias + self.rng.gauss(self.noise.mean, self.noise.stddev)
-
-
-def seeded_rng(seed: int, *names: str) -> random.Random:
-    """A random stream per sensor, stable across runs (string seeds hash with SHA-512)."""
-    return random.Random(":".join([str(seed), *names]))
