@@ -14,6 +14,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+from mlaunch.standins.camera import DEPTH_TYPES, CameraParams, parse_depth_camera
 from mlaunch.standins.plugins import (
     CLASSIC_DIFF_DRIVE,
     CLASSIC_JOINT_STATES,
@@ -173,6 +174,7 @@ class ModelSpec:
     drive: DiffDriveParams | None = None
     lidars: list[LidarParams] = field(default_factory=list)
     imus: list[ImuParams] = field(default_factory=list)
+    cameras: list[CameraParams] = field(default_factory=list)
     joint_states: JointStateParams | None = None
     radius: float = 0.1  # the robot's footprint as one disc around the root frame origin
     height: tuple[float, float] = (0.0, 0.3)  # z span relative to the root frame
@@ -190,6 +192,10 @@ class ModelSpec:
             parts.append(f"diff drive {self.drive.cmd_topic} -> {self.drive.odom_topic}")
         parts += [f"lidar {s.topic} @{s.update_rate:g} Hz" for s in self.lidars]
         parts += [f"imu {s.topic} @{s.update_rate:g} Hz" for s in self.imus]
+        parts += [
+            f"depth camera {c.depth_topic} {c.width}x{c.height} {c.encoding} @{c.update_rate:g} Hz"
+            for c in self.cameras
+        ]
         if self.joint_states:
             parts.append(f"joint states {self.joint_states.topic}")
         return ", ".join(parts)
@@ -298,6 +304,8 @@ def _sensors_of(spec: ModelSpec, block: ET.Element, link: str, robot_namespace: 
             spec.lidars.append(parse_lidar(sensor, link, mount, robot_namespace))
         elif kind in IMU_TYPES:
             spec.imus.append(parse_imu(sensor, link, mount, robot_namespace))
+        elif kind in DEPTH_TYPES:
+            spec.cameras.append(parse_depth_camera(sensor, link, mount, robot_namespace))
         else:
             spec.warnings.append(
                 f"sensor {sensor.get('name')!r} of type {kind!r} on {link!r} "

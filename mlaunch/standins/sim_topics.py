@@ -14,6 +14,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from mlaunch.standins.camera import CameraParams, DepthRenderer, camera_info
 from mlaunch.standins.diffdrive import DiffDrive, ImuParams, LidarParams, ModelSpec, Pose2D
 from mlaunch.standins.simulation import Schedule, SimRobot, Simulation
 
@@ -105,6 +106,13 @@ def make_outputs(node: Any, sim: Simulation, robot: SimRobot, qos: Any, tf: Any)
         outputs.append(
             Output(
                 Schedule.every(imu.update_rate, start), _imu_publisher(node, sim, robot, imu, qos)
+            )
+        )
+    for camera in spec.cameras:
+        outputs.append(
+            Output(
+                Schedule.every(camera.update_rate, start),
+                _depth_camera_publisher(node, sim, robot, camera, qos),
             )
         )
     return outputs
@@ -279,5 +287,53 @@ def _imu_publisher(
         msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = wx, wy, wz
         msg.linear_acceleration.x, msg.linear_acceleration.y, msg.linear_acceleration.z = ax, ay, az
         publisher.publish(msg)
+
+    return publish
+
+
+def _depth_camera_publisher(
+    node: Any, sim: Simulation, robot: SimRobot, camera: CameraParams, qos: Any
+) -> Callable[[int, int], None]:
+    """Depth image, its camera info and the point cloud of one depth camera.
+
+    The image and the cloud are ray-cast only when someone subscribes to them (the camera info
+    goes out every frame): a 640x480 frame costs milliseconds the simulator's loop must not
+    spend for nobody.
+    """
+    from sensor_msgs.msg import CameraInfo, Image, PointCloud2, PointField
+
+    renderer = DepthRenderer(camera, sim.world.shapes)
+    image = Image(height=camera.height, width=camera.width, encoding=camera.encoding)
+    image.header.frame_id = camera.frame_id
+    image.step = camera.width * (2 if camera.encoding == "16UC1" else 4)
+    info = camera_info(camera, CameraInfo())
+    cloud = PointCloud2(height=camera.height, width=camera.width, is_dense=False)
+    cloud.header.frame_id = camera.frame_id
+    cloud.fields = [
+        PointField(name=axis, offset=4 * i, datatype=PointField.FLOAT32, count=1)
+        for i, axis in enumerate("xyz")
+    ]
+    cloud.point_step, cloud.row_step = 12, 12 * camera.width
+    image_pub = make_publisher(node, Image, camera.depth_topic, qos)
+    info_pub = make_publisher(node, CameraInfo, camera.depth_info_topic, qos)
+    cloud_pub = make_publisher(node, PointCloud2, camera.points_topic, qos)
+
+    def publish(sec: int, nanosec: int) -> None:
+        for msg in (image, info, cloud):
+            msg.header.stamp.sec = sec
+            msg.header.stamp.nanosec = nanosec
+        info_pub.publish(info)
+        want_image = image_pub.get_subscription_count() > 0
+        want_cloud = cloud_pub.get_subscription_count() > 0
+        if not (want_image or want_cloud):
+            return
+        x, y, z, yaw = sim.sensor_pose(robot, camera.mount)
+        depth = renderer.render(x, y, z, yaw, sim.others(robot))
+        if want_image:
+            image.data = array.array("B", renderer.image_bytes(depth))
+            image_pub.publish(image)
+        if want_cloud:
+            cloud.data = array.array("B", renderer.cloud_bytes(depth))
+            cloud_pub.publish(cloud)
 
     return publish

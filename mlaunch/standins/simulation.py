@@ -12,6 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mlaunch.standins.diffdrive import DiffDrive, ImuParams, LidarParams, ModelSpec, Pose2D
+from mlaunch.standins.sensors import Mount
 from mlaunch.standins.world import (
     Disc,
     NoiseSampler,
@@ -145,19 +146,26 @@ class Simulation:
 
     def scan(self, robot: SimRobot, lidar: LidarParams) -> list[float]:
         """One noisy scan: exact ray casts, then Gazebo's noise clamped to the range limits."""
-        p = robot.pose
-        m = lidar.mount
-        c, s = math.cos(p.yaw), math.sin(p.yaw)
-        x, y = p.x + c * m.x - s * m.y, p.y + s * m.x + c * m.y
-        others = [r.disc() for r in self.robots.values() if r is not robot]
+        x, y, z, yaw = self.sensor_pose(robot, lidar.mount)
         ranges = self.caster.scan(
-            x, y, robot.z + m.z, p.yaw + m.yaw, lidar.scan, others, m.upside_down
+            x, y, z, yaw, lidar.scan, self.others(robot), lidar.mount.upside_down
         )
         noise = robot.lidar_noise[lidar.name]
         if noise.noise.is_zero:
             return ranges
         lo, hi = lidar.scan.range_min, lidar.scan.range_max
         return [r if r == math.inf else min(hi, max(lo, noise.apply(r))) for r in ranges]
+
+    def sensor_pose(self, robot: SimRobot, mount: Mount) -> tuple[float, float, float, float]:
+        """(x, y, z, yaw) in the world of a sensor mounted on a robot."""
+        p = robot.pose
+        c, s = math.cos(p.yaw), math.sin(p.yaw)
+        x, y = p.x + c * mount.x - s * mount.y, p.y + s * mount.x + c * mount.y
+        return x, y, robot.z + mount.z, p.yaw + mount.yaw
+
+    def others(self, robot: SimRobot) -> list[Disc]:
+        """The other robots, as discs a sensor of ``robot`` can see."""
+        return [r.disc() for r in self.robots.values() if r is not robot]
 
     def imu(self, robot: SimRobot, imu: ImuParams) -> tuple[float, list[float]]:
         """(yaw, [wx, wy, wz, ax, ay, az]) in the sensor frame, noise applied."""
