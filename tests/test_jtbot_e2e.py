@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 from conftest import requires_rclpy
 from procutil import REPO, Running, clean_env, mlaunch, pid_alive, wait_until
+from test_interfaces import HAVE_TF2_MSGS
 
 pytestmark = [requires_rclpy, pytest.mark.slow]
 
@@ -45,6 +46,24 @@ def run_probe(env: dict[str, str], nodes: list[str]) -> dict[str, object]:
     return json.loads(done.stdout.strip().splitlines()[-1])  # type: ignore[no-any-return]
 
 
+def check_tf_tree(env: dict[str, str]) -> None:
+    """Every jtbot link is reachable from odom: odom -> base_link from the simulator's diff
+    drive, moving wheels from robot_state_publisher on /tf, fixed joints on /tf_static."""
+    done = subprocess.run(
+        [sys.executable, str(Path(__file__).parent / "tf_tree_probe.py"), "odom", "30"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-2000:]
+    tree = json.loads(done.stdout.strip().splitlines()[-1])
+    parents, topics = tree["parents"], tree["topics"]
+    assert parents["base_footprint"] == "odom" and topics["base_footprint"] == "/tf"
+    assert topics["left_wheel_link"] == "/tf" and topics["camera_depth_frame"] == "/tf_static"
+    assert parents["camera_depth_frame"] == "camera_link"
+
+
 def test_jtbot_sim_end_to_end(ros_env: dict[str, str], tmp_path: Path) -> None:
     env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
     env["ROS_LOG_DIR"] = str(tmp_path / "log")
@@ -66,6 +85,8 @@ def test_jtbot_sim_end_to_end(ros_env: dict[str, str], tmp_path: Path) -> None:
         with urllib.request.urlopen(url + "state.json", timeout=5) as response:
             state = json.loads(response.read())
         assert state, "the viewer serves no state"
+        if HAVE_TF2_MSGS:
+            check_tf_tree(env)
         # Ctrl-C: everything ends, nothing is left behind.
         everything = descendants_of(run.proc.pid)
         sent = time.monotonic()
@@ -118,6 +139,11 @@ def test_jtbot_sim_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: Path) 
             "/odom",
             "--expect-topic",
             "/imu",
+            "--expect-topic",
+            "/depth_camera/depth/image_raw",
+            "--expect-topic",
+            "/depth_camera/points",
+            *(("--expect-topic", "/tf", "--expect-topic", "/tf_static") if HAVE_TF2_MSGS else ()),
             "--expect-output",
             "spawn_entity.py:spawned entity 'jtbot'",
             "--hold",

@@ -359,7 +359,9 @@ def test_jtbot_diff_drive_is_derived_from_the_properties(
     for flag in ("publish_odom", "publish_odom_tf", "publish_wheel_tf"):
         assert text(drive, flag) == "true", flag
     assert text(drive, "odometry_frame") == "odom"
-    assert text(drive, "robot_base_frame") == "base_link"
+    # The URDF's root, so odom -> base_footprint -> base_link is one tree (base_link has its
+    # parent from the state publisher already).
+    assert text(drive, "robot_base_frame") == "base_footprint" == check_tree(jtbot)
 
 
 def test_jtbot_imu(jtbot: ET.Element) -> None:
