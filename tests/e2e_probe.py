@@ -93,10 +93,21 @@ def main() -> int:
         cmd.publish(twist)
         rclpy.spin_once(node, timeout_sec=0.05)
     cmd.publish(Twist())
-    after_scan_wait = time.monotonic()
+
+    # A loaded machine delivers late: wait for a scan taken no earlier than the last odometry
+    # of the drive (sim-time stamps), not for a wall-clock delay.
+    def stamp(msg: object) -> float:
+        header = msg.header  # type: ignore[attr-defined]
+        return float(header.stamp.sec + header.stamp.nanosec * 1e-9)
+
+    moved = latest.get("odom")
     spin_until(
-        lambda: latest.get("scan") is not before_scan and time.monotonic() - after_scan_wait > 0.3,
-        3.0,
+        lambda: (
+            moved is not None
+            and latest.get("scan") is not before_scan
+            and stamp(latest["scan"]) >= stamp(moved)
+        ),
+        10.0,
     )
     after_odom = latest.get("odom")
     after_scan = latest.get("scan")
