@@ -63,34 +63,43 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-def _wait_listening(port: int, process: subprocess.Popen[bytes], log: Path) -> None:
+def _wait_listening(address: str, port: int, process: subprocess.Popen[bytes], log: Path) -> None:
     deadline = time.monotonic() + START_DEADLINE
     while time.monotonic() < deadline:
         if process.poll() is not None:
             raise RuntimeError(f"sshd exited at start: {log.read_text()}")
         try:
-            with socket.create_connection(("127.0.0.1", port), timeout=0.2):
+            with socket.create_connection((address, port), timeout=0.2):
                 return
         except OSError:
             time.sleep(0.02)
     raise RuntimeError(f"sshd did not listen on port {port} within {START_DEADLINE} s")
 
 
-def start(root: Path) -> Server:
-    """Generate keys and configs under ``root`` and start sshd on a free port."""
+def start(
+    root: Path,
+    *,
+    address: str = "127.0.0.1",
+    alias: str = HOST_ALIAS,
+    wrap: tuple[str, ...] = (),
+) -> Server:
+    """Generate keys and configs under ``root`` and start sshd on a free port of ``address``.
+
+    ``wrap`` runs sshd through a command (``ip netns exec NS``: a second "host").
+    """
     host_pub = _keygen(root / "host_key")
     client_pub = _keygen(root / "client_key")
     (root / "authorized_keys").write_text(client_pub + "\n")
     port = _free_port()
     (root / "sshd_config").write_text(
-        f"Port {port}\nListenAddress 127.0.0.1\nHostKey {root / 'host_key'}\n"
+        f"Port {port}\nListenAddress {address}\nHostKey {root / 'host_key'}\n"
         f"AuthorizedKeysFile {root / 'authorized_keys'}\nPidFile {root / 'sshd.pid'}\n"
         "StrictModes no\nUsePAM no\nPasswordAuthentication no\nKbdInteractiveAuthentication no\n"
         "PermitRootLogin prohibit-password\nMaxSessions 64\nLogLevel ERROR\n"
     )
-    (root / "known_hosts").write_text(f"[127.0.0.1]:{port} {host_pub}\n")
+    (root / "known_hosts").write_text(f"[{address}]:{port} {host_pub}\n")
     (root / "ssh_config").write_text(
-        f"Host {HOST_ALIAS}\n  HostName 127.0.0.1\n  Port {port}\n  User {getpass.getuser()}\n"
+        f"Host {alias}\n  HostName {address}\n  Port {port}\n  User {getpass.getuser()}\n"
         f"  IdentityFile {root / 'client_key'}\n  IdentitiesOnly yes\n"
         f"  UserKnownHostsFile {root / 'known_hosts'}\n  StrictHostKeyChecking yes\n"
         "  LogLevel ERROR\n"
@@ -100,14 +109,14 @@ def start(root: Path) -> Server:
     log = root / "sshd.log"
     with open(log, "wb") as err:
         process = subprocess.Popen(
-            [str(SSHD), "-D", "-e", "-f", str(root / "sshd_config")],
+            [*wrap, str(SSHD), "-D", "-e", "-f", str(root / "sshd_config")],
             stdin=subprocess.DEVNULL,
             stdout=err,
             stderr=err,
             start_new_session=True,
         )
     try:
-        _wait_listening(port, process, log)
+        _wait_listening(address, port, process, log)
     except BaseException:
         process.kill()
         process.wait()
@@ -135,3 +144,60 @@ def serve(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
         yield server
     finally:
         stop(server)
+
+
+class Namespace:
+    """A network namespace joined to this one by a veth pair: a second "host" on one machine."""
+
+    def __init__(self) -> None:
+        tag = f"{os.getpid() % 100000}{os.urandom(1).hex()}"
+        self.name = f"mlaunch-{tag}"
+        self.veth = f"mlv{tag}"[:13]
+        subnet = 4 * (os.getpid() % 60)
+        third = int(os.urandom(1).hex(), 16)
+        self.host_ip = f"10.231.{third}.{subnet + 1}"
+        self.ns_ip = f"10.231.{third}.{subnet + 2}"
+
+    def create(self) -> None:
+        ns, host, inner = self.name, self.veth + "a", self.veth + "b"
+        for command in (
+            ["ip", "netns", "add", ns],
+            ["ip", "link", "add", host, "type", "veth", "peer", "name", inner],
+            ["ip", "link", "set", inner, "netns", ns],
+            ["ip", "addr", "add", f"{self.host_ip}/30", "dev", host],
+            ["ip", "link", "set", host, "up"],
+            ["ip", "netns", "exec", ns, "ip", "addr", "add", f"{self.ns_ip}/30", "dev", inner],
+            ["ip", "netns", "exec", ns, "ip", "link", "set", inner, "up"],
+            ["ip", "netns", "exec", ns, "ip", "link", "set", "lo", "up"],
+        ):
+            subprocess.run(command, check=True, capture_output=True, timeout=10)
+
+    def delete(self) -> None:
+        subprocess.run(["ip", "link", "del", self.veth + "a"], capture_output=True, timeout=10)
+        subprocess.run(["ip", "netns", "del", self.name], capture_output=True, timeout=10)
+
+
+def serve_in_namespace(tmp_path_factory: pytest.TempPathFactory, alias: str) -> Iterator[Server]:
+    """A module fixture's body: sshd in a network namespace of its own, or a clear skip."""
+    if SSHD is None or shutil.which("ssh") is None or shutil.which("ip") is None:
+        pytest.skip("sshd, ssh or ip not installed: apt-get install openssh-server iproute2")
+    namespace = Namespace()
+    try:
+        namespace.create()
+    except (OSError, subprocess.CalledProcessError) as e:
+        namespace.delete()
+        detail = getattr(e, "stderr", b"") or b""
+        pytest.skip(f"cannot make a network namespace here (needs root): {detail.decode().strip()}")
+    try:
+        server = start(
+            tmp_path_factory.mktemp("sshd-ns"),
+            address=namespace.ns_ip,
+            alias=alias,
+            wrap=("ip", "netns", "exec", namespace.name),
+        )
+        try:
+            yield server
+        finally:
+            stop(server)
+    finally:
+        namespace.delete()

@@ -173,7 +173,7 @@ def test_a_killed_connection_stops_the_remote_and_is_reported(
         masters = [p for p in marked(token) if b"ControlMaster=yes" in _cmdline(p)]
         assert len(masters) == 1, describe(marked(token))
         os.kill(masters[0], signal.SIGKILL)
-        run.wait_for(r"connection to machine 'robot' .* ended before the process did", 20)
+        run.wait_for(r"no exit status came back from machine 'robot' .* the connection ended", 20)
         assert run.finish(20) == 0, run.text
     finally:
         run.kill()
@@ -270,3 +270,45 @@ def test_mlaunch_test_works_across_machines(sshd: Server, tmp_path: Path, token:
     )  # fmt: skip
     assert done.returncode == 0, done.stdout + done.stderr
     assert_nothing_left(token)
+
+
+@pytest.fixture(scope="module")
+def second_host(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    yield from sshd_server.serve_in_namespace(tmp_path_factory, "mltest2")
+
+
+def test_two_hosts_and_this_computer_run_print_and_stop_cleanly(
+    sshd: Server, second_host: Server, tmp_path: Path, token: str
+) -> None:
+    config = tmp_path / "ssh_config"
+    config.write_text(sshd.client_config.read_text() + second_host.client_config.read_text())
+    path = write_launch(
+        tmp_path,
+        token,
+        [
+            "Machine(name='far', address='mltest2')",
+            "ExecuteProcess(cmd=['sh', '-c', 'echo here-up; exec sleep 30'], output='screen')",
+            remote("echo robot-up $(hostname -I); exec sleep 30"),
+            remote("echo far-up $(hostname -I); exec sleep 30").replace("'robot'", "'far'"),
+        ],
+    )
+    env = {**env_for(sshd, token), "MLAUNCH_SSH_CONFIG": str(config)}
+    run = Running(mlaunch(str(path)), env=env)
+    try:
+        run.wait_for(r"\[sh-1\] here-up", 20)
+        run.wait_for(r"\[sh-2\] robot-up", 20)
+        far = run.wait_for(r"\[sh-3\] far-up (.*)", 20)
+        assert far.group(1).split()[0] == second_host_address(second_host)
+        run.signal(signal.SIGINT)
+        assert run.finish(20) == 130, run.text
+    finally:
+        run.kill()
+    assert run.text.count("process stopped by SIGINT") == 3, run.text
+    assert_nothing_left(token)
+
+
+def second_host_address(server: Server) -> str:
+    for line in server.client_config.read_text().splitlines():
+        if line.strip().startswith("HostName"):
+            return line.split()[1]
+    raise AssertionError("no HostName in the second host's config")

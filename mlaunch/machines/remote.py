@@ -49,8 +49,9 @@ NOT_FORWARDED = frozenset(
 # The agent waits at most this long between SIGTERM and SIGKILL when mlaunch is gone.
 MAX_GRACE = 10.0
 LOST = (
-    "mlaunch: the connection to machine {name!r} ({where}) ended before the process did;"
-    " its remote process group is being stopped by the agent there\n"
+    "mlaunch: no exit status came back from machine {name!r} ({where}): the connection ended"
+    " before the process did (the agent there stops its group), or the agent could not start"
+    " (is python3 on that machine's PATH?)\n"
 )
 
 
