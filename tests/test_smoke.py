@@ -245,8 +245,8 @@ def test_hold_catches_a_crash_after_ready_and_deadline_fails_output(tmp_path: Pa
     assert held.returncode == 1, held.stdout + held.stderr
     assert "holding for 5 s" in held.stdout
     assert "exited with status 4 after" in held.stdout
-    # Without --allow-exit the one-shot process is a failure too; an output never printed
-    # fails at its own deadline with what was looked for.
+    # A process that exits 0 and is not respawned is a one-shot, fine without --allow-exit; an
+    # output never printed fails at its own deadline with what was looked for.
     missed = run_mlaunch(
         "test",
         _plain(tmp_path, 60),
@@ -257,8 +257,44 @@ def test_hold_catches_a_crash_after_ready_and_deadline_fails_output(tmp_path: Pa
         env=clean_env(),
     )
     assert missed.returncode == 1
-    assert "process oneshot-3 starts and keeps running" in missed.stdout
-    assert "exited with status 0" in missed.stdout
+    oneshot = _row(missed.stdout, "process oneshot-3")
+    assert oneshot.startswith("ok") and "a one-shot, finished" in oneshot, missed.stdout
+    assert _row(missed.stdout, "output of worker").startswith("FAIL"), missed.stdout
+
+
+RESPAWNER = """
+import sys
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+PY = sys.executable
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        ExecuteProcess(cmd=[PY, "-c", "import time; time.sleep(60)"], name="steady"),
+        ExecuteProcess(
+            cmd=[PY, "-c", "import time; time.sleep(0.5)"], name="looper", respawn=True,
+            respawn_delay=0.2,
+        ),
+    ])
+"""
+
+
+def test_default_hold_catches_a_late_crash_and_a_respawning_exit_fails(tmp_path: Path) -> None:
+    # No --hold: the default hold (3 s) still sees the worker die 2 s after it started.
+    late = run_mlaunch("test", _plain(tmp_path, 2.0), env=clean_env())
+    assert late.returncode == 1, late.stdout + late.stderr
+    assert "holding for 3 s" in late.stdout
+    assert "exited with status 4 after" in _row(late.stdout, "process worker-2")
+    # A process started with respawn that exits fails, even with status 0.
+    path = tmp_path / "respawn.launch.py"
+    path.write_text(RESPAWNER)
+    done = run_mlaunch("test", str(path), "--hold", "2", env=clean_env())
+    assert done.returncode == 1, done.stdout + done.stderr
+    row = _row(done.stdout, "process looper-2")
+    assert row.startswith("FAIL") and "exited with status 0" in row, done.stdout
+    assert _row(done.stdout, "process steady-1").startswith("ok")
 
 
 def test_bad_options_are_one_line_errors(tmp_path: Path) -> None:

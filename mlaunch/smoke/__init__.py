@@ -1,7 +1,7 @@
 """``mlaunch test FILE [name:=value ...] [options]``: a CI smoke run of a launch file.
 
 It starts the launch exactly as ``mlaunch FILE`` would, waits until the system is *ready*,
-optionally holds it (``--hold S``) watching for crashes, shuts it down and exits 0; anything
+holds it (``--hold S``, 3 s by default) watching for crashes, shuts it down and exits 0; anything
 else exits 1 with a table of what was expected and what was seen, and the last lines of output
 of the processes involved (``--junit FILE`` writes the same as JUnit XML).
 
@@ -12,8 +12,12 @@ Ready means, by default:
   - with use_sim_time (``--use-sim-time``, ``use_sim_time:=true``, a SetParameter or a node's
     own parameter), ``/clock`` is advancing;
 and at the end, every process stopped within its stop ladder (none needed SIGKILL). A process
-that exits before the end fails the test even if it would be respawned; ``--allow-exit LABEL``
-lets a one-shot process (label or base name) finish with status 0. Processes started later by
+that exits with a failure (non-zero status, or a signal) before the end fails the test; one that
+exits 0 is a one-shot (a spawner, a loader) and fine, unless it was started with respawn: a
+respawning process that exits fails even with status 0, and ``--allow-exit LABEL`` lets it
+(label or base name) finish with status 0. At the end, a process that started less than
+STARTUP_GRACE seconds ago is given the rest of that time before the stop signals, so it is not
+interrupted half-way through its imports. Processes started later by
 timers or event handlers are watched from when they start.
 
 More expectations, from the command line (each has the overall ``--timeout`` as deadline unless
@@ -70,6 +74,11 @@ _HELP = __doc__ or ""
 EXIT_PASS = 0
 EXIT_FAIL = 1
 DEFAULT_TIMEOUT = 30.0
+# Held after ready so a node that crashes a few seconds in is caught (--hold 0 skips it).
+DEFAULT_HOLD = 3.0
+# At the end, the youngest process is given up to this long since its start before the stop
+# signals: SIGINT during a Python node's imports leaves a traceback in a passing run.
+STARTUP_GRACE = 2.0
 RING_LINES = 20
 # A topic given with a rate passes at this fraction of it (publishers jitter, CI machines lag).
 RATE_TOLERANCE = 0.9
@@ -308,7 +317,7 @@ class Settings:
 
     expectations: list[Expectation] = field(default_factory=list)
     timeout: float = DEFAULT_TIMEOUT
-    hold: float = 0.0
+    hold: float = DEFAULT_HOLD
     junit: str | None = None
     allow_exit: list[str] = field(default_factory=list)
 
@@ -367,14 +376,22 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help=f"deadline for everything to be ready (default {DEFAULT_TIMEOUT:g} s)",
     )
-    parser.add_argument("--hold", type=float, default=0.0, metavar="S", help="stay up S seconds")
+    parser.add_argument(
+        "--hold",
+        type=float,
+        default=DEFAULT_HOLD,
+        metavar="S",
+        help=f"stay up S seconds after ready, watching for crashes (default {DEFAULT_HOLD:g};"
+        " 0 skips it)",
+    )
     parser.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     parser.add_argument(
         "--allow-exit",
         action="append",
         default=[],
         metavar="LABEL",
-        help="a process (label or base name) that may finish with status 0 (repeatable)",
+        help="a respawning process (label or base name) that may still finish with status 0"
+        " (repeatable; a process without respawn that exits 0 is a one-shot, fine anyway)",
     )
     return parser
 
@@ -696,6 +713,9 @@ class SmokeRun:
         what = f"{describe_status(code)} after {uptime:.1f} s (pid {process.pid})"
         if self.phase == "done" or process.stopping or self.supervisor.shutting_down:
             return
+        if code == 0 and process.spec.respawn.mode == "never":
+            e.seen = f"{what}: a one-shot, finished"
+            return
         if code == 0 and _allowed(process.spec, self.settings.allow_exit):
             e.seen = f"{what}: allowed by --allow-exit"
             return
@@ -778,10 +798,21 @@ class SmokeRun:
     def _finish(self, reason: str) -> None:
         if self.phase == "done":
             return
+        wait = self._starting_for()
+        if wait > 0:
+            # Let the youngest process finish starting (see STARTUP_GRACE); checks still run.
+            self.supervisor.schedule(wait, lambda: self._finish(reason), keeps_alive=False)
+            return
         self.phase = "done"
         self.failed_reason = reason if "failed" in reason else ""
         self._stop.set()
         self.supervisor.begin_shutdown(reason)
+
+    def _starting_for(self) -> float:
+        """How much longer the youngest running process needs to reach STARTUP_GRACE of age."""
+        now = self.supervisor.clock()
+        ages = [now - p.started_at for p in self.supervisor.processes if p.running]
+        return max(0.0, STARTUP_GRACE - min(ages)) if ages else 0.0
 
     # --- checker thread ---------------------------------------------------------------------------
 
