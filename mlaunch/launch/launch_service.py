@@ -304,11 +304,9 @@ class LaunchService:
             pass  # a full pipe already wakes the loop; a closed one means the run ended
 
     def _run_calls(self, fd: int) -> None:
-        try:
-            while os.read(fd, 4096):
-                pass
-        except BlockingIOError:
-            pass
+        from mlaunch.run.signals import drain
+
+        drain(fd)
         while self._calls:
             self._calls.popleft()()
 

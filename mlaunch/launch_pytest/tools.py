@@ -78,42 +78,38 @@ def _assert_output(
         validate(_text(_run(launch_context), action, fd))  # raises its own assertion
 
 
-def wait_for_output_sync(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> bool:
-    """Whether ``validate_output(stdout so far)`` became true within ``timeout`` seconds."""
-    return _wait_output(launch_context, action, lambda out: bool(validate_output(out)), timeout, 1)
+def _output_waiter(fd: int) -> Callable[..., bool]:
+    def wait(
+        launch_context: Any,
+        action: Any,
+        validate_output: Callable[[str], Any],
+        timeout: float | None = None,
+    ) -> bool:
+        """Whether ``validate_output(output so far)`` became true within ``timeout`` seconds."""
+        return _wait_output(
+            launch_context, action, lambda out: bool(validate_output(out)), timeout, fd
+        )
+
+    return wait
 
 
-def assert_output_sync(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> None:
-    """Wait until ``validate_output(stdout so far)`` raises no AssertionError; else raise it."""
-    _assert_output(launch_context, action, validate_output, timeout, 1)
+def _output_asserter(fd: int) -> Callable[..., None]:
+    def check(
+        launch_context: Any,
+        action: Any,
+        validate_output: Callable[[str], Any],
+        timeout: float | None = None,
+    ) -> None:
+        """Wait until ``validate_output(output so far)`` raises no AssertionError; else raise."""
+        _assert_output(launch_context, action, validate_output, timeout, fd)
+
+    return check
 
 
-def wait_for_stderr_sync(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> bool:
-    return _wait_output(launch_context, action, lambda out: bool(validate_output(out)), timeout, 2)
-
-
-def assert_stderr_sync(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> None:
-    _assert_output(launch_context, action, validate_output, timeout, 2)
+wait_for_output_sync = _output_waiter(1)
+wait_for_stderr_sync = _output_waiter(2)
+assert_output_sync = _output_asserter(1)
+assert_stderr_sync = _output_asserter(2)
 
 
 def _wait_event(launch_context: Any, action: Any, exited: bool, timeout: float | None) -> bool:
@@ -136,53 +132,22 @@ def wait_for_exit_sync(launch_context: Any, action: Any, timeout: float | None =
     return _wait_event(launch_context, action, True, timeout)
 
 
-async def wait_for_output(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> bool:
-    return await asyncio.to_thread(
-        wait_for_output_sync, launch_context, action, validate_output, timeout
-    )
+def _in_a_thread(function: Callable[..., Any]) -> Callable[..., Any]:
+    """The coroutine version of a ``*_sync`` function: it waits in a worker thread."""
+
+    async def run(*args: Any, **kwargs: Any) -> Any:
+        return await asyncio.to_thread(function, *args, **kwargs)
+
+    run.__name__ = run.__qualname__ = function.__name__.removesuffix("_sync")
+    return run
 
 
-async def assert_output(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> None:
-    await asyncio.to_thread(assert_output_sync, launch_context, action, validate_output, timeout)
-
-
-async def wait_for_stderr(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> bool:
-    return await asyncio.to_thread(
-        wait_for_stderr_sync, launch_context, action, validate_output, timeout
-    )
-
-
-async def assert_stderr(
-    launch_context: Any,
-    action: Any,
-    validate_output: Callable[[str], Any],
-    timeout: float | None = None,
-) -> None:
-    await asyncio.to_thread(assert_stderr_sync, launch_context, action, validate_output, timeout)
-
-
-async def wait_for_start(launch_context: Any, action: Any, timeout: float | None = None) -> bool:
-    return await asyncio.to_thread(wait_for_start_sync, launch_context, action, timeout)
-
-
-async def wait_for_exit(launch_context: Any, action: Any, timeout: float | None = None) -> bool:
-    return await asyncio.to_thread(wait_for_exit_sync, launch_context, action, timeout)
-
+wait_for_output = _in_a_thread(wait_for_output_sync)
+assert_output = _in_a_thread(assert_output_sync)
+wait_for_stderr = _in_a_thread(wait_for_stderr_sync)
+assert_stderr = _in_a_thread(assert_stderr_sync)
+wait_for_start = _in_a_thread(wait_for_start_sync)
+wait_for_exit = _in_a_thread(wait_for_exit_sync)
 
 # launch_pytest.tools.process is this module too (``from launch_pytest.tools import process``).
 process = sys.modules[__name__]

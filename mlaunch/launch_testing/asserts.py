@@ -10,7 +10,7 @@ from mlaunch.launch_testing.util import NO_CMD_ARGS, resolveProcesses
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Callable, Sequence
     from typing import Any
 
 EXIT_OK = 0
@@ -81,48 +81,25 @@ def assertInStream(
     )
 
 
-def assertInStdout(
-    proc_output: Any,
-    expected_output: Any,
-    process: Any,
-    cmd_args: Any = None,
-    *,
-    output_filter: Any = None,
-    strict_proc_matching: bool = True,
-    strip_ansi_escape_sequences: bool = True,
-) -> None:
-    assertInStream(
-        proc_output,
-        expected_output,
-        process,
-        cmd_args,
-        output_filter=output_filter,
-        strict_proc_matching=strict_proc_matching,
-        strip_ansi_escape_sequences=strip_ansi_escape_sequences,
-        stream="stdout",
-    )
+def _in_one_stream(stream: str) -> Callable[..., None]:
+    """assertInStream with ``stream`` fixed (assertInStdout, assertInStderr)."""
+
+    def check(
+        proc_output: Any,
+        expected_output: Any,
+        process: Any,
+        cmd_args: Any = None,
+        **options: Any,
+    ) -> None:
+        assertInStream(proc_output, expected_output, process, cmd_args, stream=stream, **options)
+
+    check.__name__ = check.__qualname__ = f"assertIn{stream.capitalize()}"
+    check.__doc__ = f"assertInStream on the {stream} of ``process``."
+    return check
 
 
-def assertInStderr(
-    proc_output: Any,
-    expected_output: Any,
-    process: Any,
-    cmd_args: Any = None,
-    *,
-    output_filter: Any = None,
-    strict_proc_matching: bool = True,
-    strip_ansi_escape_sequences: bool = True,
-) -> None:
-    assertInStream(
-        proc_output,
-        expected_output,
-        process,
-        cmd_args,
-        output_filter=output_filter,
-        strict_proc_matching=strict_proc_matching,
-        strip_ansi_escape_sequences=strip_ansi_escape_sequences,
-        stream="stderr",
-    )
+assertInStdout = _in_one_stream("stdout")
+assertInStderr = _in_one_stream("stderr")
 
 
 def assertDefaultStream() -> str:

@@ -51,11 +51,7 @@ class SignalWatch:
         self.pending.append(signum)
 
     def _drain_wakeup(self, fd: int) -> None:
-        try:
-            while os.read(fd, 4096):
-                pass
-        except BlockingIOError:
-            pass
+        drain(fd)
 
     def stop(self) -> None:
         """Put back the handlers and wake-up fd that were there before ``start``."""
@@ -72,3 +68,12 @@ class SignalWatch:
                 os.close(fd)
             except OSError:
                 pass
+
+
+def drain(fd: int) -> None:
+    """Read a non-blocking wake-up pipe empty (its bytes only say "look again")."""
+    try:
+        while os.read(fd, 4096):
+            pass
+    except BlockingIOError:
+        pass
