@@ -37,7 +37,7 @@ def one_run(launch: str, index: int) -> tuple[int, float, str]:
         timeout=RUN_TIMEOUT,
         stdin=subprocess.DEVNULL,
     )
-    failed = [line for line in done.stdout.splitlines() if line.startswith("FAIL")]
+    failed = [line.strip() for line in done.stdout.splitlines() if line.strip().startswith("FAIL")]
     return done.returncode, time.monotonic() - started, "; ".join(failed)[:200]
 
 
@@ -58,7 +58,7 @@ def main() -> int:
         for i, (code, seconds, failed) in enumerate(results, 1):
             mark = "ok " if code == expected else "BAD"
             good += code == expected
-            print(f"{mark} {launch} run {i}: status {code} in {seconds:.1f} s {failed}")
+            print(f"{mark} {launch} run {i}: status {code} in {seconds:.1f} s {failed}", flush=True)
         print(f"{launch}: {good}/{args.runs} runs gave status {expected}")
         ok &= good == args.runs
     return 0 if ok else 1

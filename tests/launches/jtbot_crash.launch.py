@@ -1,4 +1,4 @@
-"""jtbot_sim plus one node that crashes 3 s after it starts: ``mlaunch test`` must fail it, every
+"""jtbot_sim plus one node that crashes 3 s after its process starts: ``mlaunch test`` must fail it, every
 time (scripts/smoke_repeat.py runs both 20 times)."""
 
 import os
@@ -20,7 +20,11 @@ def generate_launch_description():
             ),
             Node(
                 executable=sys.executable,
-                arguments=[os.path.join(ROOT, "tests", "nodes", "talker.py"), "--die-after", "3"],
+                arguments=[
+                    os.path.join(ROOT, "tests", "nodes", "crasher.py"),
+                    "--crash-after",
+                    "3",
+                ],
                 name="crasher",
                 output="screen",
             ),
