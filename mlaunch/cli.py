@@ -20,6 +20,10 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.ros.search import PackageSearch
+    from mlaunch.run.lifeline import Lifeline
+
+# The private params folder of a run; other commands (export, LaunchService) make one too.
+from mlaunch.run.lifeline import private_temp_dir, remove_private_dir  # noqa: E402, F401
 
 SUBCOMMANDS = {
     "test": "mlaunch.smoke",
@@ -262,8 +266,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     debug = "--debug" in args or "-d" in args
     try:
         return run_cli(args)
-    except KeyboardInterrupt:
-        return 130
+    except KeyboardInterrupt as e:  # Ctrl-C, or lifeline.Stopped: SIGTERM, SIGHUP
+        return getattr(e, "exit_code", 130)
+    except BrokenPipeError:
+        from mlaunch.run.lifeline import stdout_gone
+
+        return stdout_gone()
     except Exception as e:
         return report_error(e, debug)
 
@@ -275,13 +283,14 @@ def report_error(error: BaseException, debug: bool) -> int:
         import traceback
 
         traceback.print_exception(error)
+    from mlaunch.run.lifeline import say
+
     if isinstance(error, MlaunchError):
-        print(f"mlaunch: error: {error}", file=sys.stderr)
+        say(f"mlaunch: error: {error}")
         return error.exit_code
-    print(
+    say(
         f"mlaunch: internal error: {type(error).__name__}: {error}"
-        " (run with --debug for the traceback)",
-        file=sys.stderr,
+        " (run with --debug for the traceback)"
     )
     return 70
 
@@ -338,80 +347,53 @@ def resolve_for_run(
 
 
 def run_cli(argv: Sequence[str]) -> int:
+    from mlaunch.run.lifeline import Lifeline, write_stdout
+
     opts = parse_options(argv)
-    path, description = load_target(opts)
-    if opts.show_args:
-        from mlaunch.ros.search import searching
-        from mlaunch.run.resolve import collect_arguments
+    # From here on a launch file's code and substitutions may start processes: signals, the
+    # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
+    with Lifeline() as life:
+        path, description = load_target(opts)
+        if opts.show_args:
+            from mlaunch.ros.search import searching
+            from mlaunch.run.resolve import collect_arguments
 
-        with searching(package_search(opts, path)):
-            infos = collect_arguments(
-                description, path=path, arguments=opts.arguments, environ=os.environ
-            )
-        sys.stdout.write(format_arguments(infos))
-        return 0
-    return launch(opts, path, description)
-
-
-def private_temp_dir() -> str:
-    """A directory only this user can read, for params files (tempfile costs ~4 ms to import)."""
-    base = os.environ.get("TMPDIR") or "/tmp"
-    for _ in range(100):
-        path = os.path.join(base, f"mlaunch-{os.getpid()}-{os.urandom(4).hex()}")
-        try:
-            os.mkdir(path, 0o700)
-        except FileExistsError:
-            continue
-        return path
-    raise OSError(f"cannot create a private directory in {base}")
-
-
-def remove_private_dir(path: str) -> None:
-    """Remove the params-file folder: flat, so no shutil (2 ms to import at exit)."""
-    try:
-        entries = list(os.scandir(path))
-    except FileNotFoundError:
-        return
-    if any(e.is_dir(follow_symlinks=False) for e in entries):
-        import shutil
-
-        shutil.rmtree(path, ignore_errors=True)
-        return
-    for entry in entries:
-        try:
-            os.unlink(entry.path)
-        except FileNotFoundError:
-            pass
-    try:
-        os.rmdir(path)
-    except OSError:
-        pass
-
-
-def launch(opts: Options, path: str, description: object) -> int:
-    temp_dir = private_temp_dir()
-    try:
-        log_dir = ""
-        if not opts.print_plan:
-            from mlaunch.run.logfiles import make_run_log_dir
-
-            log_dir = make_run_log_dir(os.environ)
-        plan, options, labels = resolve_for_run(
-            opts, path, description, temp_dir=temp_dir, log_dir=log_dir
-        )
-        if opts.print_plan:
-            from mlaunch.run.describe import describe_plan
-
-            sys.stdout.write(describe_plan(plan, path))
+            with searching(package_search(opts, path)):
+                infos = collect_arguments(
+                    description, path=path, arguments=opts.arguments, environ=os.environ
+                )
+            write_stdout(format_arguments(infos))
             return 0
-        return supervise(opts, plan, options, labels, log_dir)
-    finally:
-        remove_private_dir(temp_dir)
+        return launch(opts, path, description, life)
 
 
-def supervise(opts: Options, plan: object, options: object, labels: object, log_dir: str) -> int:
+def launch(opts: Options, path: str, description: object, life: Lifeline) -> int:
+    log_dir = ""
+    if not opts.print_plan:
+        from mlaunch.run.logfiles import make_run_log_dir
+
+        log_dir = make_run_log_dir(os.environ)
+    plan, options, labels = resolve_for_run(
+        opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir
+    )
+    if opts.print_plan:
+        from mlaunch.run.describe import describe_plan
+        from mlaunch.run.lifeline import write_stdout
+
+        write_stdout(describe_plan(plan, path))
+        return 0
+    return supervise(opts, plan, options, labels, log_dir, life)
+
+
+def supervise(
+    opts: Options,
+    plan: object,
+    options: object,
+    labels: object,
+    log_dir: str,
+    life: Lifeline,
+) -> int:
     from mlaunch.errors import UsageError
-    from mlaunch.run.guard import Guard, new_run_id
     from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
     from mlaunch.run.output import Printer, stdout_is_color_terminal
     from mlaunch.run.supervisor import Supervisor
@@ -420,9 +402,7 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
         raise UsageError(
             f"--log-max-bytes is {opts.log_max_bytes}; valid: 0 (never rotate) or more"
         )
-    # The guard first, before any child exists: if mlaunch is killed it ends what mlaunch began.
-    run_id = new_run_id()
-    guard = Guard.start(run_id, temp_dir=getattr(options, "temp_dir", None))
+    guard, run_id = life.guard, life.run_id
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
     printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet, rotate_bytes=rotate)
@@ -442,7 +422,11 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
         if spawner is not None:
             spawner.connect(plan.processes())  # type: ignore[attr-defined]
         extensions = _extensions(opts, supervisor)
-        code = supervisor.run()
+        life.block()  # until the supervisor's own handlers are in
+        try:
+            code = supervisor.run()
+        finally:
+            life.hand_over()
     finally:
         for ext in extensions:
             close = getattr(ext, "close", None)
@@ -452,7 +436,8 @@ def supervise(opts: Options, plan: object, options: object, labels: object, log_
             spawner.close()
         printer.close()
         # Everything the run started has ended (run() kills what is left even when it fails).
-        guard.close()
+        if guard is not None:
+            guard.close()
     return code
 
 
@@ -528,6 +513,9 @@ def program() -> None:
     only stdio buffers remain, so flushing them and calling os._exit skips ~8 ms of teardown
     between the last child's death and mlaunch's. Tests call main() instead.
     """
+    from mlaunch.run.lifeline import ensure_std_streams
+
+    ensure_std_streams()  # a closed stdout (mlaunch FILE >&-) must not lend its number to a file
     try:
         code = main()
     except SystemExit as e:  # argparse's usage errors and --help

@@ -30,6 +30,7 @@ class SignalWatch:
         self._wake_r = self._wake_w = -1
         self._old_wakeup = -1
         self._old_handlers: dict[int, Any] = {}
+        self._old_mask: set[int | signal.Signals] | None = None
 
     def start(self, selector: selectors.BaseSelector) -> None:
         """Install the handlers; the wake-up pipe is read from ``selector``."""
@@ -46,6 +47,9 @@ class SignalWatch:
         selector.register(self._wake_r, selectors.EVENT_READ, self._drain_wakeup)
         ours = (*STOP_SIGNALS, signal.SIGCHLD) if self.install else (signal.SIGCHLD,)
         self._old_handlers = {sig: signal.signal(sig, self._record) for sig in ours}
+        # mlaunch blocks the stop signals while it hands them over to us (lifeline): what
+        # arrived in that window is delivered now, to these handlers. The mask is put back.
+        self._old_mask = signal.pthread_sigmask(signal.SIG_UNBLOCK, ours)
 
     def _record(self, signum: int, frame: object) -> None:
         self.pending.append(signum)
@@ -54,9 +58,13 @@ class SignalWatch:
         drain(fd)
 
     def stop(self) -> None:
-        """Put back the handlers and wake-up fd that were there before ``start``."""
+        """Put back the mask, handlers and wake-up fd that were there before ``start``."""
         if self.polling:
             return
+        if self._old_mask is not None:
+            # Blocked again first, if they were: none may reach a handler that is not ours.
+            signal.pthread_sigmask(signal.SIG_SETMASK, self._old_mask)
+            self._old_mask = None
         for sig, handler in self._old_handlers.items():
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
         signal.set_wakeup_fd(self._old_wakeup)

@@ -241,8 +241,16 @@ class Supervisor:
     # --- plan steps ------------------------------------------------------------------------------
 
     def execute(self, steps: list[Step]) -> None:
+        skipped = 0
         for step in steps:
+            if self.signals.pending:
+                # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
+                # after the last one started. Exits wait for the loop, as in ROS 2.
+                self._handle_stop_signals()
             if isinstance(step, Spawn) and step.spec is not None:
+                if self.shutting_down:
+                    skipped += 1  # said once below, not once per process
+                    continue
                 self.start(step.spec)
             elif isinstance(step, Log):
                 self.printer.message(step.level, step.source, step.message)
@@ -261,6 +269,10 @@ class Supervisor:
                 self.begin_shutdown(step.reason)
             elif isinstance(step, EmitEvent):
                 self.emit(step.event)
+        if skipped:
+            self.printer.message(
+                "WARNING", "launch", f"{skipped} processes not started: the launch is shutting down"
+            )
 
     def fire(self, body: Deferred, event: Any) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
@@ -613,18 +625,33 @@ class Supervisor:
             if sig == signal.SIGCHLD:
                 self._reap()
                 continue
-            self._stop_presses += 1
-            if self._stop_presses == 1:
-                self.exit_code = max(self.exit_code, 128 + sig)
-                self.printer.message(
-                    "WARNING",
-                    "launch",
-                    f"user interrupted with {signal_name(sig)}; stopping (again to kill)",
-                )
-                self.begin_shutdown(f"{signal_name(sig)} received", due_to_signal=sig)
-            else:
-                self.kill_everything()
+            self._stop_pressed(sig)
         self._reap()
+
+    def _handle_stop_signals(self) -> None:
+        """Act on the stop signals recorded so far; leave exits (SIGCHLD) for the loop."""
+        pending = self.signals.pending
+        i = 0
+        while i < len(pending):  # in place: the handler may append meanwhile
+            sig = pending[i]
+            if sig == signal.SIGCHLD:
+                i += 1
+                continue
+            del pending[i]
+            self._stop_pressed(sig)
+
+    def _stop_pressed(self, sig: int) -> None:
+        self._stop_presses += 1
+        if self._stop_presses == 1:
+            self.exit_code = max(self.exit_code, 128 + sig)
+            self.printer.message(
+                "WARNING",
+                "launch",
+                f"user interrupted with {signal_name(sig)}; stopping (again to kill)",
+            )
+            self.begin_shutdown(f"{signal_name(sig)} received", due_to_signal=sig)
+        else:
+            self.kill_everything()
 
     def _notify(self, what: str, process: Process) -> None:
         for listener in self.listeners:

@@ -65,6 +65,7 @@ from mlaunch.run.plan import Step
 
 if TYPE_CHECKING:
     from mlaunch.ros.lifecycle import LifecycleManager, Outcome, SharedGraph
+    from mlaunch.run.lifeline import Lifeline
     from mlaunch.run.plan import Plan, ProcessSpec
     from mlaunch.run.process import Process
     from mlaunch.run.resolve import Resolver
@@ -491,27 +492,25 @@ def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
     from mlaunch import cli
     from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.run.lifeline import Lifeline
     from mlaunch.run.logfiles import make_run_log_dir
 
-    path, description = cli.load_target(opts)
-    collector = _CollectConfigurations()
-    temp_dir = cli.private_temp_dir()
-    try:
+    with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
+        path, description = cli.load_target(opts)
+        collector = _CollectConfigurations()
         log_dir = make_run_log_dir(os.environ)
         plan, options, labels = cli.resolve_for_run(
             opts,
             path,
             LaunchDescription([description, collector]),
-            temp_dir=temp_dir,
+            temp_dir=life.temp_dir,
             log_dir=log_dir,
         )
         # use_sim_time:=true is an ordinary launch argument; a file that declares it is
         # expected to run on simulated time, as --use-sim-time is.
         sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
         expectations = build_expectations(plan, settings, collector, sim_time)
-        return supervise(opts, settings, plan, options, labels, log_dir, path, expectations)
-    finally:
-        cli.remove_private_dir(temp_dir)
+        return supervise(opts, settings, plan, options, labels, log_dir, path, expectations, life)
 
 
 def build_expectations(
@@ -581,6 +580,7 @@ def supervise(
     log_dir: str,
     path: str,
     expectations: list[Expectation],
+    life: Lifeline,
 ) -> int:
     """Run the plan through ``mlaunch FILE``'s own supervise(), with the smoke checks attached.
 
@@ -604,7 +604,7 @@ def supervise(
 
     extensions.ATTACH.append(attach)
     try:
-        code = cli.supervise(opts, plan, options, labels, log_dir)
+        code = cli.supervise(opts, plan, options, labels, log_dir, life)
     finally:
         extensions.ATTACH.remove(attach)
     if not runs:

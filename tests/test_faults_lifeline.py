@@ -1,0 +1,243 @@
+"""Faults outside the supervisor's loop: a signal (or kill -9) while the launch file is loaded or
+resolved, Ctrl-C during a long batch of spawns, closed and broken standard streams.
+
+The windows are made long and observable on purpose: a ``Command`` substitution (or the launch
+file's own code) starts a helper that writes its pid, and the run id it inherited, to a file,
+then waits; the test waits for that file with a deadline, then injects the fault.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+from test_faults import PY, Mlaunch, alive, assert_nothing_left, wait_until
+
+# Writes "<run id> <pid>" to argv[1], starts a grandchild in a session of its own that does the
+# same to argv[1] + ".grand", then waits: what a slow xacro or a daemon-starting command is.
+HELPER = (
+    "import os, subprocess, sys, time\n"
+    "path = sys.argv[1]\n"
+    "if not path.endswith('.grand'):\n"
+    "    subprocess.Popen([sys.executable, path + '.py', path + '.grand'], start_new_session=True)\n"
+    "with open(path + '.tmp', 'w') as f:\n"
+    "    f.write(f\"{os.environ.get('MLAUNCH_RUN_ID')} {os.getpid()}\")\n"
+    "os.rename(path + '.tmp', path)\n"
+    "time.sleep(60)\n"
+)
+
+
+def helper(tmp_path: Path, name: str) -> Path:
+    """The helper's pid file (the code is beside it, for the grandchild to run)."""
+    pid_file = tmp_path / name
+    (tmp_path / f"{name}.py").write_text(HELPER)
+    return pid_file
+
+
+def read_pids(pid_file: Path) -> tuple[str, list[int]]:
+    """(run id, [helper pid, grandchild pid]) once both have written their files."""
+    grand = Path(f"{pid_file}.grand")
+    assert wait_until(lambda: pid_file.exists() and grand.exists(), 20), "helper never started"
+    run_id, pid = pid_file.read_text().split()
+    grand_id, grand_pid = grand.read_text().split()
+    assert run_id == grand_id != "None", "the run's marker must reach what loading starts"
+    return run_id, [int(pid), int(grand_pid)]
+
+
+def command_launch(tmp_path: Path, pid_file: Path) -> Path:
+    """A launch whose resolving runs the helper through a Command substitution."""
+    path = tmp_path / "slow_command.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "from launch.substitutions import Command\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([ExecuteProcess(\n"
+        f"        cmd=['echo', Command([{PY!r}, ' ', {str(pid_file) + '.py'!r}, ' ',"
+        f" {str(pid_file)!r}])], output='screen')])\n"
+    )
+    return path
+
+
+def loading_launch(tmp_path: Path, pid_file: Path) -> Path:
+    """A launch file whose own code, at load time, starts the helper and then takes its time."""
+    path = tmp_path / "slow_load.launch.py"
+    path.write_text(
+        "import subprocess, sys, time\n"
+        "from launch import LaunchDescription\n"
+        f"subprocess.Popen([sys.executable, {str(pid_file) + '.py'!r}, {str(pid_file)!r}])\n"
+        "def generate_launch_description():\n"
+        "    time.sleep(60)\n"
+        "    return LaunchDescription([])\n"
+    )
+    return path
+
+
+# --- a signal, or kill -9, while loading or resolving ---------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "sig", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT], ids=lambda s: s.name
+)
+@pytest.mark.parametrize("phase", ["resolving", "loading"])
+def test_a_stop_signal_before_the_launch_starts(tmp_path: Path, phase: str, sig: int) -> None:
+    pid_file = helper(tmp_path, "helper")
+    make = command_launch if phase == "resolving" else loading_launch
+    m = Mlaunch(tmp_path, make(tmp_path, pid_file))
+    try:
+        run_id, pids = read_pids(pid_file)
+        assert len(list(m.tmp.glob("mlaunch-*"))) == 1  # the private folder exists already
+        m.popen.send_signal(sig)
+        assert m.wait() == 128 + sig, m.text
+        err = m.stderr()
+        assert f"stopped by {signal.Signals(sig).name} before the launch had started" in err, err
+        assert "Traceback" not in err and "internal error" not in err, err
+        # The command, and its grandchild in a session of its own, end with mlaunch.
+        assert_nothing_left(run_id, pids, timeout=1)
+        assert not list(m.tmp.glob("mlaunch-*")), "private folder left on disk"
+    finally:
+        m.close()
+
+
+@pytest.mark.parametrize("phase", ["resolving", "loading"])
+def test_kill_9_before_the_launch_starts_leaves_nothing(tmp_path: Path, phase: str) -> None:
+    pid_file = helper(tmp_path, "helper")
+    make = command_launch if phase == "resolving" else loading_launch
+    m = Mlaunch(tmp_path, make(tmp_path, pid_file))
+    try:
+        run_id, pids = read_pids(pid_file)
+        m.popen.send_signal(signal.SIGKILL)
+        assert m.wait() == -signal.SIGKILL
+        assert_nothing_left(run_id, pids)  # the guard, forked before loading, ends them
+        assert wait_until(lambda: not list(m.tmp.glob("mlaunch-*")), 5), "private folder left"
+        assert "died without stopping its processes" in m.stderr()
+    finally:
+        m.close()
+
+
+# --- Ctrl-C during the first batch of spawns ------------------------------------------------------
+
+BATCH = 300
+
+
+def batch_launch(tmp_path: Path, killer: str, stubborn: bool) -> Path:
+    """``killer`` (a shell line) first, then BATCH sleepers; each spawn takes milliseconds."""
+    sleeper = "trap '' INT TERM; exec sleep 60" if stubborn else "exec sleep 60"
+    timeouts = ", sigterm_timeout='30', sigkill_timeout='30'" if stubborn else ""
+    path = tmp_path / "batch.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        f"    first = [ExecuteProcess(cmd=['sh', '-c', {killer!r}], name='killer'{timeouts})]\n"
+        "    return LaunchDescription(first + [\n"
+        f"        ExecuteProcess(cmd=['sh', '-c', {sleeper!r}], name='s'{timeouts})\n"
+        f"        for _ in range({BATCH})])\n"
+    )
+    return path
+
+
+def started(text: str) -> int:
+    return text.count("process started with pid")
+
+
+def test_ctrl_c_during_the_spawn_batch_acts_at_once(tmp_path: Path) -> None:
+    # The first process interrupts mlaunch while the other 300 are still being started.
+    m = Mlaunch(tmp_path, batch_launch(tmp_path, "kill -INT $PPID; exec sleep 60", False))
+    try:
+        assert m.wait(timeout=60) == 130, m.text
+        n = started(m.text)
+        assert n < BATCH, f"all {n} processes were started before Ctrl-C was acted on"
+        assert f"{BATCH + 1 - n} processes not started: the launch is shutting down" in m.text
+        assert m.text.count("not started") == 1  # one line, not one per process
+    finally:
+        m.close()
+
+
+def test_a_second_ctrl_c_during_the_spawn_batch_kills_at_once(tmp_path: Path) -> None:
+    # Everything ignores SIGINT and SIGTERM (30 s each): only the second Ctrl-C's SIGKILL ends
+    # them. The killer sends both, the second once the first was acted on (the log says so).
+    killer = (
+        "trap '' INT TERM; kill -INT $PPID; "
+        "while ! grep -qs 'user interrupted' \"$ROS_LOG_DIR\"/*/launch.log; do sleep 0.01; done; "
+        "kill -INT $PPID; exec sleep 60"
+    )
+    m = Mlaunch(tmp_path, batch_launch(tmp_path, killer, True))
+    try:
+        t0 = time.monotonic()
+        assert m.wait(timeout=60) == 130, m.text
+        print(f"second Ctrl-C: mlaunch exited {time.monotonic() - t0:.2f} s after start")
+        assert "stopping now: SIGKILL to every process" in m.text
+        assert started(m.text) < BATCH + 1
+        pids = [
+            int(w.strip("[]")) for w in m.text.split() if w.startswith("[") and w[1:-1].isdigit()
+        ]
+        assert wait_until(lambda: not any(alive(p) for p in pids), 5), "a sleeper outlived mlaunch"
+    finally:
+        m.close()
+
+
+# --- closed and broken standard streams ---------------------------------------------------------
+
+
+def quick_launch(tmp_path: Path) -> Path:
+    path = tmp_path / "quick.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        "        ExecuteProcess(cmd=['echo', 'hello from the child'], output='screen')])\n"
+    )
+    return path
+
+
+def run_with_shell(tmp_path: Path, shell: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """``shell`` with $M the mlaunch command line (so a stream can be closed with >&-)."""
+    env = dict(os.environ, TMPDIR=str(tmp_path), ROS_LOG_DIR=str(tmp_path / "log"))
+    env.pop("MLAUNCH_RUN_ID", None)
+    command = " ".join([PY, "-m", "mlaunch", *args])
+    return subprocess.run(
+        ["bash", "-c", shell.replace("$M", command)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+
+
+@pytest.mark.parametrize("closed", ["stdout", "stderr"])
+def test_a_closed_stream_at_start(tmp_path: Path, closed: str) -> None:
+    redirect = ">&-" if closed == "stdout" else "2>&-"
+    result = run_with_shell(tmp_path, f"$M {redirect}; echo status=$?", str(quick_launch(tmp_path)))
+    assert "status=0" in result.stdout, result.stdout + result.stderr
+    assert "Traceback" not in result.stderr and "internal error" not in result.stderr
+    if closed == "stderr":
+        assert "[echo-1] hello from the child" in result.stdout
+    logs = list((tmp_path / "log").glob("*/echo-1.log"))
+    assert logs and "hello from the child" in logs[0].read_text()
+    assert "All log files" in next((tmp_path / "log").glob("*/launch.log")).read_text()
+    assert not list(tmp_path.glob("mlaunch-*"))
+
+
+@pytest.mark.parametrize("view", ["--print", "--show-args"])
+def test_a_reader_that_goes_away_ends_mlaunch_like_a_unix_tool(tmp_path: Path, view: str) -> None:
+    # Large enough that the reader leaves long before mlaunch has written everything.
+    path = tmp_path / "big.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import DeclareLaunchArgument, ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription(\n"
+        "        [DeclareLaunchArgument(f'a{i}', default_value='x' * 40) for i in range(3000)]\n"
+        "        + [ExecuteProcess(cmd=['echo', str(i)]) for i in range(3000)])\n"
+    )
+    shell = '$M | head -1; echo "status=${PIPESTATUS[0]}"'
+    result = run_with_shell(tmp_path, shell, str(path), view)
+    assert "status=141" in result.stdout, result.stdout + result.stderr  # as `cat`: SIGPIPE
+    assert result.stderr == "", result.stderr
+    assert not list(tmp_path.glob("mlaunch-*"))
