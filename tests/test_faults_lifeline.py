@@ -241,3 +241,28 @@ def test_a_reader_that_goes_away_ends_mlaunch_like_a_unix_tool(tmp_path: Path, v
     assert "status=141" in result.stdout, result.stdout + result.stderr  # as `cat`: SIGPIPE
     assert result.stderr == "", result.stderr
     assert not list(tmp_path.glob("mlaunch-*"))
+
+
+# --- the marker scan --------------------------------------------------------------------------------
+
+
+def test_the_marker_scan_finds_a_process_in_the_middle_of_exec() -> None:
+    # While a process runs execve() its environment reads empty for a moment; a sweep that
+    # looked just then used to miss a stray (setsid here is exec'ing sleep when it is scanned).
+    from mlaunch.run import guard as guards
+
+    run_id = guards.new_run_id()
+    env = dict(os.environ, MLAUNCH_RUN_ID=run_id)
+    missed = []
+    for _ in range(60):
+        sh = subprocess.Popen(
+            ["/bin/sh", "-c", "setsid sleep 5 & echo $!; exit 0"], stdout=subprocess.PIPE, env=env
+        )
+        assert sh.stdout is not None
+        pid = int(sh.stdout.readline())
+        info = guards.proc_info(pid)  # looked at first, at once: the race is in the first ms
+        if info is not None and not guards.marked(run_id, [info]):
+            missed.append(pid)
+        sh.wait()
+        os.kill(pid, signal.SIGKILL)
+    assert not missed, f"{len(missed)} of 60 marked processes were not found"

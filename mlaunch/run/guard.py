@@ -178,19 +178,54 @@ def tree(root: int) -> list[ProcInfo]:
 
 def has_marker(pid: int, run_id: str) -> bool:
     """Whether ``pid``'s environment carries ``MLAUNCH_RUN_ID=run_id``."""
+    env = _environ(pid)
+    return env is not None and f"{MARKER}={run_id}".encode() in env.split(b"\0")
+
+
+def _environ(pid: int) -> bytes | None:
     try:
-        env = _read(f"/proc/{pid}/environ")
+        return _read(f"/proc/{pid}/environ")
     except OSError:
-        return False  # gone, or not ours to read
-    entry = f"{MARKER}={run_id}".encode()
-    return entry in env.split(b"\0")
+        return None  # gone, or not ours to read
+
+
+# Waits before looking again at a process whose environment reads empty (see ``marked``).
+EXEC_RETRIES = (0.002, 0.004, 0.008, 0.016)
 
 
 def marked(run_id: str, procs: list[ProcInfo] | None = None) -> list[ProcInfo]:
-    """Living processes of this run, found by the marker in their environment."""
+    """Living processes of this run, found by the marker in their environment.
+
+    A process in the middle of execve() shows an empty environment for a moment (its new
+    memory has no environment block yet), so one that reads empty and is not a kernel thread
+    is looked at again a few times, ~30 ms at most: a stray caught exec'ing would be missed.
+    """
     procs = scan() if procs is None else procs
     me = os.getpid()
-    return [p for p in procs if not p.zombie and p.pid != me and has_marker(p.pid, run_id)]
+    entry = f"{MARKER}={run_id}".encode()
+    found: list[ProcInfo] = []
+    blank: list[ProcInfo] = []
+    for p in procs:
+        if p.zombie or p.pid == me:
+            continue
+        env = _environ(p.pid)
+        if env == b"" and p.ppid not in (0, 2):  # kernel threads are children of kthreadd (2)
+            blank.append(p)
+        elif env and entry in env.split(b"\0"):
+            found.append(p)
+    for pause in EXEC_RETRIES:
+        if not blank:
+            break
+        time.sleep(pause)
+        still: list[ProcInfo] = []
+        for p in blank:
+            env = _environ(p.pid)
+            if env == b"":
+                still.append(p)
+            elif env and entry in env.split(b"\0"):
+                found.append(p)
+        blank = still
+    return found
 
 
 # --- the mlaunch side -----------------------------------------------------------------------------
