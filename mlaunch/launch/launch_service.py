@@ -192,14 +192,14 @@ class LaunchService:
     # --- running --------------------------------------------------------------------------------
 
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
-        from mlaunch import cli
         from mlaunch.run.guard import Guard, new_run_id
+        from mlaunch.run.lifeline import private_temp_dir, remove_private_dir
         from mlaunch.run.logfiles import make_run_log_dir
         from mlaunch.run.output import Printer, stdout_is_color_terminal
         from mlaunch.run.resolve import LabelCounter, ResolveOptions
         from mlaunch.run.supervisor import Supervisor
 
-        temp_dir = cli.private_temp_dir()
+        temp_dir = private_temp_dir()
         guard = None
         printer = None
         wake_r = -1
@@ -252,7 +252,7 @@ class LaunchService:
                 if fd >= 0:
                     os.close(fd)
             self._wake_w = -1
-            cli.remove_private_dir(temp_dir)
+            remove_private_dir(temp_dir)
 
     def _resolve(self, description: Any) -> Plan:
         """Resolve ``description`` in the service's context (shared by every include)."""
