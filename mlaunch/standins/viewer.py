@@ -378,14 +378,44 @@ def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRe
     return Handler
 
 
-def serve(state: ViewerState, port: int, clock: Any) -> ThreadingHTTPServer:
+# A browser that goes away mid-request (a reload, a cancelled poll, a closed tab) is routine.
+BROWSER_GONE = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError, TimeoutError)
+
+
+class PageServer(ThreadingHTTPServer):
+    """The page's HTTP server: a browser that resets its connection is not an error.
+
+    socketserver prints a 20-line traceback into the launch output for every failed request;
+    here a reset is counted (``gone``) and anything else is one line on stderr, written in one
+    call so that concurrent requests do not interleave.
+    """
+
+    daemon_threads = True
+    gone = 0
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        error = sys.exc_info()[1]
+        if isinstance(error, BROWSER_GONE):
+            self.gone += 1
+            return
+        try:
+            where = f"{client_address[0]}:{client_address[1]}"
+        except (TypeError, IndexError):
+            where = str(client_address)
+        line = f"viewer: a request from {where} failed: {type(error).__name__}: {error}\n"
+        try:
+            os.write(2, line.encode("utf-8", "replace"))
+        except OSError:
+            pass
+
+
+def serve(state: ViewerState, port: int, clock: Any) -> PageServer:
     """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
     page = PAGE.read_bytes()
     try:
-        server = ThreadingHTTPServer(("127.0.0.1", port), make_handler(state, page, clock))
+        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock))
     except OSError as exc:
         raise ViewerError(f"cannot listen on 127.0.0.1:{port}: {exc.strerror}") from None
-    server.daemon_threads = True
     threading.Thread(target=server.serve_forever, name="viewer-http", daemon=True).start()
     return server
 
