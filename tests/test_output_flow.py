@@ -333,8 +333,13 @@ def test_an_orphan_from_before_the_subreaper_is_found_by_its_marker(monkeypatch:
                 assert wait_until(self.a_child_has_exited, 10)
             super().set_subreaper(on)
 
-    # The grandchild leaves the child's session (or it would linger in the child's group).
-    daemonize = "setsid sleep 30 & echo $!; exit 0"
+    # The grandchild leaves the child's session (or it would linger in the child's group). The
+    # child waits until it has: under load it would otherwise still be in the group when that
+    # is stopped, and end as a member of the group instead of as a stray.
+    daemonize = (
+        'setsid sleep 30 & p=$!; while [ "$(cut -d" " -f6 /proc/$p/stat)" != "$p" ];'
+        " do sleep 0.01; done; echo $p; exit 0"
+    )
     spec = make_spec("daemonizer", "", argv=("/bin/sh", "-c", daemonize))
     h = Harness([spec], stray_grace=0.3)
     h.sup.strays = LateSubreaper(h.sup.run_id, grace=0.3)
