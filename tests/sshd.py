@@ -95,7 +95,7 @@ def start(
         f"Port {port}\nListenAddress {address}\nHostKey {root / 'host_key'}\n"
         f"AuthorizedKeysFile {root / 'authorized_keys'}\nPidFile {root / 'sshd.pid'}\n"
         "StrictModes no\nUsePAM no\nPasswordAuthentication no\nKbdInteractiveAuthentication no\n"
-        "PermitRootLogin prohibit-password\nMaxSessions 64\nLogLevel ERROR\n"
+        "PermitRootLogin prohibit-password\nLogLevel ERROR\n"  # MaxSessions: the default 10
     )
     (root / "known_hosts").write_text(f"[{address}]:{port} {host_pub}\n")
     (root / "ssh_config").write_text(

@@ -312,3 +312,23 @@ def second_host_address(server: Server) -> str:
         if line.strip().startswith("HostName"):
             return line.split()[1]
     raise AssertionError("no HostName in the second host's config")
+
+
+def test_more_processes_than_an_sshd_allows_sessions_per_connection(
+    sshd: Server, tmp_path: Path, token: str
+) -> None:
+    # The fixture's sshd keeps OpenSSH's default MaxSessions 10: 12 processes need 2 connections.
+    entries = [remote(f"echo up-{i}; exec sleep 30") for i in range(12)]
+    path = write_launch(tmp_path, token, entries)
+    run = Running(mlaunch(str(path)), env=env_for(sshd, token))
+    try:
+        for i in range(12):
+            run.wait_for(rf"\] up-{i}$", 30)
+        masters = [p for p in marked(token) if b"ControlMaster=yes" in _cmdline(p)]
+        assert len(masters) == 2, describe(marked(token))
+        run.signal(signal.SIGINT)
+        assert run.finish(30) == 130, run.text
+    finally:
+        run.kill()
+    assert "refused" not in run.text, run.text
+    assert_nothing_left(token)

@@ -46,6 +46,9 @@ NOT_FORWARDED = frozenset(
     {"ROS_DISTRO", "ROS_VERSION", "ROS_PYTHON_VERSION", "ROS_HOME", "ROS_LOG_DIR",
      "ROS_PACKAGE_PATH", "ROS_ETC_DIR", "ROS_ROOT", "ROS_MASTER_URI"}
 )  # fmt: skip
+# OpenSSH servers allow 10 sessions per connection (sshd_config MaxSessions, default 10): a
+# machine running more processes than that gets another connection for each ten.
+SESSIONS_PER_CONNECTION = 10
 # The agent waits at most this long between SIGTERM and SIGKILL when mlaunch is gone.
 MAX_GRACE = 10.0
 LOST = (
@@ -268,25 +271,31 @@ def _write_all(fd: int, data: bytes) -> None:
 class Spawner:
     """Makes the run's processes: plain ones here, ``RemoteProcess`` on other machines.
 
-    One per run: it owns a private directory for the control sockets and one ``Connection`` per
-    machine. ``connect`` opens the machines the launch starts with before anything runs, so an
-    unreachable machine is a clear error (exit 2) instead of a first node that fails.
+    One per run: it owns a private directory for the control sockets and the connections, one
+    per machine for each ``SESSIONS_PER_CONNECTION`` processes running there. ``connect`` opens
+    the machines the launch starts with before anything runs, so an unreachable machine is a
+    clear error (exit 2) instead of a first node that fails.
     """
 
     def __init__(self, environ: Mapping[str, str], extra_env: Mapping[str, str] | None = None):
+        import itertools
         import tempfile
 
         self.environ = dict(environ)
         self.extra_env = dict(extra_env or {})
         self.socket_dir = tempfile.mkdtemp(prefix="mlaunch-ssh-")
-        self.connections: dict[MachineSpec, Connection] = {}
+        self.connections: dict[MachineSpec, list[Connection]] = {}
+        self._numbers = itertools.count()
 
     def connection(self, machine: MachineSpec) -> Connection:
-        conn = self.connections.get(machine)
-        if conn is None:
-            path = os.path.join(self.socket_dir, str(len(self.connections)))
-            conn = Connection(machine, path, self.environ, self.extra_env)
-            self.connections[machine] = conn
+        """A connection to ``machine`` with a session to spare (a new one when all are full)."""
+        pool = self.connections.setdefault(machine, [])
+        for conn in pool:
+            if conn.users < SESSIONS_PER_CONNECTION:
+                return conn
+        path = os.path.join(self.socket_dir, str(next(self._numbers)))
+        conn = Connection(machine, path, self.environ, self.extra_env)
+        pool.append(conn)
         return conn
 
     def __call__(self, spec: ProcessSpec, index: int, restarts: int = 0) -> Process:
@@ -311,8 +320,9 @@ class Spawner:
 
     def close(self) -> None:
         """Close every connection and remove the socket directory."""
-        for conn in self.connections.values():
-            conn.close()
+        for pool in self.connections.values():
+            for conn in pool:
+                conn.close()
         import shutil
 
         shutil.rmtree(self.socket_dir, ignore_errors=True)
