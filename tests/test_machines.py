@@ -332,3 +332,51 @@ def test_more_processes_than_an_sshd_allows_sessions_per_connection(
         run.kill()
     assert "refused" not in run.text, run.text
     assert_nothing_left(token)
+
+
+TALKER = """#!/bin/sh
+echo "remote talker at $0"
+for a in "$@"; do
+  if [ "$prev" = "--params-file" ]; then echo "params at $a"; cat "$a"; fi
+  prev=$a
+done
+"""
+
+
+def test_a_remote_node_is_found_there_and_gets_its_params_file(
+    sshd: Server, tmp_path: Path, token: str
+) -> None:
+    # The package exists only on the "remote" (its env-loader's AMENT_PREFIX_PATH), not here.
+    prefix = tmp_path / "remote-prefix"
+    program = prefix / "lib" / "mlaunch_demo" / "talker"
+    program.parent.mkdir(parents=True)
+    program.write_text(TALKER)
+    program.chmod(0o755)
+    loader = tmp_path / "env.sh"
+    loader.write_text(f'#!/bin/sh\nexport AMENT_PREFIX_PATH="{prefix}"\nexec "$@"\n')
+    loader.chmod(0o755)
+    path = tmp_path / "node.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n"
+        "from mlaunch.actions import Machine\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        f"        Machine(name='robot', address='{HOST_ALIAS}', env_loader='{loader}'),\n"
+        "        Node(package='mlaunch_demo', executable='talker', name='talker',\n"
+        "             machine='robot', output='screen', parameters=[{'rate': 5}],\n"
+        f"             additional_env={{'MLTEST_REMOTE': '{token}'}}),\n"
+        "    ])\n"
+    )
+    env = env_for(sshd, token)
+    env.pop("AMENT_PREFIX_PATH", None)
+    done = run_mlaunch(str(path), env=env)
+    out = done.stdout + done.stderr
+    assert f"remote talker at {program}" in out, out
+    assert "rate: 5" in out, out
+    params = next(
+        line.split("params at ", 1)[1] for line in out.splitlines() if "params at" in line
+    )
+    assert not params.startswith(str(tmp_path))  # a copy in the remote's own temp dir
+    assert wait_until(lambda: not os.path.exists(os.path.dirname(params)), 10), params
+    assert_nothing_left(token)
