@@ -7,7 +7,6 @@ import sys
 import types
 
 from mlaunch.errors import LaunchFileError, MlaunchError
-from mlaunch.frontends.encoding import not_utf8
 from mlaunch.origin import user_location
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -44,6 +43,8 @@ def load(path: str) -> Any:
         code = compile(source, path, "exec")
     except SyntaxError as e:
         if "codec can't decode" in str(e.msg):
+            from mlaunch.frontends.encoding import not_utf8  # error path only
+
             raise not_utf8(source, path) or LaunchFileError(e.msg, where=f"{path}:{e.lineno}")
         col = f":{e.offset}" if e.offset else ""
         raise LaunchFileError(f"Python syntax error: {e.msg}", where=f"{path}:{e.lineno}{col}")

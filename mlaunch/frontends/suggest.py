@@ -7,8 +7,6 @@ minutes), and the fallback listed every declared name. Both are capped here.
 
 from __future__ import annotations
 
-import difflib
-
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
     from collections.abc import Iterable
@@ -32,6 +30,8 @@ class Suggester:
         if not self.names:
             return ""
         if self.budget >= len(self.names):
+            import difflib  # only when a name is unknown: ~1 ms of start-up otherwise
+
             self.budget -= len(self.names)
             close = difflib.get_close_matches(name, self.names, n=1)
             if close:

@@ -12,7 +12,6 @@ from functools import partial
 from xml.parsers import expat
 
 from mlaunch.errors import LaunchFileError
-from mlaunch.frontends.encoding import not_utf8
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
@@ -59,6 +58,8 @@ class _TreeBuilder:
             self.parser.Parse(self.data, True)
         except expat.ExpatError as e:
             if e.code == expat.errors.codes[expat.errors.XML_ERROR_INVALID_TOKEN]:
+                from mlaunch.frontends.encoding import not_utf8  # error path only
+
                 # expat says "invalid token" for bytes that are not in the file's encoding
                 raise not_utf8(self.data, self.path) or self.expat_error(e)
             raise self.expat_error(e)

@@ -14,7 +14,6 @@ from yaml.events import CollectionEndEvent, CollectionStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mlaunch.errors import LaunchFileError
-from mlaunch.frontends.encoding import not_utf8
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
@@ -58,6 +57,8 @@ class _Reader:
         except yaml.MarkedYAMLError as e:
             raise self._yaml_error(e)
         except yaml.reader.ReaderError as e:  # a byte or character that is not YAML text
+            from mlaunch.frontends.encoding import not_utf8  # error path only
+
             raise not_utf8(data, self.path) or self._reader_error(data, e)
         except yaml.YAMLError as e:
             raise LaunchFileError(f"malformed YAML: {e}", where=self.path)

@@ -289,13 +289,15 @@ def _package_search(options: ResolveOptions, context: LaunchContext) -> _NoSearc
 def undeclared_argument_warnings(
     given: Mapping[str, str], declared: Mapping[str, ArgumentInfo]
 ) -> list[str]:
+    undeclared = [name for name in given if name not in declared]
+    if not undeclared:  # the common case imports nothing more (start-up budget)
+        return []
     from mlaunch.frontends.suggest import Suggester
 
     suggest = Suggester(declared)
     return [
         f"argument {name!r} is not declared by the launch file{suggest.hint(name)}"
-        for name in given
-        if name not in declared
+        for name in undeclared
     ]
 
 
