@@ -12,6 +12,7 @@ prints one line per run and a tally, and exits 1 unless every run gave the expec
 from __future__ import annotations
 
 import argparse
+import fcntl
 import os
 import subprocess
 import sys
@@ -24,9 +25,49 @@ PAIR = [("launches/jtbot_sim.launch.py", 0), ("tests/launches/jtbot_crash.launch
 RUN_TIMEOUT = 180.0
 
 
+def claim_domain() -> tuple[int, int]:
+    """A ROS_DOMAIN_ID nobody else on this machine holds: the lock files the test suite's
+    conftest uses, so a run never shares its DDS domain with another run or a test."""
+    for domain in range(101, 200):
+        fd = os.open(f"/tmp/mlaunch-ros-domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        if _in_use(domain):  # a leftover node of someone's earlier run, without its lock
+            os.close(fd)
+            continue
+        return domain, fd
+    raise RuntimeError("no free ROS_DOMAIN_ID in 101..199")
+
+
+def _in_use(domain: int) -> bool:
+    """Whether a process on this machine has ROS_DOMAIN_ID=domain in its environment."""
+    marker = f"ROS_DOMAIN_ID={domain}".encode()
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry.name}/environ", "rb") as f:
+                if marker in f.read().split(b"\0"):
+                    return True
+        except OSError:
+            continue
+    return False
+
+
 def one_run(launch: str, index: int) -> tuple[int, float, str]:
+    domain, lock = claim_domain()
+    try:
+        return _run(launch, domain)
+    finally:
+        os.close(lock)
+
+
+def _run(launch: str, domain: int) -> tuple[int, float, str]:
     started = time.monotonic()
-    env = dict(os.environ, ROS_DOMAIN_ID=str(110 + index % 80), NO_COLOR="1")
+    env = dict(os.environ, ROS_DOMAIN_ID=str(domain), NO_COLOR="1")
     env.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     done = subprocess.run(
         [sys.executable, "-m", "mlaunch", "test", launch],
