@@ -13,6 +13,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+from conftest import requires_rclpy
 from procutil import REPO, clean_env, mlaunch
 
 EXAMPLES = REPO / "tests" / "launch_testing"
@@ -112,6 +113,16 @@ def test_not_a_launch_test_is_a_clear_error(tmp_path: Path) -> None:
     )
     assert done.returncode == 2
     assert "must define generate_test_description()" in done.stderr
+
+
+@requires_rclpy
+def test_wait_for_topics_of_launch_testing_ros(tmp_path: Path, ros_env: dict[str, str]) -> None:
+    """launch_testing_ros.WaitForTopics receives a launched node's messages (needs rclpy)."""
+    report = tmp_path / "report.xml"
+    name = "topics.ros_test.py"
+    done = run_launch_test(mlaunch("test", str(EXAMPLES / name)), report, clean_env(**ros_env))
+    assert outcomes(report) == RECORDED["ros"][name], done.stdout + done.stderr
+    assert done.returncode == 0
 
 
 # --- the upstream examples (their sources come with the reference build) -------------------------
