@@ -32,10 +32,7 @@ def __getattr__(name: str) -> Any:
     if not name[:1].isupper():
         raise AttributeError(name)
     for module_name in _MODULES:
-        try:
-            module = importlib.import_module(module_name)
-        except ImportError:
-            continue
+        module = importlib.import_module(module_name)
         if name in getattr(module, "__all__", ()) or hasattr(module, name):
             value = getattr(module, name)
             globals()[name] = value

@@ -1,10 +1,11 @@
 """The command line: argv -> Options -> load -> resolve -> run. The only place errors are printed.
 
-Exit status:
+Exit status (the table is mlaunch.errors'):
   0    every process ended and nothing required failed (or a Shutdown action ended the launch)
   1    a required process (on_exit=Shutdown / required=True) exited with a failure
   2    bad command line or launch file: missing file, syntax error, bad argument, failed
        substitution, missing package or executable (one line on stderr, no traceback)
+  70   an internal error of mlaunch (a bug: --debug shows the traceback)
   128+N  mlaunch was stopped by signal N: 130 for Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP
 """
 
@@ -258,41 +259,28 @@ def find_launch_file(opts: Options) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """``mlaunch ...`` and its subcommands: the one place errors are caught and printed."""
     args = list(sys.argv[1:] if argv is None else argv)
-    if args and args[0] in SUBCOMMANDS and not os.path.isfile(args[0]):
-        import importlib
-
-        return int(importlib.import_module(SUBCOMMANDS[args[0]]).main(args[1:]))
     debug = "--debug" in args or "-d" in args
     try:
+        if args and args[0] in SUBCOMMANDS and not os.path.isfile(args[0]):
+            import importlib
+
+            return int(importlib.import_module(SUBCOMMANDS[args[0]]).command(args[1:]))
         return run_cli(args)
-    except KeyboardInterrupt as e:  # Ctrl-C, or lifeline.Stopped: SIGTERM, SIGHUP
-        return getattr(e, "exit_code", 130)
     except BrokenPipeError:
         from mlaunch.run.lifeline import stdout_gone
 
         return stdout_gone()
-    except Exception as e:
+    except (Exception, KeyboardInterrupt) as e:  # KeyboardInterrupt: Ctrl-C, lifeline.Stopped
         return report_error(e, debug)
 
 
 def report_error(error: BaseException, debug: bool) -> int:
-    from mlaunch.errors import MlaunchError
+    """The error printed once (see mlaunch.errors.report); its exit status."""
+    from mlaunch.errors import report
 
-    if debug:
-        import traceback
-
-        traceback.print_exception(error)
-    from mlaunch.run.lifeline import say
-
-    if isinstance(error, MlaunchError):
-        say(f"mlaunch: error: {error}")
-        return error.exit_code
-    say(
-        f"mlaunch: internal error: {type(error).__name__}: {error}"
-        " (run with --debug for the traceback)"
-    )
-    return 70
+    return report(error, debug=debug)
 
 
 def package_search(opts: Options, launch_file: str | None) -> PackageSearch:

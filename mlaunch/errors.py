@@ -1,6 +1,72 @@
-"""One small error hierarchy. Every error knows where it happened; cli.main prints it once."""
+"""One small error hierarchy and the one table of exit statuses.
+
+Every error knows where it happened; only a program's ``main`` (mlaunch.cli's, and the
+``launch_test`` program's) catches errors, prints them once through ``report`` and returns the
+status this table gives.
+"""
 
 from __future__ import annotations
+
+import sys
+
+# --- exit statuses ---------------------------------------------------------------------------
+
+EXIT_OK = 0  # every process ended and nothing required failed; a smoke run or test passed
+EXIT_FAILURE = 1  # a required process failed; a smoke expectation or a launch test failed
+EXIT_USAGE = 2  # bad input: command line, launch file, argument, substitution, package
+EXIT_INTERNAL = 70  # a bug in mlaunch (BSD's EX_SOFTWARE): reported with --debug for details
+SIGNAL_BASE = 128  # stopped by signal N: 128 + N, as a shell reports it
+EXIT_INTERRUPTED = SIGNAL_BASE + 2  # Ctrl-C (SIGINT)
+
+
+def exit_for_signal(signum: int) -> int:
+    """The status of a run stopped by signal ``signum`` (130 SIGINT, 143 SIGTERM, 129 SIGHUP)."""
+    return SIGNAL_BASE + signum
+
+
+def exit_status(error: BaseException) -> int:
+    """The status a program exits with when ``error`` ends it."""
+    if isinstance(error, MlaunchError):
+        return error.exit_code
+    if isinstance(error, KeyboardInterrupt):  # Ctrl-C; SIGTERM/SIGHUP carry their own status
+        status = getattr(error, "exit_code", EXIT_INTERRUPTED)
+        return status if isinstance(status, int) else EXIT_INTERRUPTED
+    return EXIT_INTERNAL
+
+
+def report(error: BaseException, *, debug: bool, prog: str = "mlaunch") -> int:
+    """Print ``error`` once on stderr (a traceback too with ``debug``); return its exit status.
+
+    An MlaunchError is the user's one line; anything else is mlaunch's bug, said as such.
+    """
+    if debug:
+        import traceback
+
+        traceback.print_exception(error)
+    status = exit_status(error)
+    if isinstance(error, MlaunchError):
+        _say(f"{prog}: error: {error}")
+    elif status == EXIT_INTERNAL:
+        hint = "" if debug else " (run with --debug for the traceback)"
+        _say(f"{prog}: internal error: {type(error).__name__}: {error}{hint}")
+    return status
+
+
+def _say(line: str) -> None:
+    """One line on stderr, whatever became of it (closed, a broken pipe)."""
+    try:
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def is_own_module(name: str | None) -> bool:
+    """Whether an ImportError's module is one of mlaunch's (then it is a bug, never user input)."""
+    return bool(name) and (name == "mlaunch" or str(name).startswith("mlaunch."))
+
+
+# --- the hierarchy -----------------------------------------------------------------------------
 
 
 class MlaunchError(Exception):
@@ -11,7 +77,7 @@ class MlaunchError(Exception):
     they are not known where it is raised.
     """
 
-    exit_code = 2
+    exit_code = EXIT_USAGE
 
     def __init__(self, message: str, *, where: str | None = None, what: str | None = None):
         super().__init__(message)
@@ -51,3 +117,12 @@ class PackageNotFoundError(MlaunchError):
 
 class UsageError(MlaunchError):
     """The command line itself is wrong."""
+
+
+class StandinError(MlaunchError):
+    """A stand-in program cannot use its input (URDF, world, model, arguments, parameters).
+
+    The stand-in logs the message as one line and exits 1, as the real program would fail.
+    """
+
+    exit_code = EXIT_FAILURE

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 import os
 
-from mlaunch.errors import LaunchFileError
+from mlaunch.errors import LaunchFileError, is_own_module
 from mlaunch.frontends.limits import allow_deep_trees
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -57,6 +57,11 @@ def load(path: str, hint: str | None = None) -> Any:
     allow_deep_trees()
     try:
         module = importlib.import_module(module_name)
-    except ModuleNotFoundError:
-        raise LaunchFileError(f"{path!r}: this mlaunch has no frontend {module_name!r} yet")
+    except ModuleNotFoundError as e:
+        if is_own_module(e.name):
+            raise  # a part of mlaunch is missing: a broken installation, reported as a bug
+        raise LaunchFileError(
+            f"reading {path!r} needs the Python package {e.name!r}, which is not installed"
+            " (reinstall mlaunch with its dependencies: pip install mlaunch)"
+        ) from e
     return module.load(path)

@@ -7,7 +7,7 @@ The launch_ros actions are imported only when such a tag appears.
 from __future__ import annotations
 
 import mlaunch.launch.actions as core
-from mlaunch.errors import LaunchFileError, MlaunchError
+from mlaunch.errors import MlaunchError
 from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
@@ -179,12 +179,8 @@ def _split(parts: Parts) -> list[Any]:
 
 
 def _ros_actions() -> Any:
-    try:
-        import mlaunch.launch_ros.actions as ros
-    except ImportError as err:
-        raise LaunchFileError(
-            f"launch_ros tags need mlaunch.launch_ros.actions, which is missing: {err}"
-        )
+    import mlaunch.launch_ros.actions as ros  # loaded only by files with launch_ros tags
+
     return ros
 
 

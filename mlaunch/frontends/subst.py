@@ -268,10 +268,6 @@ class _Scanner:
             )
         try:
             sub = spec.build([_value(a) for a in args])
-        except ImportError as e:
-            raise TemplateError(
-                f"$({name}) needs mlaunch's ROS layer, which is missing: {e}", start
-            )
         except (ValueError, TypeError) as e:
             raise TemplateError(f"$({name}): {e}", start)
         return sub, i + 1

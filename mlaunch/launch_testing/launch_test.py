@@ -13,14 +13,16 @@ import os
 import re
 import sys
 
+from mlaunch.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
+
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Sequence
     from types import ModuleType
 
-EXIT_PASS = 0
-EXIT_FAIL = 1
-EXIT_USAGE = 2
+# mlaunch.errors' table: a launch test's own errors (its file, its arguments) are bad input.
+EXIT_PASS = EXIT_OK
+EXIT_FAIL = EXIT_FAILURE
 
 _GENERATE = re.compile(rb"^\s*(async\s+)?def\s+generate_test_description\s*\(", re.MULTILINE)
 
@@ -118,7 +120,7 @@ def main(argv: Sequence[str] | None = None, prog: str = "launch_test") -> int:
     try:
         return run(args)
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
     except Exception as e:
         if args.verbose:
             import traceback

@@ -37,7 +37,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import LaunchFileError
+from mlaunch.errors import EXIT_FAILURE, LaunchFileError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
 from mlaunch.run.plan import AddHandler, Deferred, EmitEvent, ProcessSpec, StartTimer, Step
@@ -535,7 +535,7 @@ class LifecycleManager:
             why = f" [{outcome.reason}]" if outcome.reason else ""
             printer.message("ERROR", SOURCE, f"transition failed{why}: {result.detail}")
             if outcome.shutdown_on_failure and outcome.reason != "shutdown":
-                self.supervisor.exit_code = max(self.supervisor.exit_code, 1)
+                self.supervisor.exit_code = max(self.supervisor.exit_code, EXIT_FAILURE)
                 self.supervisor.begin_shutdown(
                     f"lifecycle node {result.node}: {result.transition} failed"
                 )

@@ -80,31 +80,33 @@ def _format_for(opts: argparse.Namespace) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``mlaunch convert ...``: 0 written, 2 bad input (one line on stderr)."""
-    from mlaunch.cli import report_error
+    """``mlaunch convert ...``: 0 written, 2 bad input (one line on stderr), through mlaunch's
+    main, which prints errors and gives the status."""
+    from mlaunch import cli
 
-    args = list(sys.argv[1:] if argv is None else argv)
-    opts = build_parser().parse_args(args)
-    try:
-        path = os.path.abspath(opts.file)
-        if not os.path.isfile(path):
-            raise LaunchFileError(f"launch file {opts.file!r} does not exist")
-        from mlaunch.ros.search import PackageSearch, searching
+    return cli.main(["convert", *(sys.argv[1:] if argv is None else argv)])
 
-        output = None if opts.output in (None, "-") else opts.output
-        with searching(PackageSearch(opts.package_path, path, os.environ)):
-            result = convert(path, _format_for(opts), output)
-        if output is None:
-            sys.stdout.write(result)
-        else:
-            try:
-                with open(output, "w", encoding="utf-8") as f:
-                    f.write(result)
-            except OSError as e:
-                raise UsageError(f"cannot write {output!r}: {e.strerror}")
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch convert``'s work; errors go up to mlaunch.cli.main."""
+    opts = build_parser().parse_args(list(args))
+    path = os.path.abspath(opts.file)
+    if not os.path.isfile(path):
+        raise LaunchFileError(f"launch file {opts.file!r} does not exist")
+    from mlaunch.ros.search import PackageSearch, searching
+
+    output = None if opts.output in (None, "-") else opts.output
+    with searching(PackageSearch(opts.package_path, path, os.environ)):
+        result = convert(path, _format_for(opts), output)
+    if output is None:
+        sys.stdout.write(result)
         return 0
-    except Exception as e:
-        return report_error(e, opts.debug)
+    try:
+        with open(output, "w", encoding="utf-8") as f:
+            f.write(result)
+    except OSError as e:
+        raise UsageError(f"cannot write {output!r}: {e.strerror}")
+    return 0
 
 
-__all__ = ["ConversionError", "convert", "main"]
+__all__ = ["ConversionError", "command", "convert", "main"]

@@ -27,6 +27,7 @@ import signal
 import sys
 import time
 
+from mlaunch.errors import exit_for_signal
 from mlaunch.run import guard as guards
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -44,7 +45,7 @@ class Stopped(KeyboardInterrupt):
     def __init__(self, signum: int) -> None:
         super().__init__(signum)
         self.signum = signum
-        self.exit_code = 128 + signum
+        self.exit_code = exit_for_signal(signum)
 
 
 class Lifeline:

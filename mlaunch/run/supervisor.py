@@ -27,7 +27,7 @@ import signal
 import time
 from collections.abc import Callable
 
-from mlaunch.errors import MlaunchError
+from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, exit_for_signal
 from mlaunch.launch import events as ev
 from mlaunch.run import guard as guards
 from mlaunch.run.handlers import LaunchHandlers
@@ -73,9 +73,6 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-EXIT_OK = 0
-EXIT_REQUIRED_FAILED = 1
-EXIT_LAUNCH_ERROR = 2
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
 POLL = 0.05
 
@@ -288,7 +285,7 @@ class Supervisor:
     def handler_failed(self, message: str) -> None:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
         self.printer.message("ERROR", "launch", message)
-        self.exit_code = max(self.exit_code, EXIT_LAUNCH_ERROR)
+        self.exit_code = max(self.exit_code, EXIT_USAGE)
         self.begin_shutdown("an event handler failed")
 
     def _dispatch(self, kind: str, process: Process | None, event: Any) -> None:
@@ -425,7 +422,7 @@ class Supervisor:
             # A required process decides the run: it ends it, and its failure is the run's.
             # First, so the shutdown names it (its on_exit=Shutdown() then has nothing to do).
             if code != 0:
-                self.exit_code = max(self.exit_code, EXIT_REQUIRED_FAILED)
+                self.exit_code = max(self.exit_code, EXIT_FAILURE)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
         event = ev.ProcessExited(
             action=spec.action,
@@ -643,7 +640,7 @@ class Supervisor:
     def _stop_pressed(self, sig: int) -> None:
         self._stop_presses += 1
         if self._stop_presses == 1:
-            self.exit_code = max(self.exit_code, 128 + sig)
+            self.exit_code = max(self.exit_code, exit_for_signal(sig))
             self.printer.message(
                 "WARNING",
                 "launch",

@@ -58,7 +58,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import LaunchFileError, UsageError
+from mlaunch.errors import EXIT_FAILURE, EXIT_OK, LaunchFileError, UsageError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import perform
 from mlaunch.run.plan import Step
@@ -72,8 +72,6 @@ if TYPE_CHECKING:
     from mlaunch.run.supervisor import Supervisor
 
 _HELP = __doc__ or ""
-EXIT_PASS = 0
-EXIT_FAIL = 1
 DEFAULT_TIMEOUT = 30.0
 # Held after ready so a node that crashes a few seconds in is caught (--hold 0 skips it).
 DEFAULT_HOLD = 3.0
@@ -457,6 +455,14 @@ def parse_settings(args: Sequence[str]) -> Settings:
 
 
 def main(args: Sequence[str]) -> int:
+    """``mlaunch test ARGS``: through mlaunch's main, which prints errors and gives the status."""
+    from mlaunch import cli
+
+    return cli.main(["test", *args])
+
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch test``'s work; errors go up to mlaunch.cli.main."""
     from mlaunch import cli
 
     args = list(args)
@@ -467,22 +473,17 @@ def main(args: Sequence[str]) -> int:
         from mlaunch.launch_testing.launch_test import main as launch_test_main
 
         return launch_test_main(args, prog="mlaunch test")
-    debug = "--debug" in args or "-d" in args
+    mine, rest = split_arguments(args)
     try:
-        mine, rest = split_arguments(args)
         settings = parse_settings(mine)
-        if not rest:
-            raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
-        opts = cli.parse_options(rest)
-        if opts.show_args or opts.print_plan:
-            return cli.run_cli(rest)
-        return run(opts, settings)
-    except KeyboardInterrupt:
-        return 130
-    except SystemExit as e:  # argparse: --help (0) or a usage error (2)
+        opts = cli.parse_options(rest) if rest else None
+    except SystemExit as e:  # argparse: --help (0) or a usage error (2), already printed
         return int(e.code or 0)
-    except Exception as e:
-        return cli.report_error(e, debug)
+    if opts is None:
+        raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
+    if opts.show_args or opts.print_plan:
+        return cli.run_cli(rest)
+    return run(opts, settings)
 
 
 # --- running --------------------------------------------------------------------------------------
@@ -618,7 +619,7 @@ def supervise(
         report.write_junit(settings.junit)
     if code >= 128:
         return code  # interrupted: say so, whatever was seen
-    return EXIT_PASS if report.passed else EXIT_FAIL
+    return EXIT_OK if report.passed else EXIT_FAILURE
 
 
 # --- watching the run -----------------------------------------------------------------------------

@@ -12,6 +12,8 @@ import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
+from mlaunch.errors import StandinError
+
 # Plugin file names, with and without the lib prefix / .so suffix (gz accepts both spellings).
 CLASSIC_DIFF_DRIVE = "gazebo_ros_diff_drive"
 CLASSIC_JOINT_STATES = "gazebo_ros_joint_state_publisher"
@@ -28,7 +30,7 @@ IMU_TYPES = ("imu",)
 DEFAULT_JOINT_STATE_RATE = 50.0
 
 
-class ModelError(ValueError):
+class ModelError(StandinError, ValueError):
     """A plugin or sensor block the simulator cannot use; the message names it and the value."""
 
 

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.errors import StandinError
 from mlaunch.standins import transforms
 from mlaunch.standins.common import EXIT_FAILURE, init_ros, spin_until_shutdown
 from mlaunch.standins.urdf import Robot, UrdfError, joint_transform, parse_urdf
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
 NODE_NAME = "robot_state_publisher"
 
 
-class ParameterError(ValueError):
+class ParameterError(StandinError, ValueError):
     """A parameter has a value the node cannot use; the message names it and the bad value."""
 
 

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mlaunch.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag
 from mlaunch.standins.diffdrive import (
     ModelError,
@@ -58,7 +59,7 @@ PROVIDED_PLUGINS = ("libgazebo_ros_init.so", "libgazebo_ros_factory.so")
 STEPS_BETWEEN_SPINS = 10  # at most this many steps back to back before serving callbacks
 
 
-class SimUsageError(Exception):
+class SimUsageError(StandinError):
     """A command line the simulator cannot run with."""
 
 

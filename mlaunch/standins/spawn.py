@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from mlaunch.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag
 from mlaunch.standins.sim import SPAWN_TOPIC, SPAWNED_TOPIC
 
@@ -32,7 +33,7 @@ NODE_NAMES = {"gazebo_ros": "spawn_entity", "ros_gz_sim": "ros_gz_sim"}
 SOURCES = ("file", "topic", "string", "stdin", "database", "param")
 
 
-class SpawnError(Exception):
+class SpawnError(StandinError):
     """Why the model was not spawned; printed as one line."""
 
     def __init__(self, message: str, exit_code: int = 1):

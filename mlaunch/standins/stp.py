@@ -16,6 +16,7 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from mlaunch.errors import StandinError
 from mlaunch.standins import transforms
 from mlaunch.standins.common import EXIT_FAILURE, EXIT_OK, init_ros, spin_until_shutdown
 
@@ -38,7 +39,7 @@ EULER = ("--roll", "--pitch", "--yaw")
 FRAMES = ("--frame-id", "--child-frame-id")
 
 
-class UsageError(ValueError):
+class UsageError(StandinError, ValueError):
     """The command line cannot be understood; the message says which argument and why."""
 
 

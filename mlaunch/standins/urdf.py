@@ -13,6 +13,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
+from mlaunch.errors import StandinError
+
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 GEOMETRY_KINDS = ("box", "cylinder", "sphere", "mesh")
 
@@ -20,7 +22,7 @@ Vec3 = tuple[float, float, float]
 Matrix = tuple[tuple[float, ...], ...]  # 4x4 homogeneous transform, row-major
 
 
-class UrdfError(ValueError):
+class UrdfError(StandinError, ValueError):
     """An invalid robot_description; the message names the link/joint and the bad value."""
 
 

@@ -23,6 +23,7 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.errors import StandinError
 from mlaunch.standins.common import init_ros, spin
 from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
 
@@ -43,7 +44,7 @@ TRAIL_STEP = 0.02  # metres between trail points: enough for a smooth line, boun
 Pose2D = tuple[float, float, float]  # x, y, yaw
 
 
-class ViewerError(ValueError):
+class ViewerError(StandinError, ValueError):
     """Unusable viewer input (port, command line); printed as one line, exit status 1."""
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
 
-from mlaunch.errors import MlaunchError
+from mlaunch.errors import StandinError
 
 # Re-exported: the simulator, its tests and its callers know these from here.
 from mlaunch.standins.raycast import GaussianNoise as GaussianNoise
@@ -47,7 +47,7 @@ RESOURCE_PATH_VARS = (
 )
 
 
-class WorldError(MlaunchError):
+class WorldError(StandinError):
     """A world file that cannot be read or understood; ``where`` is ``file:line``."""
 
 
