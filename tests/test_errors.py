@@ -97,3 +97,12 @@ def test_subcommand_errors_go_through_the_one_main(tmp_path: Path) -> None:
     done = run_main("", "test")
     assert done.returncode == EXIT_USAGE
     assert "a launch file is needed" in done.stderr
+
+
+def test_every_subcommand_has_a_command_that_raises_to_main() -> None:
+    import importlib
+
+    from mlaunch.cli import SUBCOMMANDS
+
+    for name, module in SUBCOMMANDS.items():
+        assert callable(getattr(importlib.import_module(module), "command", None)), name

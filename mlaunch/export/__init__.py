@@ -45,25 +45,30 @@ def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
 
 
 def main(args: Sequence[str]) -> int:
+    """``mlaunch export ARGS``: through mlaunch's main, which prints errors and gives the status."""
     from mlaunch import cli
 
-    args = list(args)
-    debug = "--debug" in args or "-d" in args
+    return cli.main(["export", *args])
+
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch export``'s work; errors go up to mlaunch.cli.main."""
+    from mlaunch import cli
+
     try:
-        settings, rest = parse(args)
-        fmt, out_dir = settings.to
-        if fmt not in FORMATS:
-            raise UsageError(f"--to {fmt!r} is not a format; valid: {', '.join(FORMATS)}")
-        if not rest:
-            raise UsageError(f"a launch file is needed: {USAGE}")
-        opts = cli.parse_options(rest)
-        return export_systemd(opts, settings, out_dir)
-    except KeyboardInterrupt:
-        return 130
-    except SystemExit as e:  # argparse: --help (0) or a usage error (2)
+        settings, rest = parse(list(args))
+    except SystemExit as e:  # argparse: --help (0) or a usage error (2), already printed
         return int(e.code or 0)
-    except Exception as e:
-        return cli.report_error(e, debug)
+    fmt, out_dir = settings.to
+    if fmt not in FORMATS:
+        raise UsageError(f"--to {fmt!r} is not a format; valid: {', '.join(FORMATS)}")
+    if not rest:
+        raise UsageError(f"a launch file is needed: {USAGE}")
+    try:
+        opts = cli.parse_options(rest)
+    except SystemExit as e:
+        return int(e.code or 0)
+    return export_systemd(opts, settings, out_dir)
 
 
 def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) -> int:
