@@ -150,3 +150,20 @@ def test_the_environment_file_leaves_the_login_session_out() -> None:
         {"PATH": "/usr/bin", "TERM": "xterm", "SSH_AUTH_SOCK": "/x", "ROS_DOMAIN_ID": "7"}
     )
     assert text == 'PATH="/usr/bin"\nROS_DOMAIN_ID="7"\n'
+
+
+def test_what_systemd_cannot_do_is_a_warning(tmp_path: Path) -> None:
+    launch = tmp_path / "lc.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import LifecycleNode\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([LifecycleNode(package='mlaunch_demo', executable='talker',\n"
+        "        name='lc', namespace='', autostart=True)])\n"
+    )
+    out = tmp_path / "units"
+    env = clean_env(AMENT_PREFIX_PATH=str(PREFIX))
+    done = run_mlaunch("export", str(launch), "--to", "systemd", str(out), env=env)
+    assert done.returncode == 0, done.stderr
+    assert "lifecycle node with autostart: nothing drives it to active" in done.stderr
+    assert "nothing drives it to active" in (out / "README.md").read_text()

@@ -101,6 +101,11 @@ class Export:
                 f"{spec.label} runs on machine {spec.machine.name!r}: exported to run on the"
                 " computer the units are installed on"
             )
+        if spec.node is not None and spec.node.lifecycle and spec.node.autostart:
+            self.warnings.append(
+                f"{spec.label} is a lifecycle node with autostart: nothing drives it to active"
+                " under systemd (mlaunch does that when it runs the launch)"
+            )
         unit = Unit(spec, unit_name(f"{self.prefix}-{spec.label}") + ".service")
         unit.after, unit.requires, unit.delay = list(after), list(requires), delay
         self.units.append(unit)
