@@ -79,6 +79,10 @@ def _run(launch: str, domain: int) -> tuple[int, float, str]:
         stdin=subprocess.DEVNULL,
     )
     failed = [line.strip() for line in done.stdout.splitlines() if line.strip().startswith("FAIL")]
+    # A passing run must also be a clean one: no process interrupted into a traceback.
+    tracebacks = (done.stdout + done.stderr).count("Traceback")
+    if tracebacks:
+        failed.append(f"{tracebacks} traceback(s) in the output")
     return done.returncode, time.monotonic() - started, "; ".join(failed)[:200]
 
 
@@ -97,8 +101,9 @@ def main() -> int:
             results = list(pool.map(one_run, [launch] * args.runs, range(args.runs)))
         good = 0
         for i, (code, seconds, failed) in enumerate(results, 1):
-            mark = "ok " if code == expected else "BAD"
-            good += code == expected
+            clean = "traceback" not in failed
+            mark = "ok " if code == expected and clean else "BAD"
+            good += code == expected and clean
             print(f"{mark} {launch} run {i}: status {code} in {seconds:.1f} s {failed}", flush=True)
         print(f"{launch}: {good}/{args.runs} runs gave status {expected}")
         ok &= good == args.runs
