@@ -33,7 +33,6 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.run.plan import Plan
-    from mlaunch.run.process import Process
     from mlaunch.run.resolve import LabelCounter, ResolveOptions
     from mlaunch.run.supervisor import Supervisor
 
@@ -77,8 +76,6 @@ class LaunchService:
         self._error = False
         self._event_loop: Any = None
         self.return_code: int | None = None
-        # Called from the loop thread with ("started" | "exited", Process) for every process.
-        self.listeners: list[Callable[[str, Process], None]] = []
 
     # --- the public API of launch.LaunchService ------------------------------------------------
 
@@ -209,7 +206,7 @@ class LaunchService:
             self._options = ResolveOptions(temp_dir=temp_dir)
             self._labels = LabelCounter()
             try:
-                plan = self._resolve(LaunchDescription(pending))
+                plan = self._resolve(LaunchDescription([*self._bookkeeping(), *pending]))
             except MlaunchError as e:
                 print(f"mlaunch: error: {e}", file=sys.stderr)
                 return 1
@@ -228,7 +225,6 @@ class LaunchService:
                 # A script may have children of its own: the run's are found by their marker.
                 adopt=False,
             )
-            supervisor.listeners.append(self._on_process)
             wake_r, self._wake_w = os.pipe()
             os.set_blocking(wake_r, False)
             os.set_blocking(self._wake_w, False)
@@ -270,23 +266,35 @@ class LaunchService:
         """A pending timer is what keeps an idle supervisor running; re-arm it forever."""
         supervisor.schedule(KEEP_ALIVE_PERIOD, lambda: self._keep_alive(supervisor))
 
-    def _on_process(self, what: str, process: Process) -> None:
-        spec = process.spec
-        action = spec.action
-        if what == "started" and action is not None:
-            # What ROS 2's ExecuteProcess.process_details holds once the process runs.
-            action.process_details = {
-                "type": "command",
-                "name": spec.label,
-                "cmd": list(spec.argv),
-                "cwd": spec.cwd,
-                "env": dict(spec.env),
-                "pid": process.pid,
-            }
-        elif what == "exited" and action is not None:
-            action.return_code = process.returncode
-        for listener in self.listeners:
-            listener(what, process)
+    def _bookkeeping(self) -> list[Any]:
+        """Handlers that give each process action ROS 2's process_details and return_code.
+
+        Registered through the launch API like any launch file's, before what was included (a
+        handler sees only the processes started after it), so a launch file's own handler of
+        the same start runs first and may not see process_details filled in yet.
+        """
+        from mlaunch.launch.actions import RegisterEventHandler
+        from mlaunch.launch.event_handlers import OnProcessExit, OnProcessStart
+
+        def started(event: Any, context: Any) -> None:
+            if event.action is not None:
+                event.action.process_details = {
+                    "type": "command",
+                    "name": event.name,
+                    "cmd": list(event.cmd),
+                    "cwd": event.cwd,
+                    "env": dict(event.env or {}),
+                    "pid": event.pid,
+                }
+
+        def exited(event: Any, context: Any) -> None:
+            if event.action is not None:
+                event.action.return_code = event.returncode
+
+        return [
+            RegisterEventHandler(OnProcessStart(on_start=started)),
+            RegisterEventHandler(OnProcessExit(on_exit=exited)),
+        ]
 
     # --- calls from other threads ---------------------------------------------------------------
 
