@@ -86,70 +86,62 @@ def generate_launch_description() -> LaunchDescription:
                     },
                 ],
             ),
-            # smartcar_display.launch:31
-            # WARNING: tf2_ros static_transform_publisher is not installed and mlaunch has no
-            # stand-in for it (tf2_msgs has no wheel): the static transform base_link ->
-            # left_front_link is not published (the node is dropped; it runs where tf2_ros is
-            # installed)
+            # smartcar_display.launch:31: ROS 1 static_transform_publisher arguments, written as
+            # tf2_ros's named options
             # WARNING: the period (100 ms) of ROS 1 tf static_transform_publisher is dropped:
             # tf2_ros publishes a static transform once, latched on /tf_static
             # WARNING: frame ids lose their leading '/' (tf2 rejects it)
-            # Where it can run:
-            # Node(
-            #     package="tf2_ros",
-            #     executable="static_transform_publisher",
-            #     name="odom_left_wheel_broadcaster",
-            #     arguments=[
-            #         "--x",
-            #         "0",
-            #         "--y",
-            #         "0",
-            #         "--z",
-            #         "0",
-            #         "--yaw",
-            #         "0",
-            #         "--pitch",
-            #         "0",
-            #         "--roll",
-            #         "0",
-            #         "--frame-id",
-            #         "base_link",
-            #         "--child-frame-id",
-            #         "left_front_link",
-            #     ],
-            # )
-            # smartcar_display.launch:32
-            # WARNING: tf2_ros static_transform_publisher is not installed and mlaunch has no
-            # stand-in for it (tf2_msgs has no wheel): the static transform base_link ->
-            # right_front_link is not published (the node is dropped; it runs where tf2_ros is
-            # installed)
+            Node(
+                package="tf2_ros",
+                executable="static_transform_publisher",
+                name="odom_left_wheel_broadcaster",
+                arguments=[
+                    "--x",
+                    "0",
+                    "--y",
+                    "0",
+                    "--z",
+                    "0",
+                    "--yaw",
+                    "0",
+                    "--pitch",
+                    "0",
+                    "--roll",
+                    "0",
+                    "--frame-id",
+                    "base_link",
+                    "--child-frame-id",
+                    "left_front_link",
+                ],
+            ),
+            # smartcar_display.launch:32: ROS 1 static_transform_publisher arguments, written as
+            # tf2_ros's named options
             # WARNING: the period (100 ms) of ROS 1 tf static_transform_publisher is dropped:
             # tf2_ros publishes a static transform once, latched on /tf_static
             # WARNING: frame ids lose their leading '/' (tf2 rejects it)
-            # Where it can run:
-            # Node(
-            #     package="tf2_ros",
-            #     executable="static_transform_publisher",
-            #     name="odom_right_wheel_broadcaster",
-            #     arguments=[
-            #         "--x",
-            #         "0",
-            #         "--y",
-            #         "0",
-            #         "--z",
-            #         "0",
-            #         "--yaw",
-            #         "0",
-            #         "--pitch",
-            #         "0",
-            #         "--roll",
-            #         "0",
-            #         "--frame-id",
-            #         "base_link",
-            #         "--child-frame-id",
-            #         "right_front_link",
-            #     ],
-            # )
+            Node(
+                package="tf2_ros",
+                executable="static_transform_publisher",
+                name="odom_right_wheel_broadcaster",
+                arguments=[
+                    "--x",
+                    "0",
+                    "--y",
+                    "0",
+                    "--z",
+                    "0",
+                    "--yaw",
+                    "0",
+                    "--pitch",
+                    "0",
+                    "--roll",
+                    "0",
+                    "--frame-id",
+                    "base_link",
+                    "--child-frame-id",
+                    "right_front_link",
+                ],
+            ),
             # smartcar_display.launch:34: ROS 1 rviz/rviz is rviz2/rviz2 in ROS 2
             # WARNING: the RViz config $(find smartcar_description)/urdf.rviz is a ROS 1 RViz
             # config (Class: rviz/...): rviz2 cannot load ROS 1 configs (display classes rviz/...

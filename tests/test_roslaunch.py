@@ -637,14 +637,37 @@ def test_static_transforms_become_tf2_ros_options_where_tf2_ros_runs(
     assert "tf.launch:2: frame ids lose their leading '/'" in text
 
 
-def test_static_transforms_without_tf2_ros_are_dropped_with_a_warning(tmp_path: Path) -> None:
+def test_static_transforms_without_tf2_ros_or_tf2_msgs_are_dropped_with_a_warning(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mlaunch import standins
+
+    # As on a machine where scripts/setup could not build tf2_msgs.
+    monkeypatch.setattr(standins, "NEEDS", {"stp": "mlaunch_test_no_such_module"})
     path = write(tmp_path, "tf.launch", STATIC_TF)
     plan = plan_of(path)
     assert plan.processes() == []
     text = warnings_text(plan)
     assert "tf.launch:2: tf2_ros static_transform_publisher is not installed" in text
+    assert "stand-in for it needs tf2_msgs (./scripts/setup builds it)" in text
     assert "base_link -> laser is not published" in text
     assert "tf.launch:4: tf2_ros static_transform_publisher is not installed" in text
+
+
+def test_static_transforms_run_as_the_standin_without_tf2_ros(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mlaunch import standins
+
+    monkeypatch.setattr(standins, "NEEDS", {})  # the stand-in counts as usable here
+    path = write(tmp_path, "tf.launch", STATIC_TF)
+    euler, quat = plan_of(path).processes()
+    assert euler.standin == quat.standin == "tf2_ros/static_transform_publisher"
+    assert euler.argv[1:3] == ("-m", "mlaunch.standins.stp")
+    assert euler.argv[3 : euler.argv.index("--ros-args")] == (
+        *("--x", "1", "--y", "2", "--z", "3", "--yaw", "0.1", "--pitch", "0.2", "--roll", "0.3"),
+        *("--frame-id", "base_link", "--child-frame-id", "laser"),
+    )
 
 
 def test_joint_state_publisher_use_gui_chooses_the_gui_package(tmp_path: Path) -> None:

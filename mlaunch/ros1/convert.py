@@ -38,7 +38,7 @@ def convert(path: str, fmt: str, output: str | None = None) -> str:
     if fmt not in WRITERS:
         raise UsageError(f"format {fmt!r} is not one of {', '.join(WRITERS)}")
     source = Source(os.path.abspath(path), output, fmt)
-    items = read(source.path)
+    items = read(source.path, converting=True)
     return str(WRITERS[fmt](source).write(items))
 
 

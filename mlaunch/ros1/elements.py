@@ -146,6 +146,7 @@ class ElementReader:
     def __init__(self, path: str) -> None:
         self.path = os.path.abspath(path)
         self._index: Any = None
+        self.converting = False  # writing a file for elsewhere: nothing depends on this machine
         self.descriptions: list[Desc] = []
         self.arbotix: list[tuple[NodeItem, ProcessItem, NodeItem, str]] = []
         self.jsp_nodes: list[NodeItem] = []

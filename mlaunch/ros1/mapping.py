@@ -85,7 +85,7 @@ class NodeMapper(ElementReader):
         else:
             node.arguments = self.static_tf_arguments(node, list(args), ros1_tf)
         program = "tf2_ros static_transform_publisher"
-        if self.available("tf2_ros", "static_transform_publisher"):
+        if self.converting or self.available("tf2_ros", "static_transform_publisher"):
             return [node]
         frames = " -> ".join(describe_value(a) for a in _frame_args(node.arguments))
         return [
@@ -93,9 +93,9 @@ class NodeMapper(ElementReader):
                 origin=node.origin,
                 condition=node.condition,
                 warnings=[
-                    f"{program} is not installed and mlaunch has no stand-in for it (tf2_msgs"
-                    f" has no wheel): the static transform {frames} is not published (the node"
-                    " is dropped; it runs where tf2_ros is installed)",
+                    f"{program} is not installed and mlaunch's stand-in for it needs tf2_msgs"
+                    f" (./scripts/setup builds it): the static transform {frames} is not"
+                    " published (the node is dropped; it runs where either is installed)",
                     *node.warnings,
                 ],
                 node=node,

@@ -406,7 +406,13 @@ def _wrap(item: Item, conds: tuple[Cond, ...]) -> Item:
     return item
 
 
-def read(path: str) -> list[Item]:
-    """The ROS 2 description (as the model) a roslaunch file maps to."""
+def read(path: str, converting: bool = False) -> list[Item]:
+    """The ROS 2 description (as the model) a roslaunch file maps to.
+
+    ``converting``: the description is written out for another machine, so what is installed
+    here must not decide what it contains (static transforms stay live nodes).
+    """
     allow_deep_trees()  # reading, building and converting the model are recursive walks
-    return Reader(path).read()
+    reader = Reader(path)
+    reader.converting = converting
+    return reader.read()

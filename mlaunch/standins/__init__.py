@@ -31,11 +31,21 @@ PACKAGE_EXECUTABLES: dict[tuple[str, str], tuple[str, tuple[str, ...]]] = {
     ("gazebo_ros", "spawn_entity.py"): ("spawn", ("spawn_entity.py",)),
     ("ros_gz_sim", "create"): ("spawn", ("create",)),
     ("gazebo_ros", "gzserver"): ("sim", ()),
+    ("tf2_ros", "static_transform_publisher"): ("stp", ()),
 }
+
+# What a stand-in needs beyond rclpy: module -> the Python package that must be importable.
+# tf2_msgs has no wheel on PyPI; scripts/setup builds it (interfaces/).
+NEEDS: dict[str, str] = {"stp": "tf2_msgs"}
 
 
 def rclpy_available() -> bool:
     return importlib.util.find_spec("rclpy") is not None
+
+
+def _usable(module: str) -> bool:
+    needs = NEEDS.get(module)
+    return rclpy_available() and (needs is None or importlib.util.find_spec(needs) is not None)
 
 
 def _module_argv(module: str) -> list[str]:
@@ -59,7 +69,7 @@ def standin_for(argv: list[str]) -> list[str] | None:
 def standin_for_package(package: str, executable: str) -> list[str] | None:
     """The argv items that replace ``<prefix>/lib/<package>/<executable>``, or None."""
     entry = PACKAGE_EXECUTABLES.get((package, executable))
-    if entry is None or not rclpy_available():
+    if entry is None or not _usable(entry[0]):
         return None
     module, first = entry
     return [*_module_argv(module), *first]
