@@ -202,3 +202,30 @@ def test_stp_same_parent_and_child_is_refused(spawn: Callable[..., Proc]) -> Non
     assert stp.popen.wait(timeout=20) == 1
     assert "cannot publish static transform from 'a' to 'a', exiting" in stp.stderr()
     assert "Traceback" not in stp.stderr()
+
+
+def test_a_missing_tf2_msgs_is_named_when_static_transform_publisher_cannot_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from test_roslaunch import plan_of
+
+    from mlaunch import standins
+    from mlaunch.errors import MlaunchError
+
+    monkeypatch.setattr(standins, "NEEDS", {"stp": "mlaunch_test_no_such_module"})
+    launch = tmp_path / "stp.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n\n\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([Node(package='tf2_ros',"
+        " executable='static_transform_publisher',"
+        " arguments=['--frame-id', 'a', '--child-frame-id', 'b'])])\n"
+    )
+    with pytest.raises(MlaunchError) as info:
+        plan_of(str(launch))
+    assert "package 'tf2_ros' not found" in str(info.value)
+    assert (
+        "(mlaunch's stand-in for it needs mlaunch_test_no_such_module: ./scripts/setup builds it)"
+        in str(info.value)
+    )

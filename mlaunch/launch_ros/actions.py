@@ -616,6 +616,8 @@ def _not_installed(
             hint = " (mlaunch has a stand-in for it: run without --no-standins)"
         elif not standins.rclpy_available():
             hint = " (mlaunch's stand-in for it needs rclpy: pip install 'mlaunch[ros]')"
+        elif (need := standins.unmet_need(package, executable)) is not None:
+            hint = f" (mlaunch's stand-in for it needs {need}: ./scripts/setup builds it)"
     source = index.source(package)
     if source is None:
         return PackageNotFoundError(

@@ -66,6 +66,15 @@ def standin_for(argv: list[str]) -> list[str] | None:
     return [*_module_argv(module), *argv[consumed:]]
 
 
+def unmet_need(package: str, executable: str) -> str | None:
+    """The Python package a stand-in for this executable needs and does not find, if any."""
+    entry = PACKAGE_EXECUTABLES.get((package, executable))
+    needs = None if entry is None else NEEDS.get(entry[0])
+    if needs is None or importlib.util.find_spec(needs) is not None:
+        return None
+    return needs
+
+
 def standin_for_package(package: str, executable: str) -> list[str] | None:
     """The argv items that replace ``<prefix>/lib/<package>/<executable>``, or None."""
     entry = PACKAGE_EXECUTABLES.get((package, executable))
