@@ -139,10 +139,10 @@ def test_jtbot_sim_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: Path) 
             "/odom",
             "--expect-topic",
             "/imu",
+            # The image, not the 3.7 MB point cloud at 30 Hz: that would slow the simulator on
+            # a loaded CI machine (test_standin_camera checks the cloud's content).
             "--expect-topic",
             "/depth_camera/depth/image_raw",
-            "--expect-topic",
-            "/depth_camera/points",
             *(("--expect-topic", "/tf", "--expect-topic", "/tf_static") if HAVE_TF2_MSGS else ()),
             "--expect-output",
             "spawn_entity.py:spawned entity 'jtbot'",
