@@ -121,6 +121,7 @@ def generate_launch_description():
         (('machine="robot")', 'machine="robt")'), r"machine 'robt' is not declared \(did you mean"),
         (("ssh_port=2200", "ssh_port=70000"), r"ssh_port of machine 'robot' is 70000"),
         (("timeout=3", "timeout=0"), r"timeout of machine 'robot' is 0"),
+        (('"robot-alias"', '"-oProxyCommand=x"'), r"address of machine 'robot' is '-oProxy"),
         (('name="gpu", address="gpu-alias"', 'name="robot", address="x"'), r"declared again"),
     ],
 )

@@ -78,8 +78,13 @@ class Machine(Action):
         if problem is not None:
             raise LaunchFileError(f"machine name {name!r} is invalid: {problem}", where=self.origin)
         address = perform_substitutions(ctx, self.address).strip()
-        if not address:
-            raise LaunchFileError(f"machine {name!r} has an empty address", where=self.origin)
+        if not address or address.startswith("-") or any(c.isspace() for c in address):
+            # A leading '-' would reach ssh as an option (-oProxyCommand=...), not a host.
+            raise LaunchFileError(
+                f"address of machine {name!r} is {address!r}; valid: a host name, an IP address"
+                " or an ssh Host alias (no spaces, not starting with '-')",
+                where=self.origin,
+            )
         user = None if self.user is None else perform_substitutions(ctx, self.user) or None
         port = None
         if self.ssh_port is not None and str(self.ssh_port) != "":
