@@ -119,7 +119,7 @@ def test_not_a_launch_test_is_a_clear_error(tmp_path: Path) -> None:
 def test_wait_for_topics_of_launch_testing_ros(tmp_path: Path, ros_env: dict[str, str]) -> None:
     """launch_testing_ros.WaitForTopics receives a launched node's messages (needs rclpy)."""
     report = tmp_path / "report.xml"
-    name = "topics.ros_test.py"
+    name = "wait_for_topics.ros.py"
     done = run_launch_test(mlaunch("test", str(EXAMPLES / name)), report, clean_env(**ros_env))
     assert outcomes(report) == RECORDED["ros"][name], done.stdout + done.stderr
     assert done.returncode == 0
