@@ -43,6 +43,7 @@ class Options:
         arguments: dict[str, str] | None = None,
         show_args: bool = False,
         print_plan: bool = False,
+        check: bool = False,
         debug: bool = False,
         use_sim_time: bool | None = None,
         package_path: list[str] | None = None,
@@ -59,6 +60,7 @@ class Options:
         self.launch_argv: list[str] = []
         self.show_args = show_args
         self.print_plan = print_plan
+        self.check = check
         self.debug = debug
         self.use_sim_time = use_sim_time
         self.package_path: list[str] = [] if package_path is None else package_path
@@ -130,6 +132,12 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         dest="print_plan",
         action="store_true",
         help="print the resolved plan (argv, cwd, env, respawn, shutdown) and exit",
+    )
+    view.add_argument(
+        "--check",
+        action="store_true",
+        help="report what ros2 launch (Jazzy) would reject or read differently in the file"
+        " and the files it includes by path; exit 1 if anything",
     )
     parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
     parser.add_argument(
@@ -214,6 +222,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         target=ns.target,
         show_args=ns.show_args,
         print_plan=ns.print_plan,
+        check=ns.check,
         debug=ns.debug,
         use_sim_time=ns.use_sim_time,
         package_path=list(ns.package_path),
@@ -338,6 +347,8 @@ def run_cli(argv: Sequence[str]) -> int:
     from mlaunch.run.lifeline import Lifeline, write_stdout
 
     opts = parse_options(argv)
+    if opts.check:
+        return check_target(opts)
     # From here on a launch file's code and substitutions may start processes: signals, the
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
     with Lifeline() as life:
@@ -353,6 +364,15 @@ def run_cli(argv: Sequence[str]) -> int:
             write_stdout(format_arguments(infos))
             return 0
         return launch(opts, path, description, life)
+
+
+def check_target(opts: Options) -> int:
+    """``--check``: the portability report of the launch file, without loading or running it."""
+    from mlaunch.portability import report
+    from mlaunch.ros.search import searching
+
+    with searching(package_search(opts, None)):
+        return report(find_launch_file(opts), sys.stdout)
 
 
 def launch(opts: Options, path: str, description: object, life: Lifeline) -> int:

@@ -190,7 +190,11 @@ def test_includes_cross_formats_in_every_direction(tmp_path: Path) -> None:
     for fmt in FORMATS:
         summary = summarize("include", fmt, {"robot": "r2"}, tmp_path / fmt)
         camera, driver_video, driver_acm = _processes(summary)
-        assert camera["argv"] == ["sh", "-c", "echo camera front on r2"]  # from YAML
+        assert camera["argv"] == ["sh", "-c", "echo camera $CAMERA on $ROBOT"]  # from YAML
+        assert {k: camera["env_changes"][k] for k in ("CAMERA", "ROBOT")} == {
+            "CAMERA": "front",
+            "ROBOT": "r2",
+        }
         assert driver_video["argv"][-1] == "/dev/video_front"  # YAML -> Python
         assert driver_acm["argv"][-1] == "/dev/ttyACM0"  # top level -> Python
         logs = [s[3] for s in summary["steps"] if s[0] == "log"]

@@ -4,11 +4,9 @@ and Python directly. Run: mlaunch launches/examples/include.launch.py robot:=r2
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, IncludeLaunchDescription, LogInfo
-from launch.launch_description_sources import (
-    PythonLaunchDescriptionSource,
-    YAMLLaunchDescriptionSource,
-)
+from launch.launch_description_sources import PythonLaunchDescriptionSource
 from launch.substitutions import LaunchConfiguration, PathJoinSubstitution, ThisLaunchFileDir
+from launch_yaml.launch_description_sources import YAMLLaunchDescriptionSource
 
 
 def generate_launch_description():
@@ -18,13 +16,13 @@ def generate_launch_description():
         [
             DeclareLaunchArgument("robot", default_value="scout"),
             IncludeLaunchDescription(
-                YAMLLaunchDescriptionSource(parts / "sensors.launch.yaml"),
+                YAMLLaunchDescriptionSource(PathJoinSubstitution([parts, "sensors.launch.yaml"])),
                 launch_arguments=[("camera", "front"), ("robot", robot)],
             ),
             # Includes are not scoped (as in ROS 2): the included file's let is visible here.
             LogInfo(msg=[robot, " has ", LaunchConfiguration("sensor_count"), " sensor(s)"]),
             IncludeLaunchDescription(
-                PythonLaunchDescriptionSource(parts / "driver.launch.py"),
+                PythonLaunchDescriptionSource(PathJoinSubstitution([parts, "driver.launch.py"])),
                 launch_arguments={"port": "/dev/ttyACM0"}.items(),
             ),
         ]

@@ -40,8 +40,9 @@ def generate_launch_description():
                     SetLaunchConfiguration("site", "field"),
                     SetEnvironmentVariable("ZONE", "inner"),
                     ExecuteProcess(
-                        cmd=["sh", "-c", ["echo site=$SITE zone=$ZONE mode=", mode]],
+                        cmd=["sh", "-c", "echo site=$SITE zone=$ZONE mode=$MODE"],
                         name="reporter",
+                        additional_env={"MODE": mode},
                         output="screen",
                         sigterm_timeout="2",
                         sigkill_timeout="1",
@@ -69,8 +70,7 @@ def generate_launch_description():
                     ExecuteProcess(
                         cmd=["python3", "-c", "import time; time.sleep(30)"],
                         name="hardware",
-                        required=True,
-                        respawn="on-failure",
+                        respawn=True,
                         respawn_delay=0.5,
                         respawn_max_retries=3,
                     )
@@ -78,7 +78,11 @@ def generate_launch_description():
                 condition=IfCondition(is_real),
             ),
             ExecuteProcess(
-                cmd=["python3", "-c", ["print('simulating', ", workers, ", 'workers')"]],
+                cmd=[
+                    "python3",
+                    "-c",
+                    "import os; print('simulating', os.environ['WORKERS'], 'workers')",
+                ],
                 name="simulator",
                 output="screen",
                 condition=UnlessCondition(is_real),

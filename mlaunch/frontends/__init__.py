@@ -47,6 +47,14 @@ def frontend_for(path: str, hint: str | None = None) -> str:
     )
 
 
+def load_root(path: str) -> Any:
+    """The root Entity of a YAML or XML launch file, read but not built (for --check)."""
+    module_name = frontend_for(path)
+    if module_name not in ("mlaunch.frontends.yaml", "mlaunch.frontends.xml"):
+        raise LaunchFileError(f"{path!r} is not a YAML or XML launch file")
+    return importlib.import_module(module_name).read_root(path)
+
+
 def load(path: str, hint: str | None = None) -> Any:
     """The LaunchDescription in the file at ``path`` (absolute), with every error located."""
     if not os.path.exists(path):

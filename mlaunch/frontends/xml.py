@@ -27,6 +27,11 @@ _ATTRIBUTE = re.compile(rb"\s*([^\s=/>]+)\s*=\s*([\"'])")
 
 def load(path: str) -> Any:
     """The LaunchDescription of the XML launch file at ``path``."""
+    return build_description(read_root(path))
+
+
+def read_root(path: str) -> Entity:
+    """The root Entity of the XML file at ``path`` (read, not built)."""
     try:
         with open(path, "rb") as f:
             data = f.read()
@@ -35,7 +40,7 @@ def load(path: str) -> Any:
     root = _TreeBuilder(path, data).parse()
     for name in [n for n in root.attrs if _ROOT_IGNORED.match(n)]:
         del root.attrs[name]
-    return build_description(root)
+    return root
 
 
 class _TreeBuilder:

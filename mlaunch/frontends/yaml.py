@@ -34,12 +34,17 @@ class _Loader(_Base):  # type: ignore[misc, valid-type]
 
 def load(path: str) -> Any:
     """The LaunchDescription of the YAML launch file at ``path``."""
+    return build_description(read_root(path))
+
+
+def read_root(path: str) -> Entity:
+    """The root ``launch`` Entity of the YAML file at ``path`` (read, not built)."""
     try:
         with open(path, "rb") as f:
             data = f.read()
     except OSError as e:
         raise LaunchFileError(f"cannot read launch file: {e.strerror}", where=path)
-    return _Reader(path).description(data)
+    return _Reader(path).root(data)
 
 
 class _Reader:
@@ -49,7 +54,7 @@ class _Reader:
         self.path = path
         self.constructor = SafeConstructor()
 
-    def description(self, data: bytes) -> Any:
+    def root(self, data: bytes) -> Entity:
         try:
             if _bound_of_depth(data) > _NODE_DEPTH_LIMIT:
                 self.check_depth(data)
@@ -70,7 +75,7 @@ class _Reader:
         tag = self.key_text(key)
         if tag != "launch":
             raise self.error(key, f"the root key must be 'launch', not {tag!r}")
-        return build_description(self.entity(tag, key, value))
+        return self.entity(tag, key, value)
 
     def check_depth(self, data: bytes) -> None:
         """Stop a file nested deeper than the limit before composing it.

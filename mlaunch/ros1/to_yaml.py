@@ -72,13 +72,16 @@ class YamlWriter:
         return lines
 
     def scalar(self, key: str, value: str, item: Item) -> str:
-        """Attribute values are text; respawn/scoped flags and numbers keep their YAML type."""
-        if key in ("respawn", "scoped") and value in ("true", "false"):
+        """Attribute values are text, as Jazzy's launch_yaml reads them (a YAML boolean or
+        number where it wants text is a TypeError there); only the attributes it reads typed
+        (scoped, respawn_delay) keep their YAML type. set_parameter's value is text that
+        launch_ros types as YAML, so "false" still sets a boolean."""
+        if key == "scoped" and value in ("true", "false"):
             return value
         if key == "respawn_delay" and isinstance(getattr(item, "respawn_delay", None), float):
             return value
         if key == "value" and isinstance(item, SetParam) and item.value.dynamic is None:
-            return _yaml_literal(item.value.literal)
+            return yaml_str(literal_text(item.value.literal))
         return yaml_str(value)
 
     def children(self, item: Item, indent: int) -> list[str]:
