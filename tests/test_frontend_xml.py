@@ -175,7 +175,7 @@ def test_executable_every_attribute(tmp_path: Path) -> None:
     assert first.respawn.max_retries == 3
     assert (first.sigterm_timeout, first.sigkill_timeout) == (2.0, 0.5)
     assert first.env_changes["ROBOT"] == "r1"
-    assert first.env["RCUTILS_COLORIZED_OUTPUT"] == "1"
+    assert first.emulate_tty and "RCUTILS_COLORIZED_OUTPUT" not in first.env  # a pty, as launch
     assert first.required and first.on_exit is not None
     (shutdown,) = first.on_exit.entities
     assert isinstance(shutdown, actions.Shutdown) and shutdown.origin.endswith(":2")

@@ -686,6 +686,7 @@ class ExecuteProcess(Action):
             env_changes=_env_changes(ctx.initial_environment, env),
             cwd=None if self.cwd is None else perform_substitutions(ctx, self.cwd),
             shell=self.shell,
+            emulate_tty=self._emulate_tty(ctx),
             output=self._output(ctx),
             respawn=self._respawn(resolver),
             sigterm_timeout=_number(resolver, self.sigterm_timeout, "sigterm_timeout", self.origin),
@@ -744,11 +745,13 @@ class ExecuteProcess(Action):
         # about the older RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED, so only the new one is set.
         env.setdefault("PYTHONUNBUFFERED", "1")
         env.setdefault("RCUTILS_LOGGING_BUFFERED_STREAM", "1")
-        if _truthy(ctx, self.emulate_tty) or _truthy(
-            ctx, ctx.launch_configurations.get("emulate_tty", False)
-        ):
-            env.setdefault("RCUTILS_COLORIZED_OUTPUT", "1")
         return env
+
+    def _emulate_tty(self, ctx: LaunchContext) -> bool:
+        """Whether the child's stdout and stderr are pseudo-terminals, as launch gives them."""
+        return _truthy(ctx, self.emulate_tty) or _truthy(
+            ctx, ctx.launch_configurations.get("emulate_tty", False)
+        )
 
     def _output(self, ctx: LaunchContext) -> str:
         override = ctx.environment.get("OVERRIDE_LAUNCH_PROCESS_OUTPUT")

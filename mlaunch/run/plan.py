@@ -119,6 +119,7 @@ class ProcessSpec(Record):
         "env_changes",
         "cwd",
         "shell",
+        "emulate_tty",
         "output",
         "respawn",
         "sigterm_timeout",
@@ -142,6 +143,7 @@ class ProcessSpec(Record):
         env_changes: dict[str, str | None],
         cwd: str | None = None,
         shell: bool = False,
+        emulate_tty: bool = False,
         output: str = "log",
         respawn: RespawnPolicy | None = None,
         sigterm_timeout: float = 5.0,
@@ -161,6 +163,7 @@ class ProcessSpec(Record):
         self.env_changes = env_changes
         self.cwd = cwd
         self.shell = shell
+        self.emulate_tty = emulate_tty  # stdout and stderr are pseudo-terminals (launch's pty)
         self.output = output
         self.respawn: RespawnPolicy = RespawnPolicy() if respawn is None else respawn
         self.sigterm_timeout = sigterm_timeout

@@ -140,6 +140,24 @@ def utf8_safe_cut(buf: bytes) -> int:
     return n
 
 
+def _ptys() -> tuple[tuple[int, int], tuple[int, int]]:
+    """Two (master, slave) pseudo-terminals for a child's stdout and stderr (emulate_tty).
+
+    As launch does, so programs that colour or line-buffer only on a terminal behave as under
+    ros2 launch. The slaves do not turn "\n" into "\r\n", so lines read back unchanged.
+    """
+    import termios
+
+    pairs = []
+    for _ in range(2):
+        master, slave = os.openpty()
+        attrs = termios.tcgetattr(slave)
+        attrs[1] &= ~termios.ONLCR
+        termios.tcsetattr(slave, termios.TCSANOW, attrs)
+        pairs.append((master, slave))
+    return pairs[0], pairs[1]
+
+
 class Stream:
     """One pipe from a child: its fd and the partial line not yet complete."""
 
@@ -232,20 +250,32 @@ class Process:
             # ROS 2 joins the command with spaces and hands it to /bin/sh, unquoted.
             args = " ".join(spec.argv)
         env = {**spec.env, **extra_env} if extra_env else spec.env
-        self.popen = subprocess.Popen(
-            args,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            env=env,
-            cwd=spec.cwd,
-            shell=spec.shell,
-            start_new_session=True,
-            close_fds=True,
-        )
+        ttys = _ptys() if spec.emulate_tty else None
+        try:
+            self.popen = subprocess.Popen(
+                args,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.PIPE if ttys is None else ttys[0][1],
+                stderr=subprocess.PIPE if ttys is None else ttys[1][1],
+                env=env,
+                cwd=spec.cwd,
+                shell=spec.shell,
+                start_new_session=True,
+                close_fds=True,
+            )
+        except BaseException:
+            for fd in [fd for pair in ttys or () for fd in pair]:
+                os.close(fd)
+            raise
         self.pid = self.popen.pid
         self.started_at = clock()
-        self.watch_pipes()
+        if ttys is None:
+            self.watch_pipes()
+            return
+        for name, (master, slave) in zip(("stdout", "stderr"), ttys, strict=True):
+            os.close(slave)  # the child has it; the master reads EOF (EIO) once the child is gone
+            os.set_blocking(master, False)
+            self.streams[master] = Stream(name, master)
 
     def watch_pipes(self) -> None:
         """Take the child's stdout and stderr as non-blocking streams (subclasses' spawns too)."""
@@ -287,6 +317,8 @@ class Process:
         stream = self.streams.pop(fd, None)
         if stream is not None and stream.file is not None:
             stream.file.close()  # type: ignore[attr-defined]
+        elif stream is not None:
+            os.close(fd)  # a pty master
 
     def reaped(
         self,
