@@ -228,15 +228,14 @@ class LocalSubstitution(Substitution):
         self.description = description
 
     def perform(self, context: LaunchContext) -> str:
-        value: Any = context.locals
-        for part in self.expression.split("."):
-            try:
-                value = getattr(value, part)
-            except AttributeError:
-                raise SubstitutionFailure(
-                    f"context.locals has no {self.expression!r} here"
-                    " (LocalSubstitution is only valid where that local is defined)"
-                )
+        # launch evaluates the expression against the locals (``event.cmd[1]``, ``event.text``).
+        try:
+            value = eval(f"_locals.{self.expression}", {}, {"_locals": context.locals})
+        except Exception as e:
+            raise SubstitutionFailure(
+                f"LocalSubstitution {self.expression!r} failed here: {type(e).__name__}: {e}"
+                " (it is only valid where that local is defined, e.g. in an event handler)"
+            )
         return str(value)
 
     def describe(self) -> str:
