@@ -53,6 +53,15 @@ ON_PURPOSE_ENV = {
 # child of a venv's python has them: a property of the installation, not of the launcher.
 # LC_CTYPE is set by Python's C-locale coercion in the recorder itself.
 INTERPRETER_ENV = ("LD_LIBRARY_PATH", "_ROS_WHEELS_BOOTSTRAP_COMPLETE", "LC_CTYPE")
+HARNESS_ENV = (
+    "PATH",
+    "HOME",
+    "ROS_LOG_DIR",
+    "AMENT_PREFIX_PATH",
+    "CONF_RECORD_DIR",
+    "NO_COLOR",
+    "LC_ALL",
+)
 _LOG_LINE = re.compile(r"^\[(INFO|WARNING|ERROR|DEBUG)\] \[([^\]]+)\]: (.*)$")
 _OUTPUT_LINE = re.compile(r"^\[([^\]\s]+)\] (.*)$")
 _STARTED = re.compile(r"^process started with pid \[\d+\]$")
@@ -198,8 +207,8 @@ def _process(
         if key in ON_PURPOSE_ENV and ON_PURPOSE_ENV[key] in (None, value):
             continue
         env[key] = _normalize(value, paths)
-    for key in given:
-        if key not in record["env"] and key not in INTERPRETER_ENV:
+    for key in HARNESS_ENV:  # what every launcher is given, whatever else it has
+        if key not in record["env"]:
             env[key] = "<unset>"
     params = []
     for text in record["params_files"]:

@@ -7,8 +7,13 @@ to ``$CONF_RECORD_DIR/records.jsonl`` (argv, cwd, the whole environment, the tex
 
   --say TEXT     print TEXT on stdout (repeatable)
   --err TEXT     print TEXT on stderr (repeatable)
+  --wait-for W   first wait (up to 20 s) until another recorded process has the word W in its argv:
+                 ordering that does not race the other process's start-up
   --linger S     stay alive S seconds (ended early by SIGINT/SIGTERM, exit 0)
   --exit N       exit with status N (default 0)
+
+SIGINT and SIGTERM are handled before the record is written, so a process that others saw
+recorded ends cleanly when the launcher stops it.
 
 Only the standard library: it must start the same under either launcher's interpreter.
 """
@@ -22,7 +27,7 @@ import time
 
 def _own_options(argv):
     """The recorder's options: everything before --ros-args, leaving the ROS part alone."""
-    opts = {"say": [], "err": [], "linger": 0.0, "exit": 0}
+    opts = {"say": [], "err": [], "linger": 0.0, "exit": 0, "wait_for": None}
     args = argv[1:]
     if "--ros-args" in args:
         args = args[: args.index("--ros-args")]
@@ -38,6 +43,8 @@ def _own_options(argv):
             opts["linger"] = float(value)
         elif key == "--exit":
             opts["exit"] = int(value)
+        elif key == "--wait-for":
+            opts["wait_for"] = value
         else:
             i += 1
             continue
@@ -57,8 +64,25 @@ def _params_files(argv):
     return texts
 
 
+def _wait_for(records, word):
+    deadline = time.monotonic() + 20
+    while time.monotonic() < deadline:
+        with open(records, encoding="utf-8") as f:
+            others = [json.loads(line) for line in f]
+            if any(word in r["argv"] and r["pid"] != os.getpid() for r in others):
+                return
+        time.sleep(0.01)  # the recorder is the child under test, not a test: polling is fine
+
+
 def main():
+    stop = []
+    signal.signal(signal.SIGINT, lambda *_: stop.append(1))
+    signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
+    if "CONF_RECORD_DIR" not in os.environ:
+        sys.exit("recorder: no CONF_RECORD_DIR in the environment, nothing recorded")
+    records = os.path.join(os.environ["CONF_RECORD_DIR"], "records.jsonl")
     record = {
+        "pid": os.getpid(),
         "argv0": os.path.basename(sys.argv[0]),
         "argv": sys.argv[1:],
         "cwd": os.getcwd(),
@@ -69,22 +93,17 @@ def main():
         "stderr_tty": os.isatty(2),
     }
     line = (json.dumps(record, sort_keys=True) + "\n").encode()
-    fd = os.open(
-        os.path.join(os.environ["CONF_RECORD_DIR"], "records.jsonl"),
-        os.O_WRONLY | os.O_APPEND | os.O_CREAT,
-        0o644,
-    )
+    fd = os.open(records, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
     os.write(fd, line)
     os.close(fd)
     opts = _own_options(sys.argv)
+    if opts["wait_for"]:
+        _wait_for(records, opts["wait_for"])
     for text in opts["say"]:
         print(text, flush=True)
     for text in opts["err"]:
         print(text, file=sys.stderr, flush=True)
     if opts["linger"] > 0:
-        stop = []
-        signal.signal(signal.SIGINT, lambda *_: stop.append(1))
-        signal.signal(signal.SIGTERM, lambda *_: stop.append(1))
         deadline = time.monotonic() + opts["linger"]
         while not stop and time.monotonic() < deadline:
             time.sleep(0.01)  # the recorder is the child under test, not a test: polling is fine

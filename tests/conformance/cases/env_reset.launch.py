@@ -1,5 +1,6 @@
 from launch import LaunchDescription
 from launch.actions import ExecuteProcess, ResetEnvironment, SetEnvironmentVariable
+from launch.substitutions import EnvironmentVariable
 from launch_ros.substitutions import ExecutableInPackage
 
 
@@ -11,7 +12,7 @@ def generate_launch_description():
             ResetEnvironment(),
             ExecuteProcess(
                 cmd=[rec, "after_reset"],
-                env={"ONLY": "this", "CONF_RECORD_DIR": "/nonexistent"},
+                env={"ONLY": "this", "CONF_RECORD_DIR": EnvironmentVariable("CONF_RECORD_DIR")},
                 name="with_env",
             ),
             ExecuteProcess(cmd=[rec, "plain"], name="plain"),

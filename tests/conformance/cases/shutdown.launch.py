@@ -14,7 +14,7 @@ from launch_ros.substitutions import ExecutableInPackage
 
 def generate_launch_description():
     rec = ExecutableInPackage("recorder", "conf_pkg")
-    quick = ExecuteProcess(cmd=[rec, "quick"], name="quick")
+    quick = ExecuteProcess(cmd=[rec, "quick", "--wait-for", "--linger"], name="quick")
     return LaunchDescription(
         [
             ExecuteProcess(cmd=[rec, "--linger", "20"], name="lingers"),
