@@ -423,6 +423,7 @@ def supervise(
         labels=labels,  # type: ignore[arg-type]
         guard=guard,
         run_id=run_id,
+        cgroup=life.cgroup,
         **({} if spawner is None else {"spawner": spawner}),
     )
     extensions: list[object] = []

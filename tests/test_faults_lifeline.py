@@ -9,6 +9,7 @@ then waits; the test waits for that file with a deadline, then injects the fault
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import time
@@ -266,3 +267,109 @@ def test_the_marker_scan_finds_a_process_in_the_middle_of_exec() -> None:
         sh.wait()
         os.kill(pid, signal.SIGKILL)
     assert not missed, f"{len(missed)} of 60 marked processes were not found"
+
+
+# --- nothing left without the marker: the run's cgroup, and a guard pkill -f does not match -------
+
+# Double-forks into a session of its own, clears its environment (so the run's marker is gone),
+# says its pid, and sleeps: what a daemon started by a launch file does.
+DAEMON = (
+    "import os, sys, time\n"
+    "if os.fork():\n"
+    "    time.sleep(60)\n"  # the launch's process stays up: the daemon is not an orphan of ours
+    "    sys.exit(0)\n"
+    "os.setsid()\n"
+    "if os.fork():\n"
+    "    os._exit(0)\n"
+    "with open(sys.argv[1] + '.tmp', 'w') as f:\n"
+    "    f.write(str(os.getpid()))\n"
+    "os.rename(sys.argv[1] + '.tmp', sys.argv[1])\n"
+    "os.execve('/bin/sleep', ['sleep', '60'], {})\n"
+)
+
+
+def run_cgroup_available() -> str:
+    """Why this machine gives a run no cgroup ("" when it does), asked as mlaunch asks."""
+    code = (
+        "import os\n"
+        "from mlaunch.run.cgroup import RunCgroup\n"
+        "group, why = RunCgroup.create(os.environ)\n"
+        "if group is not None:\n"
+        "    why = '' if group.enter() else f'cannot move into {group.path}'\n"
+        "    group.leave()\n"
+        "print(why)\n"
+    )
+    done = subprocess.run([PY, "-c", code], capture_output=True, text=True, timeout=30)
+    assert done.returncode == 0, done.stderr
+    return done.stdout.strip()
+
+
+@pytest.mark.skipif(shutil.which("pkill") is None, reason="needs pkill(1) from procps")
+def test_pkill_9_f_of_mlaunch_leaves_nothing_not_even_a_daemon(tmp_path: Path) -> None:
+    from test_faults import SLEEPER, proc, write_launch
+
+    daemon_pid = tmp_path / "daemon.pid"
+    launch = write_launch(
+        tmp_path,
+        [
+            proc(SLEEPER, "plain", sigkill_timeout=0.5),
+            "ExecuteProcess(cmd=[PY, '-c', "
+            f"{DAEMON!r}, {str(daemon_pid)!r}], name='daemonizer', sigkill_timeout=0.5)",
+        ],
+    )
+    no_cgroup = run_cgroup_available()
+    m = Mlaunch(tmp_path, launch)
+    try:
+        run_id, pid = m.wait_ups(1)[0]
+        assert wait_until(daemon_pid.exists, 15), m.text
+        daemon = int(daemon_pid.read_text())
+        # What `pkill -9 -f mlaunch` does, narrowed to this run's command line: it must not
+        # match the guard, which then ends the run.
+        subprocess.run(["pkill", "-9", "-f", str(launch)], check=True, timeout=10)
+        assert m.wait() == -signal.SIGKILL
+        assert_nothing_left(run_id, [pid])
+        assert wait_until(lambda: not list(m.tmp.glob("mlaunch-*")), 5), "private folder left"
+        err = m.stderr()
+        assert "died without stopping its processes" in err, err
+        if no_cgroup:
+            os.kill(daemon, signal.SIGKILL)
+            pytest.skip(
+                f"the daemon that cleared its environment needs the run's cgroup: {no_cgroup}"
+            )
+        assert wait_until(lambda: not alive(daemon), 10), "the daemon outlived the run"
+        assert "the run had no cgroup" not in err
+    finally:
+        m.close()
+
+
+def test_the_guard_is_not_named_after_mlaunch() -> None:
+    from mlaunch.run.guard import Guard
+
+    guard = Guard.start("probe-title")
+    try:
+        path = Path(f"/proc/{guard.pid}/cmdline")
+        assert wait_until(lambda: path.read_bytes().startswith(b"launch-guard"), 5)
+        cmdline = path.read_bytes().rstrip(b"\0").decode()
+        assert cmdline == f"launch-guard [run {os.getpid()}]"[: len(cmdline)]
+        assert "mlaunch" not in cmdline
+        assert Path(f"/proc/{guard.pid}/comm").read_text().strip() == "launch-guard [r"
+    finally:
+        guard.close()
+
+
+def test_a_normal_run_leaves_no_cgroup_behind(tmp_path: Path) -> None:
+    from mlaunch.run.cgroup import PREFIX, cgroup2_root, own_cgroup
+
+    if run_cgroup_available():
+        pytest.skip(f"no run cgroup here: {run_cgroup_available()}")
+    root, mine = cgroup2_root(), own_cgroup()
+    assert root is not None and mine is not None
+    parent = Path(root) / mine.lstrip("/")
+    m = Mlaunch(tmp_path, quick_launch(tmp_path))
+    try:
+        assert m.wait() == 0, m.text
+        # Removed before mlaunch exits (others there belong to other runs, still running).
+        ours = {p.name for p in parent.glob(f"{PREFIX}{m.popen.pid}-*")}
+        assert not ours, ours
+    finally:
+        m.close()

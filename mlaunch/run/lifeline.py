@@ -30,6 +30,10 @@ import time
 from mlaunch.errors import exit_for_signal
 from mlaunch.run import guard as guards
 
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.run.cgroup import RunCgroup
+
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 # What a process the load left behind gets between SIGTERM and SIGKILL.
 LEFTOVER_GRACE = 2.0
@@ -60,6 +64,8 @@ class Lifeline:
         self.run_id = guards.new_run_id()
         self.temp_dir = ""
         self.guard: guards.Guard | None = None
+        self.cgroup: RunCgroup | None = None
+        self.no_cgroup = ""  # why the run has no cgroup of its own
         self.received: list[int] = []
         self._raising = True
         self._old_handlers: dict[int, object] = {}
@@ -73,7 +79,16 @@ class Lifeline:
         # file's own subprocesses and their descendants, whatever session they move to.
         self.environ[guards.MARKER] = self.run_id
         self.temp_dir = private_temp_dir()
-        self.guard = guards.Guard.start(self.run_id, temp_dir=self.temp_dir)
+        from mlaunch.run.cgroup import RunCgroup
+
+        self.cgroup, self.no_cgroup = RunCgroup.create(self.environ)
+        cgroup_path = self.cgroup.path if self.cgroup is not None else None
+        self.guard = guards.Guard.start(self.run_id, temp_dir=self.temp_dir, cgroup=cgroup_path)
+        # In after the guard is forked: it must outlive (and kill) the cgroup.
+        if self.cgroup is not None and not self.cgroup.enter():
+            self.no_cgroup = f"cannot move into {self.cgroup.path}"
+            self.cgroup.remove()
+            self.cgroup = None
         return self
 
     def _on_signal(self, signum: int, frame: object) -> None:
@@ -112,7 +127,10 @@ class Lifeline:
                         f"mlaunch: stopped by {signal.Signals(error.signum).name}"
                         " before the launch had started"
                     )
-                end_leftovers(self.run_id, exclude={self.guard.pid} if self.guard else set())
+                exclude = {self.guard.pid} if self.guard else set()
+                end_leftovers(self.run_id, self.cgroup, exclude=exclude)
+            if self.cgroup is not None:
+                self.cgroup.leave()  # and what a normal run left in it is killed
             if self.temp_dir:
                 remove_private_dir(self.temp_dir)
             if self.guard is not None:
@@ -126,13 +144,19 @@ class Lifeline:
                 signal.signal(sig, handler)  # type: ignore[arg-type]
 
 
-def end_leftovers(run_id: str, *, exclude: set[int], grace: float = LEFTOVER_GRACE) -> int:
-    """SIGTERM (then SIGKILL after ``grace``) what carries the run's marker; how many there were.
+def end_leftovers(
+    run_id: str, cgroup: RunCgroup | None, *, exclude: set[int], grace: float = LEFTOVER_GRACE
+) -> int:
+    """SIGTERM (then SIGKILL after ``grace``) what carries the run's marker or is in its cgroup.
 
     Only on an abnormal way out: a normal run's supervisor has ended everything already.
+    Returns how many processes there were.
     """
     me = os.getpid()
-    first = [p.pid for p in guards.marked(run_id) if p.pid != me and p.pid not in exclude]
+    found = {p.pid for p in guards.marked(run_id)}
+    if cgroup is not None:
+        found.update(cgroup.members())
+    first = [pid for pid in found if pid != me and pid not in exclude]
     for pid in first:
         _send(pid, signal.SIGTERM)
         _send(pid, signal.SIGCONT)

@@ -20,6 +20,10 @@ from collections.abc import Callable, Iterable
 
 from mlaunch.run import guard as guards
 
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.run.cgroup import RunCgroup
+
 # How long an escaped descendant gets between SIGTERM and SIGKILL at shutdown.
 STRAY_GRACE = 2.0
 PR_SET_CHILD_SUBREAPER = 36
@@ -29,7 +33,8 @@ class Strays:
     """Finds and ends one run's stray processes (SIGTERM, then SIGKILL after ``grace``).
 
     ``adopt``: become the subreaper and end every descendant; an embedder with children of its
-    own passes False (the run's processes are still found by their marker).
+    own passes False (the run's processes are still found by their marker). ``cgroup``: the
+    run's cgroup (mlaunch.run.cgroup), whose members are the run's whatever their environment.
     """
 
     def __init__(
@@ -39,8 +44,10 @@ class Strays:
         adopt: bool = True,
         grace: float = STRAY_GRACE,
         clock: Callable[[], float] = time.monotonic,
+        cgroup: RunCgroup | None = None,
     ) -> None:
         self.run_id = run_id
+        self.cgroup = cgroup
         self.adopt = adopt
         self.grace = grace
         self.clock = clock
@@ -123,6 +130,14 @@ class Strays:
             found.update((p.pid, p) for p in guards.tree(os.getpid()))
         if thorough or not self.subreaper or self.escaped:
             found.update((p.pid, p) for p in guards.marked(self.run_id))
+        if self.cgroup is not None:
+            # Whatever it did (a daemon that cleared its environment and left before we
+            # were subreaper), a process of the run is in its cgroup.
+            me = os.getpid()
+            for pid in self.cgroup.members():
+                info = guards.proc_info(pid) if pid != me and pid not in found else None
+                if info is not None and not info.zombie:
+                    found[pid] = info
         if skip is not None:
             found.pop(skip, None)
         for pid in ours:  # our own children are the ladder's business

@@ -73,6 +73,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.run.cgroup import RunCgroup
+
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
 POLL = 0.05
 
@@ -100,6 +102,7 @@ class Supervisor:
         adopt: bool = True,
         stray_grace: float = STRAY_GRACE,
         spawner: Callable[[ProcessSpec, int, int], Process] = Process,
+        cgroup: RunCgroup | None = None,
     ) -> None:
         self.plan = plan
         self.printer = printer
@@ -119,7 +122,9 @@ class Supervisor:
         self.records: dict[str, ProcessRecord] = {}
         self.timers = Timers(clock)
         self.signals = SignalWatch(install=install_signals)
-        self.strays = Strays(self.run_id, adopt=adopt, grace=stray_grace, clock=clock)
+        self.strays = Strays(
+            self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
+        )
         self._index = itertools.count()
         self.shutting_down = False
         self._held: set[Process] = set()
