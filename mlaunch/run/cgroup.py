@@ -70,6 +70,7 @@ class RunCgroup:
         if mine is None:
             return None, "this process is in no cgroup v2"
         parent = os.path.join(root, mine.lstrip("/"))
+        _remove_stale(parent)
         path = os.path.join(parent, f"{PREFIX}{os.getpid()}-{os.urandom(4).hex()}")
         try:
             os.mkdir(path, 0o755)
@@ -135,6 +136,24 @@ class RunCgroup:
                 return False
             self.kill()
             time.sleep(0.005)
+
+
+def _remove_stale(parent: str) -> None:
+    """Remove the empty cgroups of runs whose mlaunch is gone (it and its guard were killed).
+
+    Only empty ones: rmdir fails on a cgroup with members, and those are never touched.
+    """
+    try:
+        names = [n for n in os.listdir(parent) if n.startswith(PREFIX)]
+    except OSError:
+        return
+    for name in names:
+        pid = name[len(PREFIX) :].partition("-")[0]
+        if pid.isdigit() and not os.path.exists(f"/proc/{pid}"):
+            try:
+                os.rmdir(os.path.join(parent, name))
+            except OSError:
+                pass
 
 
 def _write(path: str, text: str) -> bool:
