@@ -290,4 +290,4 @@ def stdout_gone() -> int:
         os.close(devnull)
     except OSError:
         pass
-    return 128 + signal.SIGPIPE
+    return exit_for_signal(signal.SIGPIPE)
