@@ -400,7 +400,7 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
                 groups.pop(int(line[1:]), None)
     if clean:
         return
-    ended = end_run(groups, run_id, cgroup)
+    ended = end_run(groups, run_id, cgroup, exclude={parent})
     removed = _remove_temp_dir(temp_dir)
     if ended or removed:
         what = f"ended {ended} of its processes" if ended else "no process was left"
@@ -430,24 +430,32 @@ def _keep_only_fds(fd: int) -> None:
     os.closerange(fd + 1, 1 << 16)
 
 
-def end_run(groups: dict[int, float], run_id: str, cgroup: str | None = None) -> int:
+def end_run(
+    groups: dict[int, float],
+    run_id: str,
+    cgroup: str | None = None,
+    *,
+    exclude: Iterable[int] = (),
+) -> int:
     """SIGTERM (+SIGCONT) every living process of the run, SIGKILL what outlives its grace.
 
     A process in a watched group gets that group's grace (its sigkill_timeout); one found only
     by the marker or in the run's cgroup gets the longest. Returns how many processes were
     signalled. The cgroup is then killed whole (what forked meanwhile) and removed.
+    ``exclude``: mlaunch itself, which may still be in its cgroup while the kernel ends it.
     """
     start = time.monotonic()
     longest = min(MAX_GRACE, max(groups.values(), default=DEFAULT_GRACE))
     first_seen: dict[int, float] = {}
     killed: set[int] = set()
+    skip = set(exclude)
     run_cgroup = None
     if cgroup:
         from mlaunch.run.cgroup import RunCgroup
 
         run_cgroup = RunCgroup(cgroup, os.path.dirname(cgroup))
     while time.monotonic() - start < longest + 5.0:
-        living = _living(groups, run_id, run_cgroup)
+        living = [p for p in _living(groups, run_id, run_cgroup) if p.pid not in skip]
         if not living:
             break
         now = time.monotonic()
