@@ -184,7 +184,7 @@ def _ros_actions() -> Any:
     return ros
 
 
-def _node_kwargs(e: Entity) -> dict[str, Any]:
+def node_kwargs(e: Entity) -> dict[str, Any]:
     kwargs = _process_kwargs(e, label=None)
 
     def put(key: str, value: Any) -> None:
@@ -211,13 +211,13 @@ def _node_kwargs(e: Entity) -> dict[str, Any]:
 
 def _node(e: Entity) -> Any:
     ros = _ros_actions()
-    return ros.Node(**_node_kwargs(e))
+    return ros.Node(**node_kwargs(e))
 
 
 def _lifecycle_node(e: Entity) -> Any:
     ros = _ros_actions()
     autostart = e.flag("autostart")
-    kwargs = _node_kwargs(e)
+    kwargs = node_kwargs(e)
     for required in ("name", "namespace"):
         if required not in kwargs:
             raise e.error(f"missing required attribute {required!r} (a lifecycle node needs it)")

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import mlaunch.launch.actions as core
 from mlaunch.errors import MlaunchError
+from mlaunch.frontends.composition_tags import COMPOSITION_TAGS
 from mlaunch.frontends.entity import Attr, Entity, did_you_mean
 from mlaunch.frontends.fields import (
     Builder,
@@ -221,6 +222,7 @@ ACTIONS: dict[str, Builder] = {
     "reset": _reset,
     **PROCESS_TAGS,
     **MACHINE_TAGS,
+    **COMPOSITION_TAGS,
 }
 
 # The tags whose children are actions.
@@ -228,9 +230,6 @@ TAKES_ACTIONS = ("group", "timer")
 
 # ROS 2 tags mlaunch knows but does not implement, with what to do instead.
 UNSUPPORTED: dict[str, str] = {
-    "node_container": "composable node containers are not implemented; run the nodes as <node>",
-    "load_composable_node": "composable nodes are not implemented",
-    "composable_node": "composable nodes are not implemented",
     "ros_timer": "use <timer>",
 }
 
@@ -240,6 +239,7 @@ MISPLACED: dict[str, str] = {
     "remap": "it belongs inside <node>; at the top level use set_remap",
     "env": "it belongs inside <executable> or <node>; at the top level use set_env",
     "keep": "it belongs inside <group> or <reset>",
+    "composable_node": "it belongs inside <node_container> or <load_composable_node>",
     "choice": "it belongs inside <arg>",
     "rosparam": "that is ROS 1 (a .launch file); use <param from=...> inside <node>",
     "test": "that is ROS 1 (a .launch file)",

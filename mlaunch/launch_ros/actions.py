@@ -655,8 +655,19 @@ def _remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
     return rules
 
 
+def __getattr__(name: str) -> Any:
+    # The composition actions live in their own module (which imports this one).
+    if name in ("ComposableNodeContainer", "LoadComposableNodes"):
+        from mlaunch.launch_ros import composition
+
+        return getattr(composition, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = [
+    "ComposableNodeContainer",  # noqa: F822 (module __getattr__)
     "LifecycleNode",
+    "LoadComposableNodes",  # noqa: F822 (module __getattr__)
     "Node",
     "NodeNames",
     "PushROSNamespace",

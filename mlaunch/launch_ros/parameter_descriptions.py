@@ -6,7 +6,7 @@
 - ``Parameter(name, value, *, value_type=None)``: a single ``-p name:=value`` on the command line.
 - ``ParameterFile(param_file, *, allow_substs=False)``: a params file; with ``allow_substs`` its
   ``$(...)`` are performed and the result is written to a new file.
-- ``ComposableNode``: the description of a component (data only for now).
+- ``ComposableNode``: the description of a component (in mlaunch.launch_ros.composable).
 
 The typing rules are launch's ``type_utils``: plain values are checked against ``value_type``
 when built; substitutions are performed and coerced when the node is resolved (``int``/``float``
@@ -358,33 +358,17 @@ def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -
     return write_temp("launch_params_", performed, temp_dir)
 
 
-class ComposableNode:
-    """A component to load into a container (described here; loading comes later)."""
+def __getattr__(name: str) -> Any:
+    # ComposableNode lives with the composition code; loaded only when a file names it.
+    if name == "ComposableNode":
+        from mlaunch.launch_ros.composable import ComposableNode
 
-    def __init__(
-        self,
-        *,
-        package: Any,
-        plugin: Any,
-        name: Any = None,
-        namespace: Any = None,
-        parameters: Any = None,
-        remappings: Any = None,
-        extra_arguments: Any = None,
-        condition: Any = None,
-    ) -> None:
-        self.package = normalize(package)
-        self.node_plugin = normalize(plugin)
-        self.node_name = None if name is None else normalize(name)
-        self.node_namespace = None if namespace is None else normalize(namespace)
-        self.parameters = None if parameters is None else list(parameters)
-        self.remappings = None if remappings is None else list(remappings)
-        self.extra_arguments = None if extra_arguments is None else list(extra_arguments)
-        self.condition = condition
+        return ComposableNode
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = [
-    "ComposableNode",
+    "ComposableNode",  # noqa: F822 (module __getattr__)
     "Parameter",
     "ParameterFile",
     "ParameterValue",

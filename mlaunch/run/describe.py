@@ -60,6 +60,10 @@ def describe_plan(plan: Plan, path: str) -> str:
             out.append(f"shutdown: {step.reason}")
         elif isinstance(step, EmitEvent):
             out.append(f"emit {type(step.event).__name__}")
+        elif hasattr(step, "describe_lines"):
+            # Steps of extensions (composable node loads) describe themselves.
+            out.extend(step.describe_lines())
+            out.append("")
         out.append("") if isinstance(step, Spawn) else None
     return "\n".join(out).rstrip() + "\n"
 

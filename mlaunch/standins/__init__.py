@@ -32,11 +32,14 @@ PACKAGE_EXECUTABLES: dict[tuple[str, str], tuple[str, tuple[str, ...]]] = {
     ("ros_gz_sim", "create"): ("spawn", ("create",)),
     ("gazebo_ros", "gzserver"): ("sim", ()),
     ("tf2_ros", "static_transform_publisher"): ("stp", ()),
+    ("rclcpp_components", "component_container"): ("container", ()),
+    ("rclcpp_components", "component_container_mt"): ("container", ()),
+    ("rclcpp_components", "component_container_isolated"): ("container", ()),
 }
 
 # What a stand-in needs beyond rclpy: module -> the Python package that must be importable.
 # tf2_msgs has no wheel on PyPI; scripts/setup builds it (interfaces/).
-NEEDS: dict[str, str] = {"stp": "tf2_msgs"}
+NEEDS: dict[str, str] = {"stp": "tf2_msgs", "container": "composition_interfaces"}
 
 
 def rclpy_available() -> bool:

@@ -1,0 +1,99 @@
+"""The composition tags of YAML/XML launch files: ``node_container``, ``load_composable_node``
+and their ``composable_node`` children, read as launch_ros reads them.
+
+``node_container`` takes every attribute and child of ``node`` plus ``composable_node``
+children; ``load_composable_node`` takes ``target`` (the container's name) and
+``composable_node`` children. A ``composable_node`` takes ``pkg``, ``plugin`` and ``name``
+(required, as in launch_ros), ``namespace``, ``if``/``unless``, and ``param``, ``remap`` and
+``extra_arg`` (``name``, ``value``) children; an extra argument's value is typed as YAML.
+The composition modules are imported only when such a tag appears.
+"""
+
+from __future__ import annotations
+
+from mlaunch.frontends.entity import Entity
+from mlaunch.frontends.fields import Builder, as_key, pairs, required_text
+from mlaunch.frontends.param_tags import parameter_item
+from mlaunch.frontends.process_tags import node_kwargs
+from mlaunch.launch.conditions import IfCondition, UnlessCondition
+
+TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+
+def _composable_node(e: Entity) -> Any:
+    from mlaunch.launch_ros.composable import ComposableNode
+
+    kwargs: dict[str, Any] = {
+        "package": required_text(e, "pkg"),
+        "plugin": required_text(e, "plugin"),
+        "name": required_text(e, "name"),
+    }
+    when = e.condition_text("if")
+    unless = e.condition_text("unless")
+    if when is not None and unless is not None:
+        raise e.error("'if' and 'unless' cannot both be given", e.attrs["unless"])
+    if when is not None:
+        kwargs["condition"] = IfCondition(when)
+    elif unless is not None:
+        kwargs["condition"] = UnlessCondition(unless)
+    namespace = e.text("namespace")
+    if namespace is not None:
+        kwargs["namespace"] = namespace
+    parameters = [parameter_item(p) for p in e.subentities("param")]
+    if parameters:
+        kwargs["parameters"] = parameters
+    remaps = pairs(e.subentities("remap"), "from", "to")
+    if remaps:
+        kwargs["remappings"] = remaps
+    extra = [_extra_argument(x) for x in e.subentities("extra_arg")]
+    if extra:
+        kwargs["extra_arguments"] = extra
+    e.finish()
+    description = ComposableNode(**kwargs)
+    description.origin = e.origin  # type: ignore[attr-defined]
+    return description
+
+
+def _extra_argument(x: Entity) -> dict[Any, Any]:
+    """``{name: value}``; the value is a substitution, so it is typed as YAML (as launch_ros)."""
+    from mlaunch.launch.substitutions import TextSubstitution
+
+    name = required_text(x, "name")
+    value = required_text(x, "value")
+    x.finish()
+    return {as_key(name): TextSubstitution(text=value) if isinstance(value, str) else value}
+
+
+def _descriptions(e: Entity) -> list[Any]:
+    return [_composable_node(c) for c in e.subentities("composable_node")]
+
+
+def _node_container(e: Entity) -> Any:
+    from mlaunch.launch_ros.composition import ComposableNodeContainer
+
+    kwargs = node_kwargs(e)
+    for required in ("name", "namespace"):
+        if required not in kwargs:
+            raise e.error(f"missing required attribute {required!r} (a node_container needs it)")
+    descriptions = _descriptions(e)
+    if descriptions:
+        kwargs["composable_node_descriptions"] = descriptions
+    return ComposableNodeContainer(**kwargs)
+
+
+def _load_composable_node(e: Entity) -> Any:
+    from mlaunch.launch_ros.composition import LoadComposableNodes
+
+    target = required_text(e, "target")
+    return LoadComposableNodes(
+        target_container=target, composable_node_descriptions=_descriptions(e)
+    )
+
+
+# The composition tags of the tag table (``mlaunch.frontends.tags.ACTIONS``).
+COMPOSITION_TAGS: dict[str, Builder] = {
+    "node_container": _node_container,
+    "load_composable_node": _load_composable_node,
+}

@@ -1,0 +1,81 @@
+"""``launch_ros.descriptions.ComposableNode``: a component to load into a container.
+
+Data only: what to load (package, plugin), its names, parameters, remappings, the container's
+extra arguments and a condition, each normalized when the description is built (as launch_ros
+does), so a bad parameters list fails at the line that wrote it. The request made of it is built
+in ``mlaunch.launch_ros.load_request``; the actions that load it are in
+``mlaunch.launch_ros.composition``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from mlaunch.errors import LaunchFileError
+from mlaunch.launch.substitutions import normalize
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.substitutions import Substitution
+
+    Subs = tuple[Substitution, ...]
+
+
+class ComposableNode:
+    """A component: a plugin of a package, loaded into a container by LoadNode."""
+
+    def __init__(
+        self,
+        *,
+        package: Any,
+        plugin: Any,
+        name: Any = None,
+        namespace: Any = None,
+        parameters: Any = None,
+        remappings: Any = None,
+        extra_arguments: Any = None,
+        condition: Any = None,
+    ) -> None:
+        from mlaunch.ros.params import normalize_parameters
+
+        self.package = normalize(package)
+        self.node_plugin = normalize(plugin)
+        self.node_name = None if name is None else normalize(name)
+        self.node_namespace = None if namespace is None else normalize(namespace)
+        self.parameters = None if parameters is None else normalize_parameters(parameters)
+        # launch_ros keeps an empty list of remappings / extra arguments as "none given".
+        self.remappings = remap_rules(remappings) if remappings else None
+        self.extra_arguments = normalize_parameters(extra_arguments) if extra_arguments else None
+        self._condition = condition
+
+    def condition(self) -> Any:
+        """The condition (launch_ros exposes it as a method, not a property)."""
+        return self._condition
+
+    def describe_short(self) -> str:
+        from mlaunch.launch.substitutions import describe
+
+        text = f"ComposableNode(package={describe(self.package)}"
+        text += f", plugin={describe(self.node_plugin)}"
+        if self.node_name is not None:
+            text += f", name={describe(self.node_name)}"
+        return text + ")"
+
+
+def remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
+    """``[(from, to), ...]`` or a dict, each side normalized to substitutions."""
+    items = list(remappings.items()) if isinstance(remappings, Mapping) else list(remappings)
+    rules = []
+    for item in items:
+        if not isinstance(item, (tuple, list)) or len(item) != 2:
+            raise LaunchFileError(
+                f"a remapping must be a (from, to) pair, got {item!r:.80}"
+                " (write remappings=[('from', 'to'), ...])"
+            )
+        rules.append((normalize(item[0]), normalize(item[1])))
+    return rules
+
+
+__all__ = ["ComposableNode"]
