@@ -31,11 +31,10 @@ ROOTS: dict[str, str] = {
 }
 
 # Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per
-# module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.actions``).
+# module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.launch_description``).
 SYNONYMS: dict[str, str] = {
-    "launch.action": "mlaunch.launch.actions",
-    "launch.launch_description": "mlaunch.launch.actions",
-    "launch.launch_description_entity": "mlaunch.launch.actions",
+    "launch.action": "mlaunch.launch.launch_description",
+    "launch.launch_description_entity": "mlaunch.launch.launch_description",
     "launch.substitution": "mlaunch.launch.substitutions",
     "launch.some_substitutions_type": "mlaunch.launch.substitutions",
     "launch.condition": "mlaunch.launch.conditions",

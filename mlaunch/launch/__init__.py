@@ -12,11 +12,11 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.launch.actions import Action, LaunchDescription, LaunchDescriptionEntity
     from mlaunch.launch.conditions import Condition
     from mlaunch.launch.event_handlers import EventHandler
     from mlaunch.launch.events import Event
     from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
     from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
     from mlaunch.launch.launch_service import LaunchService
     from mlaunch.launch.substitutions import (
@@ -28,9 +28,9 @@ if TYPE_CHECKING:
 
 # name -> (module, attribute in it)
 _NAMES: dict[str, tuple[str, str]] = {
-    "Action": ("mlaunch.launch.actions", "Action"),
-    "LaunchDescription": ("mlaunch.launch.actions", "LaunchDescription"),
-    "LaunchDescriptionEntity": ("mlaunch.launch.actions", "LaunchDescriptionEntity"),
+    "Action": ("mlaunch.launch.launch_description", "Action"),
+    "LaunchDescription": ("mlaunch.launch.launch_description", "LaunchDescription"),
+    "LaunchDescriptionEntity": ("mlaunch.launch.launch_description", "LaunchDescriptionEntity"),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
     "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
     "LaunchService": ("mlaunch.launch.launch_service", "LaunchService"),
@@ -57,6 +57,7 @@ _SUBMODULES = (
     "event_handlers",
     "events",
     "launch_context",
+    "launch_description",
     "launch_description_sources",
     "launch_service",
 )

@@ -1,18 +1,19 @@
 """Actions: the launch description, as the same classes and keywords as ROS 2 ``launch.actions``.
 
 An action is data plus ``execute(resolver)``, which reads the context, adds steps to the plan
-and may return entities to visit next. Nothing here starts a process or prints.
+and may return entities to visit next. Nothing here starts a process or prints. The base
+classes live in mlaunch.launch.launch_description and ExecuteProcess in
+mlaunch.launch.execute_process; both are served from here too, under ROS 2's names.
 """
 
 from __future__ import annotations
 
 import os
 
-from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.errors import LaunchArgumentError, LaunchFileError
+from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
+from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
-    LaunchConfiguration,
-    Substitution,
-    describe,
     normalize,
     perform,
     perform_substitutions,
@@ -20,15 +21,11 @@ from mlaunch.launch.substitutions import (
 )
 from mlaunch.origin import caller_origin
 from mlaunch.run.plan import (
-    OUTPUT_MODES,
     AddHandler,
     ArgumentInfo,
-    Deferred,
     Log,
-    ProcessSpec,
     RemoveHandler,
     RequestShutdown,
-    RespawnPolicy,
     StartTimer,
 )
 from mlaunch.run.plan import EmitEvent as EmitEventStep
@@ -38,87 +35,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
     from typing import Any
 
-    from mlaunch.launch.conditions import Condition
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.run.plan import NodeInfo
     from mlaunch.run.resolve import Resolver
-
-
-# The launch configuration PushMachine (or a default Machine) sets for the rest of its scope
-# (mlaunch.machines); here so that a launch without machines never imports that package.
-PUSHED_MACHINE = "mlaunch.machine"
-
-
-class LaunchDescriptionEntity:
-    """Anything that can appear in a launch description."""
-
-    def visit(self, resolver: Resolver) -> list[Any] | None:
-        return None
-
-    def describe_short(self) -> str:
-        return type(self).__name__
-
-
-class Action(LaunchDescriptionEntity):
-    """Base of every action: an optional condition and where it was written."""
-
-    def __init__(self, *, condition: Condition | None = None) -> None:
-        self.condition = condition
-        self.origin = caller_origin()
-
-    def visit(self, resolver: Resolver) -> list[Any] | None:
-        if self.condition is not None and not self.condition.evaluate(resolver.context):
-            return None
-        return self.execute(resolver)
-
-    def execute(self, resolver: Resolver) -> list[Any] | None:
-        return None
-
-    def get_sub_entities(self) -> list[Any]:
-        return []
-
-
-class LaunchDescription(LaunchDescriptionEntity):
-    """An ordered list of entities; what generate_launch_description() returns."""
-
-    def __init__(
-        self, initial_entities: Iterable[Any] | None = None, *, deprecated_reason: str | None = None
-    ) -> None:
-        self.entities: list[Any] = list(initial_entities or [])
-        self.deprecated_reason = deprecated_reason
-        self.origin = caller_origin()
-
-    def add_action(self, action: Any) -> None:
-        self.entities.append(action)
-
-    def add_entity(self, entity: Any) -> None:
-        self.entities.append(entity)
-
-    def describe_sub_entities(self) -> list[Any]:
-        return list(self.entities)
-
-    def visit(self, resolver: Resolver) -> list[Any] | None:
-        if self.deprecated_reason:
-            resolver.warn(f"launch description is deprecated: {self.deprecated_reason}")
-        resolver.visit_all(self.entities)
-        return None
-
-    def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
-        """The DeclareLaunchArgument actions in this description, includes not followed."""
-        found: list[Any] = []
-
-        def walk(entities: Iterable[Any]) -> None:
-            for entity in entities:
-                if isinstance(entity, DeclareLaunchArgument):
-                    found.append(entity)
-                elif isinstance(entity, (LaunchDescription, GroupAction)):
-                    walk(
-                        entity.entities if isinstance(entity, LaunchDescription) else entity.actions
-                    )
-
-        walk(self.entities)
-        return found
 
 
 # --- arguments and configurations ------------------------------------------------------------
@@ -544,321 +463,6 @@ class LogInfo(Action):
         resolver.add(
             Log(origin=self.origin, message=perform_substitutions(resolver.context, self.msg))
         )
-
-
-# --- processes -------------------------------------------------------------------------------
-
-
-def _number(resolver: Resolver, value: Any, what: str, origin: str) -> float:
-    return resolver.float_value(value, what, origin)
-
-
-class ExecuteProcess(Action):
-    """A process to start and supervise, with ROS 2's keywords (ExecuteProcess/ExecuteLocal).
-
-    mlaunch extensions: ``respawn`` also takes ``'always'``/``'on-failure'``; ``required=True``
-    is short for ``on_exit=Shutdown()``; ``respawn_backoff``/``respawn_max_delay`` slow a crash
-    loop down. The first restart waits ``respawn_delay`` as in ROS 2; each further exit within
-    10 s of starting multiplies the wait by ``respawn_backoff`` (default 2, so a crash loop cannot
-    burn a core), up to ``respawn_max_delay`` (30 s). ``respawn_backoff=1`` restarts like ROS 2.
-    """
-
-    # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
-    # (mlaunch.launch.launch_service fills it in; launch_testing looks processes up by it).
-    process_details: dict[str, Any] | None = None
-    # The exit status of its last run (negative: killed by that signal); None until it exits.
-    return_code: int | None = None
-
-    def __init__(
-        self,
-        *,
-        cmd: Iterable[SomeSubstitutionsType],
-        prefix: SomeSubstitutionsType | None = None,
-        name: SomeSubstitutionsType | None = None,
-        cwd: SomeSubstitutionsType | None = None,
-        env: dict[Any, Any] | None = None,
-        additional_env: dict[Any, Any] | None = None,
-        shell: bool = False,
-        sigterm_timeout: Any = None,
-        sigkill_timeout: Any = None,
-        emulate_tty: Any = False,
-        output: Any = "log",
-        output_format: str = "[{this.process_description.final_name}] {line}",
-        cached_output: bool = False,
-        log_cmd: bool = False,
-        on_exit: Any = None,
-        respawn: Any = False,
-        respawn_delay: Any = None,
-        respawn_max_retries: Any = -1,
-        respawn_backoff: Any = 2.0,
-        respawn_max_delay: Any = 30.0,
-        required: Any = False,
-        machine: SomeSubstitutionsType | None = None,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        if isinstance(cmd, (str, Substitution)):
-            cmd = [cmd]
-        self.cmd = [normalize(item) for item in cmd]
-        self.prefix = None if prefix is None else normalize(prefix)
-        self.name = None if name is None else normalize(name)
-        self.cwd = None if cwd is None else normalize(cwd)
-        self.env = env
-        self.additional_env = additional_env
-        self.shell = shell
-        # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s.
-        self.sigterm_timeout = (
-            LaunchConfiguration("sigterm_timeout", default=5)
-            if sigterm_timeout is None
-            else sigterm_timeout
-        )
-        self.sigkill_timeout = (
-            LaunchConfiguration("sigkill_timeout", default=5)
-            if sigkill_timeout is None
-            else sigkill_timeout
-        )
-        self.emulate_tty = emulate_tty
-        self.output = output
-        self.log_cmd = log_cmd
-        # Kept for launch_pytest.tools, which reads output only of processes that cache it.
-        self.cached_output = cached_output
-        self.on_exit = on_exit
-        self.respawn = respawn
-        self.respawn_delay = respawn_delay
-        self.respawn_max_retries = respawn_max_retries
-        self.respawn_backoff = respawn_backoff
-        self.respawn_max_delay = respawn_max_delay
-        self.required = required
-        # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
-        self.machine = None if machine is None else normalize(machine)
-
-    def command(self, resolver: Resolver) -> list[str]:
-        """The argv before any prefix: each cmd item performed to one element."""
-        return [perform_substitutions(resolver.context, item) for item in self.cmd]
-
-    def execute(self, resolver: Resolver) -> None:
-        resolver.spawn(self.build_spec(resolver))
-
-    def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        machine = self._machine(resolver)
-        return self.process_spec(resolver, self.command(resolver), machine=machine)
-
-    def process_spec(
-        self,
-        resolver: Resolver,
-        argv: list[str],
-        *,
-        node: NodeInfo | None = None,
-        replaced_label: str | None = None,
-        standin: str | None = None,
-        temp_files: tuple[str, ...] = (),
-        machine: Any = None,
-    ) -> ProcessSpec:
-        """The ProcessSpec for ``argv`` (before any prefix), with what the ROS layer adds.
-
-        ``replaced_label`` labels a process whose argv is already a stand-in's (a Node whose
-        package is not installed) as the program it replaces, unless a name or prefix leads;
-        ``standin`` names what it replaces, ``temp_files`` what to remove after it;
-        ``machine`` is the MachineSpec it runs on (None: no machine given or pushed).
-        """
-        ctx = resolver.context
-        remote = machine is not None and not machine.local
-        if not argv or not argv[0]:
-            raise SubstitutionFailure("the command is empty", where=self.origin)
-        named = argv
-        located = None
-        if not remote:  # another computer's programs are found there
-            argv, located = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
-        prefix = self._prefix(ctx, named)
-        # The label comes from the program the launch file named, not from its stand-in.
-        if self.name is not None:
-            base = perform_substitutions(ctx, self.name)
-        elif replaced_label is not None and not prefix:
-            base = replaced_label
-        else:
-            base = os.path.basename((prefix or named)[0])
-        env = self._environment(ctx)
-        on_exit, required = self._exit_policy(resolver)
-        spec = ProcessSpec(
-            label=resolver.new_label(base),
-            argv=tuple(prefix + argv),
-            env=env,
-            env_changes=_env_changes(ctx.initial_environment, env),
-            cwd=None if self.cwd is None else perform_substitutions(ctx, self.cwd),
-            shell=self.shell,
-            emulate_tty=self._emulate_tty(ctx),
-            output=self._output(ctx),
-            respawn=self._respawn(resolver),
-            sigterm_timeout=_number(resolver, self.sigterm_timeout, "sigterm_timeout", self.origin),
-            sigkill_timeout=_number(resolver, self.sigkill_timeout, "sigkill_timeout", self.origin),
-            required=required,
-            on_exit=on_exit,
-            origin=self.origin,
-            action=self,
-            node=node,
-            standin=standin if standin is not None else located,
-            machine=machine,
-        )
-        if temp_files:
-            spec.temp_files = (*spec.temp_files, *temp_files)
-        if not remote and spec.cwd is not None and not os.path.isdir(spec.cwd):
-            raise MlaunchError(
-                f"working directory {spec.cwd!r} does not exist", where=self.origin, what=base
-            )
-        return spec
-
-    def _machine(self, resolver: Resolver) -> Any:
-        """The MachineSpec this process runs on, or None (no machine given or pushed)."""
-        pushed = resolver.context.launch_configurations.get(PUSHED_MACHINE)
-        if self.machine is None and not pushed:
-            return None  # the common case: nothing of mlaunch.machines is imported
-        from mlaunch.machines.actions import machine_for
-
-        return machine_for(resolver, self.machine, self.origin)
-
-    def _prefix(self, ctx: LaunchContext, argv: list[str]) -> list[str]:
-        if self.prefix is not None:
-            text = perform_substitutions(ctx, self.prefix)
-        else:
-            text = str(ctx.launch_configurations.get("launch-prefix", ""))
-            pattern = str(ctx.launch_configurations.get("launch-prefix-filter", ""))
-            if text and pattern:
-                import re
-
-                if not re.match(pattern, os.path.basename(argv[0])):
-                    text = ""
-        if not text.strip():
-            return []
-        import shlex
-
-        return shlex.split(text)
-
-    def _environment(self, ctx: LaunchContext) -> dict[str, str]:
-        if self.env is not None:
-            env = {perform(ctx, k): perform(ctx, v) for k, v in _items(self.env)}
-        else:
-            env = dict(ctx.environment)
-        if self.additional_env:
-            env.update({perform(ctx, k): perform(ctx, v) for k, v in _items(self.additional_env)})
-        # Timely output from pipes (ROS 2's L#188): children line-buffer unless told otherwise.
-        # Jazzy's rcutils reads RCUTILS_LOGGING_BUFFERED_STREAM (1 = line buffered) and warns
-        # about the older RCUTILS_CONSOLE_STDOUT_LINE_BUFFERED, so only the new one is set.
-        env.setdefault("PYTHONUNBUFFERED", "1")
-        env.setdefault("RCUTILS_LOGGING_BUFFERED_STREAM", "1")
-        return env
-
-    def _emulate_tty(self, ctx: LaunchContext) -> bool:
-        """Whether the child's stdout and stderr are pseudo-terminals, as launch gives them."""
-        return _truthy(ctx, self.emulate_tty) or _truthy(
-            ctx, ctx.launch_configurations.get("emulate_tty", False)
-        )
-
-    def _output(self, ctx: LaunchContext) -> str:
-        override = ctx.environment.get("OVERRIDE_LAUNCH_PROCESS_OUTPUT")
-        value = self.output
-        if isinstance(value, dict):
-            value = _output_from_dict(value)
-        text = override or perform(ctx, value)
-        if text not in OUTPUT_MODES:
-            raise MlaunchError(
-                f"output is {text!r}; valid: {', '.join(OUTPUT_MODES)}", where=self.origin
-            )
-        return text
-
-    def _respawn(self, resolver: Resolver) -> RespawnPolicy:
-        ctx = resolver.context
-        value = self.respawn
-        if isinstance(value, bool):
-            mode = "always" if value else "never"
-        else:
-            text = perform(ctx, value).strip().lower()
-            if text in ("always", "on-failure", "on_failure", "never"):
-                mode = text.replace("_", "-")
-            else:
-                try:
-                    mode = "always" if to_bool(text, "respawn") else "never"
-                except SubstitutionFailure:
-                    raise MlaunchError(
-                        f"respawn is {text!r}; valid: true, false, always, on-failure, never",
-                        where=self.origin,
-                    )
-        delay = 0.0
-        if self.respawn_delay is not None:
-            delay = resolver.float_value(self.respawn_delay, "respawn_delay", self.origin)
-        retries = int(
-            resolver.float_value(self.respawn_max_retries, "respawn_max_retries", self.origin)
-        )
-        backoff = resolver.float_value(self.respawn_backoff, "respawn_backoff", self.origin)
-        max_delay = resolver.float_value(self.respawn_max_delay, "respawn_max_delay", self.origin)
-        if delay < 0 or backoff < 1.0:
-            raise MlaunchError(
-                f"respawn_delay must be >= 0 and respawn_backoff >= 1 (got {delay}, {backoff})",
-                where=self.origin,
-            )
-        return RespawnPolicy(
-            mode=mode, delay=delay, max_retries=retries, backoff=backoff, max_delay=max_delay
-        )
-
-    def _exit_policy(self, resolver: Resolver) -> tuple[Deferred | None, bool]:
-        ctx = resolver.context
-        required = self.required
-        if not isinstance(required, bool):
-            required = to_bool(perform(ctx, required), "required")
-        on_exit = self.on_exit
-        if on_exit is None:
-            return None, required
-        if callable(on_exit) and not hasattr(on_exit, "visit"):
-            return resolver.defer([], self.origin, callback=on_exit), required
-        entities = list(on_exit) if isinstance(on_exit, (list, tuple)) else [on_exit]
-        if any(isinstance(e, Shutdown) for e in entities):
-            required = True
-        return resolver.defer(entities, self.origin), required
-
-    def describe_short(self) -> str:
-        return "ExecuteProcess(" + " ".join(describe(c) for c in self.cmd) + ")"
-
-
-def _items(mapping: Any) -> list[tuple[Any, Any]]:
-    if isinstance(mapping, dict):
-        return list(mapping.items())
-    return list(mapping)
-
-
-def _truthy(ctx: LaunchContext, value: Any) -> bool:
-    if isinstance(value, bool):
-        return value
-    try:
-        return to_bool(perform(ctx, value), "emulate_tty")
-    except SubstitutionFailure:
-        return False
-
-
-def _output_from_dict(value: dict[str, Any]) -> str:
-    """ROS 2's dict form of ``output``, mapped to the nearest whole mode."""
-    targets = {k: ({v} if isinstance(v, str) else set(v)) for k, v in value.items()}
-    both = targets.get("both", set())
-    stdout = targets.get("stdout", set()) | both
-    stderr = targets.get("stderr", set()) | both
-    if "screen" in stdout and "screen" in stderr:
-        return "both" if ("log" in stdout or "log" in stderr) else "screen"
-    if "own_log" in stdout or "own_log" in stderr:
-        return "own_log"
-    return "log"
-
-
-def _env_changes(before: dict[str, str], after: dict[str, str]) -> dict[str, str | None]:
-    changes: dict[str, str | None] = {k: v for k, v in after.items() if before.get(k) != v}
-    changes.update({k: None for k in before if k not in after})
-    return changes
-
-
-ExecuteLocal = ExecuteProcess
-
-
-def which(name: str, env: dict[str, str]) -> str | None:
-    from mlaunch.launch.substitutions import which as which_on_path
-
-    return which_on_path(name, env.get("PATH", os.defpath))
 
 
 __all__ = [

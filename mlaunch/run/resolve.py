@@ -186,7 +186,7 @@ class Resolver:
             if os.access(program, os.X_OK) and not os.path.isdir(program):
                 return argv, None
         else:
-            from mlaunch.launch.actions import which
+            from mlaunch.launch.execute_process import which
 
             if which(program, env) is not None:
                 return argv, None

@@ -1,0 +1,94 @@
+"""The description's building blocks: ``LaunchDescriptionEntity``, ``Action`` and
+``LaunchDescription`` (ROS 2's ``launch.action`` and ``launch.launch_description``).
+
+An action is data plus ``execute(resolver)``, which reads the context, adds steps to the plan
+and may return entities to visit next. Nothing here starts a process or prints.
+"""
+
+from __future__ import annotations
+
+from mlaunch.origin import caller_origin
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from typing import Any
+
+    from mlaunch.launch.conditions import Condition
+    from mlaunch.run.resolve import Resolver
+
+
+class LaunchDescriptionEntity:
+    """Anything that can appear in a launch description."""
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        return None
+
+    def describe_short(self) -> str:
+        return type(self).__name__
+
+
+class Action(LaunchDescriptionEntity):
+    """Base of every action: an optional condition and where it was written."""
+
+    def __init__(self, *, condition: Condition | None = None) -> None:
+        self.condition = condition
+        self.origin = caller_origin()
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        if self.condition is not None and not self.condition.evaluate(resolver.context):
+            return None
+        return self.execute(resolver)
+
+    def execute(self, resolver: Resolver) -> list[Any] | None:
+        return None
+
+    def get_sub_entities(self) -> list[Any]:
+        return []
+
+
+class LaunchDescription(LaunchDescriptionEntity):
+    """An ordered list of entities; what generate_launch_description() returns."""
+
+    def __init__(
+        self, initial_entities: Iterable[Any] | None = None, *, deprecated_reason: str | None = None
+    ) -> None:
+        self.entities: list[Any] = list(initial_entities or [])
+        self.deprecated_reason = deprecated_reason
+        self.origin = caller_origin()
+
+    def add_action(self, action: Any) -> None:
+        self.entities.append(action)
+
+    def add_entity(self, entity: Any) -> None:
+        self.entities.append(entity)
+
+    def describe_sub_entities(self) -> list[Any]:
+        return list(self.entities)
+
+    def visit(self, resolver: Resolver) -> list[Any] | None:
+        if self.deprecated_reason:
+            resolver.warn(f"launch description is deprecated: {self.deprecated_reason}")
+        resolver.visit_all(self.entities)
+        return None
+
+    def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
+        """The DeclareLaunchArgument actions in this description, includes not followed."""
+        from mlaunch.launch import actions
+
+        found: list[Any] = []
+
+        def walk(entities: Iterable[Any]) -> None:
+            for entity in entities:
+                if isinstance(entity, actions.DeclareLaunchArgument):
+                    found.append(entity)
+                elif isinstance(entity, (LaunchDescription, actions.GroupAction)):
+                    walk(
+                        entity.entities if isinstance(entity, LaunchDescription) else entity.actions
+                    )
+
+        walk(self.entities)
+        return found
+
+
+__all__ = ["Action", "LaunchDescription", "LaunchDescriptionEntity"]
