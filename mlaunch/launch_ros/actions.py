@@ -1,135 +1,44 @@
-"""``launch_ros.actions``: Node and the actions that set ROS scope state (namespace, globals).
+"""``launch_ros.actions``: the actions that set ROS scope state (namespace, global parameters,
+remaps, log folder), and Node and LifecycleNode (mlaunch.launch_ros.node) under their ROS 2 names.
 
-A Node resolves to the command line launch_ros gives it, in launch_ros's order::
-
-    <exe> <arguments...> [--ros-args <ros_arguments...>] --ros-args
-        [-r __node:=<name>] [-r __ns:=<namespace>]
-        (-p <name>:=<value> | --params-file <path>)...     globals of SetParameter(s)FromFile
-        (--params-file <file per dict> | --params-file <path> | -p <name>:=<value>)...
-        (-r <from>:=<to>)...                                SetRemap globals, then remappings
-
-The ROS scope state lives in the launch configurations under ROS 2's keys: ``ros_namespace``
-(str), ``global_params`` (a tuple of ``(name, value)`` and params-file paths) and
-``ros_remaps`` (a tuple of ``(from, to)``). Deliberate fix: these are immutable tuples that each
-action replaces, never lists extended in place, so a SetParameter or SetRemap inside a scoped
-GroupAction no longer leaks out of it (launch_ros's ``list.extend`` on a shallow-copied scope
-does leak).
-
-Nothing here imports rclpy: names and namespaces are validated with rmw's rules, re-stated.
-Importing this module registers the in-process xacro for ``Command(['xacro ', ...])``.
+The scope state and the naming rules are mlaunch.launch_ros.scope's. Importing this module
+registers the in-process xacro for ``Command(['xacro ', ...])``.
 """
 
 from __future__ import annotations
 
 import os
-import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 
-from mlaunch import standins
-from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
-from mlaunch.launch.actions import Action, ExecuteProcess, LaunchDescription
+from mlaunch.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.launch.actions import Action, LaunchDescription
 from mlaunch.launch.substitutions import (
     SomeSubstitutionsType,
-    Substitution,
     describe,
     normalize,
     perform_substitutions,
 )
-from mlaunch.launch_ros.parameter_descriptions import ParameterFile, normalize_typed, perform_typed
-from mlaunch.launch_ros.substitutions import ExecutableInPackage
-from mlaunch.record import Record
-from mlaunch.ros import packages, params
+from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
+from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
+from mlaunch.launch_ros.scope import (
+    global_params,
+    make_namespace_absolute,
+    namespace_problem,
+    node_name_problem,
+    prefix_namespace,
+    ros_remaps,
+)
+from mlaunch.ros import params
 from mlaunch.ros import xacro as _xacro
-from mlaunch.ros.packages import PackageNotFoundError
-from mlaunch.run.plan import NodeInfo, ProcessSpec
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.actions import LaunchDescriptionEntity
-    from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.run.resolve import Resolver
 
 _xacro.register()
-
-Subs = tuple[Substitution, ...]
-# launch_ros's key for the count of full node names in the context globals.
-NODE_NAMES_KEY = "unique_ros_node_names"
-
-
-# --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
-
-
-def make_namespace_absolute(ns: str) -> str:
-    return ns if ns.startswith("/") else "/" + ns
-
-
-def prefix_namespace(base_ns: str | None, ns: str | None) -> str | None:
-    """``ns`` under ``base_ns`` when relative; absolute ``ns`` wins; trailing '/' stripped.
-
-    None when both are None; otherwise absolute (launch_ros's ``return_absolute_ns=True``).
-    """
-    if base_ns is None and ns is None:
-        return None
-    if ns is None:
-        combined = base_ns or ""
-    elif not base_ns or ns.startswith("/"):
-        combined = ns
-    else:
-        combined = ("" if base_ns == "/" else base_ns) + "/" + ns
-    if combined != "/":
-        combined = combined.rstrip("/")
-    return make_namespace_absolute(combined)
-
-
-NAMESPACE_MAX_LENGTH = 245
-NODE_NAME_MAX_LENGTH = 255
-_NAME_CHARS = re.compile(r"[A-Za-z0-9_]*")
-_NAMESPACE_CHARS = re.compile(r"[A-Za-z0-9_/]*")
-
-
-def node_name_problem(name: str) -> str | None:
-    """Why rmw would reject a node name, or None."""
-    if not name:
-        return "node name must not be empty"
-    if not _NAME_CHARS.fullmatch(name):
-        return "node name must not contain characters other than alphanumerics or '_'"
-    if name[0].isdigit():
-        return "node name must not start with a number"
-    if len(name) > NODE_NAME_MAX_LENGTH:
-        return f"node name length should not exceed {NODE_NAME_MAX_LENGTH}"
-    return None
-
-
-def namespace_problem(ns: str) -> str | None:
-    """Why rmw would reject an (absolute) namespace, or None."""
-    if not ns:
-        return "namespace must not be empty"
-    if not ns.startswith("/"):
-        return "namespace must be absolute, it must lead with a '/'"
-    if len(ns) > 1 and ns.endswith("/"):
-        return "namespace must not end with a '/', unless only a '/'"
-    if not _NAMESPACE_CHARS.fullmatch(ns):
-        return "namespace must not contain characters other than alphanumerics, '_', or '/'"
-    if "//" in ns:
-        return "namespace must not contain repeated '/'"
-    if any(token[:1].isdigit() for token in ns.split("/")):
-        return "namespace must not have a token that starts with a number"
-    if len(ns) > NAMESPACE_MAX_LENGTH:
-        return f"namespace should not exceed {NAMESPACE_MAX_LENGTH} characters"
-    return None
-
-
-# --- scope state --------------------------------------------------------------------------------
-
-
-def _global_params(context: LaunchContext) -> tuple[Any, ...]:
-    return tuple(context.launch_configurations.get("global_params") or ())
-
-
-def _ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
-    return tuple(context.launch_configurations.get("ros_remaps") or ())
 
 
 def with_use_sim_time(description: LaunchDescriptionEntity, value: bool) -> LaunchDescription:
@@ -182,7 +91,7 @@ class SetParameter(Action):
     def execute(self, resolver: Resolver) -> None:
         ctx = resolver.context
         entries = tuple(params.evaluate_dict(ctx, self.param_dict).items())
-        ctx.launch_configurations["global_params"] = (*_global_params(ctx), *entries)
+        ctx.launch_configurations["global_params"] = (*global_params(ctx), *entries)
 
     def describe_short(self) -> str:
         (name,) = self.param_dict
@@ -202,7 +111,7 @@ class SetParametersFromFile(Action):
         if not os.path.isfile(path):
             # launch_ros asserts when a node uses it; failing here names the right line.
             raise LaunchFileError(f"parameters file {path!r} does not exist", where=self.origin)
-        ctx.launch_configurations["global_params"] = (*_global_params(ctx), path)
+        ctx.launch_configurations["global_params"] = (*global_params(ctx), path)
 
     def describe_short(self) -> str:
         return f"SetParametersFromFile({describe(self.filename)})"
@@ -219,7 +128,7 @@ class SetRemap(Action):
     def execute(self, resolver: Resolver) -> None:
         ctx = resolver.context
         rule = (perform_substitutions(ctx, self.src), perform_substitutions(ctx, self.dst))
-        ctx.launch_configurations["ros_remaps"] = (*_ros_remaps(ctx), rule)
+        ctx.launch_configurations["ros_remaps"] = (*ros_remaps(ctx), rule)
 
     def describe_short(self) -> str:
         return f"SetRemap({describe(self.src)} -> {describe(self.dst)})"
@@ -277,384 +186,6 @@ def ros_log_dir(environ: Mapping[str, str]) -> str:
     return os.path.join(home, ".ros", "log")
 
 
-# --- Node ------------------------------------------------------------------------------------
-
-
-class NodeNames(Record):
-    """A node's name and namespace as resolved (None: not given, the node's own default)."""
-
-    _fields = ("name", "namespace")
-    __slots__ = _fields
-
-    def __init__(self, name: str | None, namespace: str | None) -> None:
-        self.name = name
-        self.namespace = namespace
-
-    @property
-    def fully_qualified(self) -> str | None:
-        if self.name is None:
-            return None
-        return prefix_namespace(self.namespace or "/", self.name)
-
-    @property
-    def params_key(self) -> str:
-        """The params-file key: the full name when both are known, else ``/**``."""
-        if self.name is not None and self.namespace is not None:
-            return prefix_namespace(self.namespace, self.name) or "/**"
-        return "/**"
-
-
-class NodeCommand(Record):
-    """What one resolution of a Node found: its names, what runs, its command line."""
-
-    _fields = ("names", "package", "executable", "exe_argv", "standin", "argv", "temp_files")
-    __slots__ = _fields
-
-    def __init__(
-        self,
-        names: NodeNames,
-        package: str | None,
-        executable: str,
-        exe_argv: list[str],
-        standin: str | None,
-        argv: list[str],
-        temp_files: tuple[str, ...],
-    ) -> None:
-        self.names = names
-        self.package = package
-        self.executable = executable
-        self.exe_argv = exe_argv  # the argv items that run the executable (or its stand-in)
-        self.standin = standin  # what a stand-in replaces, or None
-        self.argv = argv
-        self.temp_files = temp_files  # params files to remove with the process
-
-
-class Node(ExecuteProcess):
-    """A ROS node: an executable of a package (or a path) with launch_ros's command line."""
-
-    UNSPECIFIED_NODE_NAME = "<node_name_unspecified>"
-    UNSPECIFIED_NODE_NAMESPACE = "<node_namespace_unspecified>"
-    is_lifecycle = False
-
-    def __init__(
-        self,
-        *,
-        executable: SomeSubstitutionsType,
-        package: SomeSubstitutionsType | None = None,
-        name: SomeSubstitutionsType | None = None,
-        namespace: SomeSubstitutionsType | None = None,
-        exec_name: SomeSubstitutionsType | None = None,
-        parameters: Any = None,
-        remappings: Any = None,
-        ros_arguments: Iterable[SomeSubstitutionsType] | None = None,
-        arguments: Iterable[SomeSubstitutionsType] | None = None,
-        **kwargs: Any,
-    ) -> None:
-        first: Any = executable if package is None else ExecutableInPackage(executable, package)
-        super().__init__(cmd=[first], name=exec_name, **kwargs)
-        self.node_executable = normalize(executable)
-        self.node_package = None if package is None else normalize(package)
-        self._node_name = None if name is None else normalize(name)
-        self._node_namespace = None if namespace is None else normalize(namespace)
-        self.parameters = () if parameters is None else params.normalize_parameters(parameters)
-        self.remappings = _remap_rules(remappings)
-        self.ros_arguments = (
-            None if ros_arguments is None else _items(ros_arguments, "ros_arguments")
-        )
-        self.arguments = [] if arguments is None else _items(arguments, "arguments")
-        # launch_ros's node_name and friends: the names of the last resolution (for launch-file
-        # code that reads them after the node was visited; resolving itself never reads them).
-        self.resolved_names: NodeNames | None = None
-
-    # --- what launch_ros exposes ------------------------------------------------------------
-
-    @property
-    def node_name(self) -> str:
-        """The full node name once resolved (with launch_ros's placeholders for unknown parts)."""
-        names = self.resolved_names
-        if names is None:
-            raise RuntimeError("cannot access 'node_name' before executing action")
-        return (
-            prefix_namespace(
-                names.namespace or self.UNSPECIFIED_NODE_NAMESPACE,
-                names.name or self.UNSPECIFIED_NODE_NAME,
-            )
-            or ""
-        )
-
-    def is_node_name_fully_specified(self) -> bool:
-        names = self.resolved_names
-        return names is not None and names.name is not None and names.namespace is not None
-
-    @property
-    def expanded_node_namespace(self) -> str:
-        names = self.resolved_names
-        if names is None or names.namespace is None:
-            return self.UNSPECIFIED_NODE_NAMESPACE
-        return names.namespace
-
-    # --- resolving ------------------------------------------------------------------------------
-
-    def node_command(self, resolver: Resolver, *, remote: bool = False) -> NodeCommand:
-        """The node's names and launch_ros's command line for it, in the resolver's context.
-
-        ``remote``: the node runs on another computer (mlaunch.machines), which finds the
-        package's executable itself.
-        """
-        ctx = resolver.context
-        names = self._names(ctx)
-        package, executable, exe_argv, standin = self._executable(resolver, remote)
-        argv = [*exe_argv, *(perform_substitutions(ctx, a) for a in self.arguments)]
-        if self.ros_arguments is not None:
-            argv += ["--ros-args", *(perform_substitutions(ctx, a) for a in self.ros_arguments)]
-        argv.append("--ros-args")
-        if names.name is not None:
-            argv += ["-r", f"__node:={names.name}"]
-        if names.namespace is not None:
-            argv += ["-r", f"__ns:={names.namespace}"]
-        argv += self._global_parameter_arguments(ctx)
-        own, temp_files = self._parameter_arguments(resolver, names)
-        argv += own
-        for src, dst in self._remap_arguments(ctx):
-            argv += ["-r", f"{src}:={dst}"]
-        return NodeCommand(names, package, executable, exe_argv, standin, argv, temp_files)
-
-    def command(self, resolver: Resolver) -> list[str]:
-        return self.node_command(resolver).argv
-
-    def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        machine = self._machine(resolver)
-        found = self.node_command(resolver, remote=machine is not None and not machine.local)
-        info = NodeInfo(
-            name=found.names.name,
-            namespace=found.names.namespace or "/",
-            package=found.package,
-            executable=found.executable,
-            lifecycle=self.is_lifecycle,
-            autostart=bool(getattr(self, "autostart", False)),
-        )
-        spec = self.process_spec(
-            resolver,
-            found.argv,
-            node=info,
-            # A stand-in is labelled as the program it replaces (unless a launch prefix leads).
-            replaced_label=None if found.standin is None else os.path.basename(found.executable),
-            standin=found.standin,
-            temp_files=found.temp_files,
-            machine=machine,
-        )
-        self._track_name(resolver.context, found.names)
-        self.resolved_names = found.names
-        return spec
-
-    # --- pieces -------------------------------------------------------------------------------
-
-    def _names(self, ctx: LaunchContext) -> NodeNames:
-        name = None
-        if self._node_name is not None:
-            name = perform_substitutions(ctx, self._node_name)
-            problem = node_name_problem(name)
-            if problem is not None:
-                raise MlaunchError(f"node name {name!r} is invalid: {problem}")
-        given = None
-        if self._node_namespace is not None:
-            given = perform_substitutions(ctx, self._node_namespace)
-        pushed = ctx.launch_configurations.get("ros_namespace")
-        namespace = prefix_namespace(pushed, given)
-        if namespace is not None:
-            problem = namespace_problem(namespace)
-            if problem is not None:
-                detail = f"namespace={given!r}" + (f", pushed {pushed!r}" if pushed else "")
-                raise MlaunchError(f"node namespace {namespace!r} ({detail}) is invalid: {problem}")
-        return NodeNames(name, namespace)
-
-    def _executable(
-        self, resolver: Resolver, remote: bool
-    ) -> tuple[str | None, str, list[str], str | None]:
-        """(package, executable, argv items that run it, what a stand-in replaces)."""
-        ctx = resolver.context
-        executable = perform_substitutions(ctx, self.node_executable)
-        if self.node_package is None:
-            return None, executable, [executable], None
-        package = perform_substitutions(ctx, self.node_package)
-        index = packages.for_context(ctx)
-        if remote:
-            # Found on that computer (mlaunch.machines.agent looks the package up there); this
-            # computer's path is only a hint, and there are no stand-ins on other computers.
-            return package, executable, [remote_executable(index, package, executable)], None
-        if index.installed(package) is not None:
-            return package, executable, [index.executable(package, executable)], None
-        if resolver.options.standins:
-            replacement = standins.standin_for_package(package, executable)
-            if replacement is not None:
-                return package, executable, list(replacement), f"{package}/{executable}"
-        raise _not_installed(index, package, executable, resolver.options.standins)
-
-    def _global_parameter_arguments(self, ctx: LaunchContext) -> list[str]:
-        out: list[str] = []
-        for entry in _global_params(ctx):
-            if isinstance(entry, (tuple, list)) and len(entry) == 2:
-                out += ["-p", params.global_parameter_rule(str(entry[0]), entry[1])]
-                continue
-            path = os.path.abspath(str(entry))
-            if not os.path.isfile(path):
-                raise SubstitutionFailure(f"global parameters file {path!r} does not exist")
-            out += ["--params-file", path]
-        return out
-
-    def _parameter_arguments(
-        self, resolver: Resolver, names: NodeNames
-    ) -> tuple[list[str], tuple[str, ...]]:
-        """The node's own params arguments and the temporary files to remove (if mlaunch must)."""
-        if not self.parameters:
-            return [], ()
-        temp_dir = resolver.options.temp_dir
-        private = None
-        if temp_dir is None and _writes_files(self.parameters):
-            # No run directory to write into: a private one, removed with the process's files.
-            import tempfile
-
-            temp_dir = private = tempfile.mkdtemp(prefix="mlaunch-params-")
-
-        def warn(message: str) -> None:
-            resolver.warn(f"{self.origin}: {message}")
-
-        arguments = params.parameter_arguments(
-            resolver.context,
-            self.parameters,
-            node_key=names.params_key,
-            temp_dir=temp_dir,
-            warn=warn,
-        )
-        argv = [item for a in arguments for item in (a.flag, a.value)]
-        if private is None:
-            return argv, ()
-        return argv, (*(a.value for a in arguments if a.written), private)
-
-    def _remap_arguments(self, ctx: LaunchContext) -> list[tuple[str, str]]:
-        own = [
-            (perform_substitutions(ctx, src), perform_substitutions(ctx, dst))
-            for src, dst in self.remappings
-        ]
-        return [*_ros_remaps(ctx), *own]
-
-    def _track_name(self, ctx: LaunchContext, names: NodeNames) -> None:
-        """Warn when a second node gets the same full name (launch_ros's per-launch count).
-
-        The count lives in the run's context globals, as launch_ros keeps it. Counted for every
-        named node (namespace '/' when none is given); launch_ros only counts nodes whose
-        namespace is given too.
-        """
-        fqn = names.fully_qualified
-        if fqn is None:
-            return
-        counts: dict[str, int] | None = ctx.locals.get(NODE_NAMES_KEY)
-        if counts is None:
-            counts = {}
-            ctx.extend_globals({NODE_NAMES_KEY: counts})
-        counts[fqn] = counts.get(fqn, 0) + 1
-        if counts[fqn] > 1:
-            ctx.warn(
-                f"{self.origin}: there are now at least {counts[fqn]} nodes with the name {fqn}"
-                " created within this launch context"
-            )
-
-    def describe_short(self) -> str:
-        parts = []
-        if self.node_package is not None:
-            parts.append(f"package={describe(self.node_package)}")
-        parts.append(f"executable={describe(self.node_executable)}")
-        if self._node_name is not None:
-            parts.append(f"name={describe(self._node_name)}")
-        if self._node_namespace is not None:
-            parts.append(f"namespace={describe(self._node_namespace)}")
-        return f"{type(self).__name__}({', '.join(parts)})"
-
-
-class LifecycleNode(Node):
-    """A managed node: name and namespace are required; ``autostart`` configures and activates
-    it once it is up (driving the transitions is the supervisor's lifecycle support)."""
-
-    is_lifecycle = True
-
-    def __init__(
-        self,
-        *,
-        name: SomeSubstitutionsType,
-        namespace: SomeSubstitutionsType,
-        autostart: bool = False,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(name=name, namespace=namespace, **kwargs)
-        self.autostart = autostart
-
-
-def remote_executable(index: Any, package: str, executable: str) -> str:
-    """A remote node's program: this computer's path when installed here, else ``PKG/EXE``."""
-    if index.installed(package) is not None:
-        try:
-            return str(index.executable(package, executable))
-        except MlaunchError:
-            pass
-    return f"{package}/{executable}"
-
-
-def _writes_files(entries: Iterable[Any]) -> bool:
-    return any(
-        isinstance(e, dict) or (isinstance(e, ParameterFile) and e.allow_substs is not False)
-        for e in entries
-    )
-
-
-def _not_installed(
-    index: packages.PackageIndex, package: str, executable: str, standins_on: bool
-) -> PackageNotFoundError:
-    """The error for a package no ament prefix holds: missing, or only a checkout."""
-    hint = ""
-    if (package, executable) in standins.PACKAGE_EXECUTABLES:
-        if not standins_on:
-            hint = " (mlaunch has a stand-in for it: run without --no-standins)"
-        elif not standins.rclpy_available():
-            hint = " (mlaunch's stand-in for it needs rclpy: pip install 'mlaunch[ros]')"
-        elif (need := standins.unmet_need(package, executable)) is not None:
-            hint = f" (mlaunch's stand-in for it needs {need}: ./scripts/setup builds it)"
-    source = index.source(package)
-    if source is None:
-        return PackageNotFoundError(
-            f"package {package!r} not found, wanted for executable {executable!r}"
-            f" ({index.searched()}){hint}"
-        )
-    return PackageNotFoundError(
-        f"package {package!r} is only a source package at {source.share_directory!r} (not"
-        f" built): its executable {executable!r} exists once it is built and installed (colcon"
-        f" build, then source install/setup.bash){hint}"
-    )
-
-
-def _items(values: Any, what: str) -> list[Subs]:
-    if isinstance(values, (str, Substitution)):
-        raise LaunchFileError(
-            f"{what} must be a list of arguments, got {type(values).__name__} {values!r:.80}"
-            f" (write {what}=[...])"
-        )
-    return [normalize(v) for v in values]
-
-
-def _remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
-    if remappings is None:
-        return []
-    items = list(remappings.items()) if isinstance(remappings, Mapping) else list(remappings)
-    rules = []
-    for item in items:
-        if not isinstance(item, (tuple, list)) or len(item) != 2:
-            raise LaunchFileError(
-                f"a remapping must be a (from, to) pair, got {item!r:.80}"
-                " (write remappings=[('from', 'to'), ...])"
-            )
-        rules.append((normalize(item[0]), normalize(item[1])))
-    return rules
-
-
 def __getattr__(name: str) -> Any:
     # The composition actions live in their own module (which imports this one).
     if name in ("ComposableNodeContainer", "LoadComposableNodes"):
@@ -669,6 +200,7 @@ __all__ = [
     "LifecycleNode",
     "LoadComposableNodes",  # noqa: F822 (module __getattr__)
     "Node",
+    "NodeCommand",
     "NodeNames",
     "PushROSNamespace",
     "PushRosNamespace",

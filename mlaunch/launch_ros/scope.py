@@ -1,0 +1,105 @@
+"""ROS scope state and naming rules: what PushROSNamespace, SetParameter and SetRemap leave for
+the nodes after them, and rmw's rules for node names and namespaces (launch_ros.utilities).
+
+The state lives in the launch configurations under ROS 2's keys: ``ros_namespace`` (str),
+``global_params`` (a tuple of ``(name, value)`` and params-file paths) and ``ros_remaps`` (a
+tuple of ``(from, to)``). Deliberate fix: these are immutable tuples that each action replaces,
+never lists extended in place, so a SetParameter or SetRemap inside a scoped GroupAction no
+longer leaks out of it (launch_ros's ``list.extend`` on a shallow-copied scope does leak).
+
+Nothing here imports rclpy: names and namespaces are validated with rmw's rules, re-stated.
+"""
+
+from __future__ import annotations
+
+import re
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+
+
+# --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
+
+
+def make_namespace_absolute(ns: str) -> str:
+    return ns if ns.startswith("/") else "/" + ns
+
+
+def prefix_namespace(base_ns: str | None, ns: str | None) -> str | None:
+    """``ns`` under ``base_ns`` when relative; absolute ``ns`` wins; trailing '/' stripped.
+
+    None when both are None; otherwise absolute (launch_ros's ``return_absolute_ns=True``).
+    """
+    if base_ns is None and ns is None:
+        return None
+    if ns is None:
+        combined = base_ns or ""
+    elif not base_ns or ns.startswith("/"):
+        combined = ns
+    else:
+        combined = ("" if base_ns == "/" else base_ns) + "/" + ns
+    if combined != "/":
+        combined = combined.rstrip("/")
+    return make_namespace_absolute(combined)
+
+
+NAMESPACE_MAX_LENGTH = 245
+NODE_NAME_MAX_LENGTH = 255
+_NAME_CHARS = re.compile(r"[A-Za-z0-9_]*")
+_NAMESPACE_CHARS = re.compile(r"[A-Za-z0-9_/]*")
+
+
+def node_name_problem(name: str) -> str | None:
+    """Why rmw would reject a node name, or None."""
+    if not name:
+        return "node name must not be empty"
+    if not _NAME_CHARS.fullmatch(name):
+        return "node name must not contain characters other than alphanumerics or '_'"
+    if name[0].isdigit():
+        return "node name must not start with a number"
+    if len(name) > NODE_NAME_MAX_LENGTH:
+        return f"node name length should not exceed {NODE_NAME_MAX_LENGTH}"
+    return None
+
+
+def namespace_problem(ns: str) -> str | None:
+    """Why rmw would reject an (absolute) namespace, or None."""
+    if not ns:
+        return "namespace must not be empty"
+    if not ns.startswith("/"):
+        return "namespace must be absolute, it must lead with a '/'"
+    if len(ns) > 1 and ns.endswith("/"):
+        return "namespace must not end with a '/', unless only a '/'"
+    if not _NAMESPACE_CHARS.fullmatch(ns):
+        return "namespace must not contain characters other than alphanumerics, '_', or '/'"
+    if "//" in ns:
+        return "namespace must not contain repeated '/'"
+    if any(token[:1].isdigit() for token in ns.split("/")):
+        return "namespace must not have a token that starts with a number"
+    if len(ns) > NAMESPACE_MAX_LENGTH:
+        return f"namespace should not exceed {NAMESPACE_MAX_LENGTH} characters"
+    return None
+
+
+# --- scope state --------------------------------------------------------------------------------
+
+
+def global_params(context: LaunchContext) -> tuple[Any, ...]:
+    return tuple(context.launch_configurations.get("global_params") or ())
+
+
+def ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
+    return tuple(context.launch_configurations.get("ros_remaps") or ())
+
+
+__all__ = [
+    "global_params",
+    "make_namespace_absolute",
+    "namespace_problem",
+    "node_name_problem",
+    "prefix_namespace",
+    "ros_remaps",
+]
