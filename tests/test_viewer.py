@@ -183,6 +183,63 @@ def test_state_reports_unknown_laser_frame_and_bad_urdf() -> None:
     assert snap["robot"] is None and "2 root links" in snap["robot_error"]
 
 
+def test_tf_places_the_scan_where_odometry_and_the_urdf_cannot() -> None:
+    """A laser on a frame the URDF lacks, mounted by a static transform: TF puts it in place."""
+    state = ViewerState(DisplayConfig())
+    state.set_description(URDF, now=0.0)
+    state.set_odom("odom", "base_footprint", (1.0, 0.0, 0.0), now=0.0)
+    state.set_transforms(
+        [
+            ("odom", "base_footprint", (1.0, 0.0, 0.0)),
+            ("base_footprint", "base_link", (0.0, 0.0, 0.0)),
+            ("base_link", "rear_laser", (-0.5, 0.0, math.pi)),  # looks backwards
+        ],
+        now=0.0,
+    )
+    state.set_scan("rear_laser", 0.0, 0.1, [2.0], (0.05, 10.0), now=0.0)
+    snap = state.snapshot(now=0.0)
+    ((x, y),) = snap["scan"]["points"]
+    assert (x, y) == (pytest.approx(-1.5), pytest.approx(0.0))  # 1 - 0.5 - 2, behind the robot
+    assert not snap["warnings"]  # TF knew the frame: no "not a link" warning
+    assert {"odom", "base_footprint", "base_link", "rear_laser"} <= set(snap["frames"])
+
+
+def test_tf_places_the_robot_without_odometry() -> None:
+    state = ViewerState(DisplayConfig())
+    state.set_description(URDF, now=0.0)
+    state.set_transforms([("odom", "base_footprint", (0.5, -1.0, 0.25))], now=0.0)
+    snap = state.snapshot(now=0.0)
+    assert snap["pose"] == {"x": 0.5, "y": -1.0, "yaw": 0.25}
+
+
+def test_depth_image_becomes_a_small_grey_png() -> None:
+    import struct
+    import zlib
+
+    import numpy as np
+
+    state = ViewerState(DisplayConfig(depth_topic="/cam/depth/image_raw"))
+    depth = np.full((480, 640), 2.0, dtype="<f4")
+    depth[:, :320] = np.inf  # the left half sees nothing
+    state.set_depth(640, 480, "32FC1", depth.tobytes(), 4.0, now=0.0)
+    snap = state.snapshot(now=0.0)
+    assert snap["depth"] == {
+        "seq": 1,
+        "topic": "/cam/depth/image_raw",
+        "size": [640, 480],
+        "encoding": "32FC1",
+    }
+    png = state.depth_png()
+    assert png is not None and png.startswith(b"\x89PNG\r\n\x1a\n")
+    width, height = struct.unpack(">II", png[16:24])
+    assert (width, height) == (160, 120)  # a quarter of the camera's size
+    idat = png.index(b"IDAT")
+    (length,) = struct.unpack(">I", png[idat - 4 : idat])
+    rows = zlib.decompress(png[idat + 4 : idat + 4 + length])
+    first = rows[1 : 1 + width]  # after the filter byte
+    assert set(first[:80]) == {0} and set(first[80:]) == {127}  # no reading black; 2 of 4 m
+
+
 # ---------------------------------------------------------------- processes
 
 FAKE_ROBOT = textwrap.dedent(

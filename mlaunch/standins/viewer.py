@@ -2,14 +2,14 @@
 
 There is no RViz here, so this node serves a small web page on 127.0.0.1 that draws, top-down,
 the robot outline from ``robot_description`` at its odometry pose, the odometry trail and the
-laser scan. It takes rviz2's command line and reads the fixed frame and the LaserScan, Odometry and
-RobotModel topics from a display config. Only the standard library serves the page (http.server
+laser scan (placed through /tf and /tf_static when they are published), and shows the depth image
+of an Image display. It takes rviz2's command line and reads the fixed frame and the topics from a
+display config (viewer_config.py). Only the standard library serves the page (http.server
 in a thread); rclpy is imported inside main() only.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -23,9 +23,17 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import StandinError
 from mlaunch.standins.common import init_ros, spin
 from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
+from mlaunch.standins.viewer_config import (
+    DisplayConfig,
+    ViewerError,
+    parse_args,
+    read_display_config,
+    viewer_port,
+)
+from mlaunch.standins.viewer_config import config_from_data as config_from_data
+from mlaunch.standins.viewer_tf import DepthPicture, PlanarTf, compose, invert, planar, yaw_of
 
 if TYPE_CHECKING:
     from nav_msgs.msg import Odometry
@@ -34,7 +42,6 @@ if TYPE_CHECKING:
     from std_msgs.msg import String
 
 NODE_NAME = "rviz"
-PORT_ENV = "MLAUNCH_VIEWER_PORT"
 PAGE = Path(__file__).with_name("viewer.html")
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -42,141 +49,11 @@ TRAIL_MAX = 5000
 TRAIL_STEP = 0.02  # metres between trail points: enough for a smooth line, bounded memory
 
 Pose2D = tuple[float, float, float]  # x, y, yaw
-
-
-class ViewerError(StandinError, ValueError):
-    """Unusable viewer input (port, command line); printed as one line, exit status 1."""
-
-
-# ---------------------------------------------------------------- command line and config
-
-
-@dataclass(frozen=True)
-class DisplayConfig:
-    """What the viewer takes from an .rviz file: the fixed frame and the topics it draws."""
-
-    fixed_frame: str = "odom"
-    scan_topic: str = "scan"
-    odom_topic: str = "odom"
-    description_topic: str = "robot_description"
-    warnings: tuple[str, ...] = ()
-
-
-def parse_args(args: Sequence[str]) -> argparse.Namespace:
-    """rviz2's options (ROS arguments removed); the GUI-only ones are accepted and unused."""
-    parser = argparse.ArgumentParser(
-        prog="rviz2", description="mlaunch stand-in for rviz2: a top-down view in the browser"
-    )
-    parser.add_argument("-d", "--display-config", metavar="FILE", help="an .rviz config file")
-    parser.add_argument("-f", "--fixed-frame", metavar="FRAME", help="frame to draw in")
-    parser.add_argument("-s", "--splash-screen", nargs="?", const="", metavar="IMAGE")
-    parser.add_argument("-l", "--ogre-log", action="store_true", help="(ignored)")
-    parser.add_argument("--fullscreen", action="store_true", help="(ignored)")
-    parser.add_argument("--no-stereo", action="store_true", help="(ignored)")
-    parser.add_argument("--disable-anti-aliasing", action="store_true", help="(ignored)")
-    parser.add_argument("--opengl", metavar="VERSION", help="(ignored)")
-    options, unknown = parser.parse_known_args(list(args))
-    if unknown:
-        raise ViewerError(
-            f"unknown rviz2 option {unknown[0]!r}; see python -m mlaunch.standins.viewer --help"
-        )
-    return options
-
-
-def read_display_config(path: str | None) -> DisplayConfig:
-    """The fixed frame and topics of an .rviz file; a missing or broken file gives defaults + a
-    warning, as rviz2 starts with its default config then."""
-    if not path:
-        return DisplayConfig()
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        return DisplayConfig(warnings=(f"display config {path!r} not loaded: {exc.strerror}",))
-    import yaml  # only when there is a config to read
-
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        return DisplayConfig(warnings=(f"display config {path!r} is not valid YAML: {exc}",))
-    return config_from_data(data)
-
-
-def config_from_data(data: Any) -> DisplayConfig:
-    """Pick the viewer's settings out of a loaded .rviz document (missing parts keep defaults)."""
-    manager = data.get("Visualization Manager") if isinstance(data, dict) else None
-    if not isinstance(manager, dict):
-        return DisplayConfig(warnings=("display config has no 'Visualization Manager' section",))
-    found: dict[str, Any] = {}
-    options = manager.get("Global Options")
-    if isinstance(options, dict) and isinstance(options.get("Fixed Frame"), str):
-        found["fixed_frame"] = options["Fixed Frame"]
-    for display in _displays(manager.get("Displays")):
-        kind = str(display.get("Class", "")).rsplit("/", 1)[-1]
-        if kind == "LaserScan":
-            _take(found, "scan_topic", _topic(display.get("Topic")))
-        elif kind == "Odometry":
-            _take(found, "odom_topic", _topic(display.get("Topic")))
-        elif kind == "RobotModel":
-            _take(found, "description_topic", _topic(display.get("Description Topic")))
-    return replace(DisplayConfig(), **found)
-
-
-def _displays(items: Any) -> list[dict[str, Any]]:
-    """Enabled displays, flattened out of display groups."""
-    result: list[dict[str, Any]] = []
-    for item in items if isinstance(items, list) else []:
-        if not isinstance(item, dict) or item.get("Enabled", True) is False:
-            continue
-        result.append(item)
-        result.extend(_displays(item.get("Displays")))
-    return result
-
-
-def _topic(value: Any) -> str | None:
-    """A display's topic: ``Topic: /scan`` (old files) or ``Topic: {Value: /scan, ...}``."""
-    if isinstance(value, dict):
-        value = value.get("Value")
-    return value if isinstance(value, str) and value else None
-
-
-def _take(found: dict[str, Any], key: str, value: str | None) -> None:
-    if value is not None and key not in found:  # the first enabled display of a kind wins
-        found[key] = value
-
-
-def viewer_port(environ: dict[str, str]) -> int:
-    """The port to listen on from MLAUNCH_VIEWER_PORT; 0 (the default) means any free port."""
-    text = environ.get(PORT_ENV, "").strip() or "0"
-    try:
-        port = int(text)
-    except ValueError:
-        port = -1
-    if not 0 <= port <= 65535:
-        raise ViewerError(f"{PORT_ENV}={text!r} is not a port; use 0..65535 (0 = any free port)")
-    return port
+# compose, invert, yaw_of and config_from_data are re-exported: tests know them from here.
+__all__ = ["compose", "config_from_data", "invert", "yaw_of"]
 
 
 # ---------------------------------------------------------------- what the page shows
-
-
-def compose(a: Pose2D, b: Pose2D) -> Pose2D:
-    """Pose b (given in frame a) expressed in a's parent frame."""
-    ax, ay, ayaw = a
-    bx, by, byaw = b
-    c, s = math.cos(ayaw), math.sin(ayaw)
-    return (ax + c * bx - s * by, ay + s * bx + c * by, ayaw + byaw)
-
-
-def invert(a: Pose2D) -> Pose2D:
-    """The inverse 2D transform of a."""
-    x, y, yaw = a
-    c, s = math.cos(yaw), math.sin(yaw)
-    return (-(c * x + s * y), s * x - c * y, -yaw)
-
-
-def yaw_of(qx: float, qy: float, qz: float, qw: float) -> float:
-    """Heading of a quaternion (rotation about z), as rviz draws it top-down."""
-    return math.atan2(2.0 * (qw * qz + qx * qy), 1.0 - 2.0 * (qy * qy + qz * qz))
 
 
 @dataclass
@@ -212,6 +89,8 @@ class ViewerState:
     seq: int = 0
     warnings: dict[str, str] = field(default_factory=dict)
     stats: dict[str, TopicStats] = field(default_factory=dict)
+    tf: PlanarTf = field(default_factory=PlanarTf)
+    depth: DepthPicture = field(default_factory=DepthPicture)
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def __post_init__(self) -> None:
@@ -219,6 +98,8 @@ class ViewerState:
             ("description", self.config.description_topic),
             ("odom", self.config.odom_topic),
             ("scan", self.config.scan_topic),
+            ("tf", "/tf"),
+            *((("depth", self.config.depth_topic),) if self.config.depth_topic else ()),
         ):
             self.stats[key] = TopicStats(topic)
 
@@ -247,6 +128,30 @@ class ViewerState:
                 self.trail.append((round(x, 4), round(y, 4)))
             self._seen("odom", now)
 
+    def set_transforms(self, transforms: Sequence[tuple[str, str, Pose2D]], now: float) -> None:
+        """Transforms (parent, child, pose seen from above) from /tf or /tf_static."""
+        with self.lock:
+            for parent, child, pose in transforms:
+                self.tf.set(parent, child, pose)
+            self._seen("tf", now)
+
+    def set_depth(
+        self, width: int, height: int, encoding: str, data: Any, far: float, now: float
+    ) -> None:
+        """A depth image for the page's picture."""
+        with self.lock:
+            self.depth.set(width, height, encoding, data, far)
+            self._seen("depth", now)
+
+    def depth_png(self) -> bytes | None:
+        with self.lock:
+            return self.depth.png()
+
+    def _in_odom(self, frame: str) -> Pose2D | None:
+        """Where a frame is in the odometry (or fixed) frame by TF, when TF connects them."""
+        reference = self.odom_frame or self.config.fixed_frame
+        return self.tf.lookup(reference, frame) if frame else None
+
     def set_scan(
         self,
         frame: str,
@@ -259,7 +164,11 @@ class ViewerState:
         """A laser scan, turned into points in the odometry frame at the robot's current pose."""
         low, high = range_limits
         with self.lock:
-            laser = compose(self.pose or (0.0, 0.0, 0.0), self._laser_in_base(frame))
+            # TF places the laser where it is (any mount, any tree); without TF, the odometry
+            # pose and the URDF at zero joints do.
+            laser = self._in_odom(frame) or compose(
+                self.pose or (0.0, 0.0, 0.0), self._laser_in_base(frame)
+            )
             points = []
             for index, r in enumerate(ranges):
                 if not math.isfinite(r) or r < low or r > high:
@@ -323,9 +232,10 @@ class ViewerState:
             robot = None
             if self.robot is not None:
                 robot = {"name": self.robot.name, "root": self.robot.root, "shapes": self._shapes()}
-            pose = (
-                None if self.pose is None else dict(zip(("x", "y", "yaw"), self.pose, strict=True))
-            )
+            current = self.pose
+            if current is None and self.robot is not None:  # no odometry: TF may place it
+                current = self._in_odom(self.base_frame or self.robot.root)
+            pose = None if current is None else dict(zip(("x", "y", "yaw"), current, strict=True))
             return {
                 "seq": self.seq,
                 "fixed_frame": fixed,
@@ -339,6 +249,15 @@ class ViewerState:
                 "trail": [list(p) for p in self.trail],
                 "scan": {"frame": self.scan_frame, "points": [list(p) for p in self.scan_points]},
                 "topics": {key: stats.to_json(now) for key, stats in self.stats.items()},
+                "depth": None
+                if self.depth.grey is None
+                else {
+                    "seq": self.depth.seq,
+                    "topic": self.config.depth_topic,
+                    "size": list(self.depth.size),
+                    "encoding": self.depth.encoding,
+                },
+                "frames": self.tf.frames(),
                 "warnings": [*self.config.warnings, *self.warnings.values()],
             }
 
@@ -362,6 +281,8 @@ def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRe
             elif path == "/state.json":
                 body = json.dumps(state.snapshot(clock()), separators=(",", ":")).encode()
                 self._send(200, "application/json", body)
+            elif path == "/depth.png" and (png := state.depth_png()) is not None:
+                self._send(200, "image/png", png)
             else:
                 self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
 
@@ -461,6 +382,39 @@ def subscribe(node: Node, state: ViewerState) -> None:
     # Best effort hears both best-effort (simulated sensors) and reliable publishers.
     node.create_subscription(Odometry, config.odom_topic, on_odom, qos_profile_sensor_data)
     node.create_subscription(LaserScan, config.scan_topic, on_scan, qos_profile_sensor_data)
+    subscribe_tf_and_depth(node, state, latched, qos_profile_sensor_data)
+
+
+def subscribe_tf_and_depth(node: Node, state: ViewerState, latched: Any, sensor: Any) -> None:
+    """/tf and /tf_static where tf2_msgs is installed; the depth image when the config has one."""
+    from mlaunch.standins.transforms import have_tf2_msgs
+
+    if have_tf2_msgs():
+        from tf2_msgs.msg import TFMessage
+
+        def on_tf(msg: TFMessage) -> None:
+            state.set_transforms(
+                [
+                    (
+                        t.header.frame_id,
+                        t.child_frame_id,
+                        planar(t.transform.translation, t.transform.rotation),
+                    )
+                    for t in msg.transforms
+                ],
+                time.monotonic(),
+            )
+
+        node.create_subscription(TFMessage, "/tf", on_tf, 100)
+        node.create_subscription(TFMessage, "/tf_static", on_tf, latched)
+    if state.config.depth_topic:
+        from sensor_msgs.msg import Image
+
+        def on_depth(msg: Image) -> None:
+            state.set_depth(msg.width, msg.height, msg.encoding, msg.data, 0.0, time.monotonic())
+
+        # Depth 1: only the newest picture matters, an old one is never worth the copy.
+        node.create_subscription(Image, state.config.depth_topic, on_depth, sensor)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
