@@ -81,20 +81,21 @@ def from_matrix(parent: str, child: str, m: Sequence[Sequence[float]], stamp: An
     return transform(parent, child, (m[0][3], m[1][3], m[2][3]), quaternion_from_matrix(m), stamp)
 
 
+def _tf_publisher(node: Node, topic: str, depth: int, latched: bool) -> tuple[Any, Any]:
+    """(TFMessage, a reliable publisher on topic): transient local when latched."""
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+    from tf2_msgs.msg import TFMessage
+
+    durability = DurabilityPolicy.TRANSIENT_LOCAL if latched else DurabilityPolicy.VOLATILE
+    qos = QoSProfile(depth=depth, reliability=ReliabilityPolicy.RELIABLE, durability=durability)
+    return TFMessage, node.create_publisher(TFMessage, topic, qos)
+
+
 class Broadcaster:
     """Publishes on /tf as tf2_ros.TransformBroadcaster: reliable, volatile, depth 100."""
 
     def __init__(self, node: Node) -> None:
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-        from tf2_msgs.msg import TFMessage
-
-        qos = QoSProfile(
-            depth=100,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.VOLATILE,
-        )
-        self._message = TFMessage
-        self._publisher = node.create_publisher(TFMessage, "/tf", qos)
+        self._message, self._publisher = _tf_publisher(node, "/tf", 100, latched=False)
 
     def send(self, transforms: Iterable[Any]) -> None:
         self._publisher.publish(self._message(transforms=list(transforms)))
@@ -108,16 +109,7 @@ class StaticBroadcaster:
     """
 
     def __init__(self, node: Node) -> None:
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-        from tf2_msgs.msg import TFMessage
-
-        qos = QoSProfile(
-            depth=1,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        )
-        self._message = TFMessage
-        self._publisher = node.create_publisher(TFMessage, "/tf_static", qos)
+        self._message, self._publisher = _tf_publisher(node, "/tf_static", 1, latched=True)
         self._by_child: dict[str, Any] = {}
 
     def send(self, transforms: Iterable[Any]) -> None:
