@@ -380,3 +380,17 @@ def test_a_remote_node_is_found_there_and_gets_its_params_file(
     assert not params.startswith(str(tmp_path))  # a copy in the remote's own temp dir
     assert wait_until(lambda: not os.path.exists(os.path.dirname(params)), 10), params
     assert_nothing_left(token)
+
+
+def test_cwd_is_a_directory_of_the_remote(sshd: Server, tmp_path: Path, token: str) -> None:
+    # Not checked here (it is the remote's): only the remote's answer says whether it exists.
+    path = write_launch(
+        tmp_path,
+        token,
+        [remote("echo in $(pwd)", cwd="/proc"), remote("echo never", cwd="/no/such/dir")],
+    )
+    done = run_mlaunch(str(path), env=env_for(sshd, token))
+    out = done.stdout + done.stderr
+    assert "[sh-1] in /proc" in out, out
+    assert "failed to start 'sh' on this computer" in out, out
+    assert "exited with status 127" in out, out
