@@ -212,6 +212,17 @@ def test_tf_places_the_robot_without_odometry() -> None:
     assert snap["pose"] == {"x": 0.5, "y": -1.0, "yaw": 0.25}
 
 
+def test_a_page_is_open_while_it_polls() -> None:
+    """The depth feed runs only while a page polls: closed after PAGE_IDLE_S without a poll."""
+    from mlaunch.standins.viewer import PAGE_IDLE_S
+
+    state = ViewerState(DisplayConfig(depth_topic="/cam/depth/image_raw"))
+    assert not state.page_open(now=100.0)
+    state.note_poll(now=100.0)
+    assert state.page_open(now=100.0 + PAGE_IDLE_S - 0.1)
+    assert not state.page_open(now=100.0 + PAGE_IDLE_S + 0.1)
+
+
 def test_depth_image_becomes_a_small_grey_png() -> None:
     import struct
     import zlib

@@ -47,6 +47,7 @@ EXIT_OK = 0
 EXIT_FAILURE = 1
 TRAIL_MAX = 5000
 TRAIL_STEP = 0.02  # metres between trail points: enough for a smooth line, bounded memory
+PAGE_IDLE_S = 5.0  # a page that has not polled for this long is closed (the depth feed stops)
 
 Pose2D = tuple[float, float, float]  # x, y, yaw
 # compose, invert, yaw_of and config_from_data are re-exported: tests know them from here.
@@ -90,6 +91,7 @@ class ViewerState:
     warnings: dict[str, str] = field(default_factory=dict)
     stats: dict[str, TopicStats] = field(default_factory=dict)
     tf: PlanarTf = field(default_factory=PlanarTf)
+    last_poll: float = -math.inf
     depth: DepthPicture = field(default_factory=DepthPicture)
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -146,6 +148,16 @@ class ViewerState:
     def depth_png(self) -> bytes | None:
         with self.lock:
             return self.depth.png()
+
+    def note_poll(self, now: float) -> None:
+        """A page asked for the state: it is open."""
+        with self.lock:
+            self.last_poll = now
+
+    def page_open(self, now: float) -> bool:
+        """Whether a page polled in the last PAGE_IDLE_S seconds."""
+        with self.lock:
+            return now - self.last_poll < PAGE_IDLE_S
 
     def _in_odom(self, frame: str) -> Pose2D | None:
         """Where a frame is in the odometry (or fixed) frame by TF, when TF connects them."""
@@ -279,6 +291,7 @@ def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRe
             if path in ("/", "/index.html"):
                 self._send(200, "text/html; charset=utf-8", page)
             elif path == "/state.json":
+                state.note_poll(clock())
                 body = json.dumps(state.snapshot(clock()), separators=(",", ":")).encode()
                 self._send(200, "application/json", body)
             elif path == "/depth.png" and (png := state.depth_png()) is not None:
@@ -408,13 +421,42 @@ def subscribe_tf_and_depth(node: Node, state: ViewerState, latched: Any, sensor:
         node.create_subscription(TFMessage, "/tf", on_tf, 100)
         node.create_subscription(TFMessage, "/tf_static", on_tf, latched)
     if state.config.depth_topic:
+        from rclpy.clock import Clock, ClockType
+
+        feed = DepthFeed(node, state)
+        # Steady time: under use_sim_time a paused /clock must not keep a closed page's feed.
+        node.create_timer(0.5, feed.tick, clock=Clock(clock_type=ClockType.STEADY_TIME))
+
+
+class DepthFeed:
+    """The depth image subscription, held only while a page polls.
+
+    Each image costs the simulator a ray cast and this process a megabyte copy: with no page
+    open nobody would see them, so the subscription (and the camera's rendering, which only runs
+    for subscribers) stops until a page polls again.
+    """
+
+    def __init__(self, node: Node, state: ViewerState) -> None:
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+        self.node, self.state = node, state
+        # Depth 1: only the newest picture matters, an old one is never worth the copy.
+        self.qos = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
+        self.subscription: Any = None
+
+    def tick(self) -> None:
         from sensor_msgs.msg import Image
 
-        def on_depth(msg: Image) -> None:
-            state.set_depth(msg.width, msg.height, msg.encoding, msg.data, 0.0, time.monotonic())
+        wanted = self.state.page_open(time.monotonic())
+        if wanted and self.subscription is None:
+            topic = self.state.config.depth_topic
+            self.subscription = self.node.create_subscription(Image, topic, self.on_depth, self.qos)
+        elif not wanted and self.subscription is not None:
+            self.node.destroy_subscription(self.subscription)
+            self.subscription = None
 
-        # Depth 1: only the newest picture matters, an old one is never worth the copy.
-        node.create_subscription(Image, state.config.depth_topic, on_depth, sensor)
+    def on_depth(self, msg: Any) -> None:
+        self.state.set_depth(msg.width, msg.height, msg.encoding, msg.data, 0.0, time.monotonic())
 
 
 def main(argv: Sequence[str] | None = None) -> int:
