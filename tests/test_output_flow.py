@@ -25,6 +25,7 @@ import pytest
 from test_supervision import Harness, gone, make_spec, wait_until
 
 from mlaunch.run import guard as guards
+from mlaunch.run.events import Event, Output
 from mlaunch.run.output import Printer
 from mlaunch.run.plan import Plan, Spawn
 from mlaunch.run.screen import Screen
@@ -309,12 +310,13 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
     h = Harness([make_spec(f"s{i}", "", argv=up) for i in range(3)])
     ups: list[str] = []
 
-    def saw(label: str, stream: str, data: bytes) -> None:
-        ups.extend(label for line in data.splitlines() if line == b"up")
-        if len(ups) == 3:
-            h.shutdown()
+    def saw(event: Event) -> None:
+        if isinstance(event, Output):
+            ups.extend(event.process.label for line in event.data.splitlines() if line == b"up")
+            if len(ups) == 3:
+                h.shutdown()
 
-    h.printer.hooks.append(saw)
+    h.sup.events.subscribe(saw)
     during_run = count_during_run(h, calls)
     assert h.run() == 0
     assert not h.sup.strays.escaped, "a child of this process had exited before the run began"

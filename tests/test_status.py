@@ -204,7 +204,7 @@ def test_status_rows_show_state_usage_and_the_last_line_without_colours() -> Non
             view.usage = fake_usage({h.sup.records["talker"].pid: []})
             running.append(view.render())
 
-    h.sup.listeners.append(snapshot)
+    h.listen(snapshot)
     assert h.run() == 0
     row = next(line for line in running[0].splitlines() if line.startswith("talker"))
     pid = str(h.sup.records["talker"].pid)

@@ -20,10 +20,17 @@ from pathlib import Path
 import pytest
 
 from mlaunch.run import guard as guards
+from mlaunch.run.events import Event, Exited, Output, Started
 from mlaunch.run.logfiles import LogFile
 from mlaunch.run.output import Printer
 from mlaunch.run.plan import Plan, ProcessSpec, RespawnPolicy, Spawn
-from mlaunch.run.process import MAX_PARTIAL, core_dump_hint, expand_core_pattern, utf8_safe_cut
+from mlaunch.run.process import (
+    MAX_PARTIAL,
+    Process,
+    core_dump_hint,
+    expand_core_pattern,
+    utf8_safe_cut,
+)
 from mlaunch.run.records import FAILED, GAVE_UP
 from mlaunch.run.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.run.screen import Screen
@@ -95,7 +102,7 @@ class Harness:
         )
         self.lines: list[tuple[str, bytes]] = []
         self._triggers: list[tuple[bytes, Callable[[str, bytes], None]]] = []
-        self.printer.hooks.append(self._saw)
+        self.sup.events.subscribe(self._saw)
         self.elapsed = 0.0
         self.timed_out = False
 
@@ -103,8 +110,22 @@ class Harness:
         """Run ``action(label, line)`` in the loop the first time a child prints ``needle``."""
         self._triggers.append((needle, action))
 
-    def _saw(self, label: str, stream: str, data: bytes) -> None:
-        for line in data.splitlines():
+    def listen(self, listener: Callable[[str, Process], object]) -> None:
+        """Call ``listener("started" | "exited", process)`` from the supervisor's event stream."""
+
+        def on_event(event: Event) -> None:
+            if isinstance(event, Started):
+                listener("started", event.process)
+            elif isinstance(event, Exited):
+                listener("exited", event.process)
+
+        self.sup.events.subscribe(on_event)
+
+    def _saw(self, event: Event) -> None:
+        if not isinstance(event, Output):
+            return
+        label = event.process.label
+        for line in event.data.splitlines():
             self.lines.append((label, line))
             for trigger in list(self._triggers):
                 if trigger[0] in line:
@@ -361,9 +382,7 @@ def test_crash_loop_backs_off_and_gives_up(tmp_path: Path) -> None:
     )
     h = Harness(plan_from(path, tmp_path))
     starts: list[tuple[str, tuple[str, ...]]] = []
-    h.sup.listeners.append(
-        lambda what, p: starts.append((p.label, p.argv)) if what == "started" else None
-    )
+    h.listen(lambda what, p: starts.append((p.label, p.argv)) if what == "started" else None)
     assert h.run() == 0
     msgs = h.messages(h.label("crasher"))
     restarts = [m for m in msgs if ", restart " in m]
@@ -431,7 +450,7 @@ def test_respawn_delay_is_interrupted_by_shutdown() -> None:
         if what == "exited":
             h.sup.schedule(0.0, h.shutdown)
 
-    h.sup.listeners.append(on_exit)
+    h.listen(on_exit)
     assert h.run() == 0
     assert h.elapsed < 5
     assert "restart 1 in 30.0 s" in h.text
@@ -739,9 +758,7 @@ def test_held_process_is_signalled_only_when_released() -> None:
 
     h.when(b"up held", ready)
     h.when(b"up free", ready)
-    h.sup.listeners.append(
-        lambda what, p: order.append(f"{what} {p.label}") if what == "exited" else None
-    )
+    h.listen(lambda what, p: order.append(f"{what} {p.label}") if what == "exited" else None)
     h.run()
     # The free one was stopped at once; the held one only after its release.
     assert order.index("exited free-2") < order.index("release") < order.index("exited held-1"), (

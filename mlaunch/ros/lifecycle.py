@@ -40,7 +40,16 @@ from typing import TYPE_CHECKING, Any
 from mlaunch.errors import EXIT_FAILURE, LaunchFileError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
-from mlaunch.run.plan import AddHandler, Deferred, EmitEvent, ProcessSpec, StartTimer, Step
+from mlaunch.run.events import (
+    Event,
+    Exited,
+    LaunchEvent,
+    Said,
+    ShutdownBegun,
+    Started,
+    Transition,
+)
+from mlaunch.run.plan import AddHandler, EmitEvent, Note, ProcessSpec, StartTimer
 
 if TYPE_CHECKING:
     from mlaunch.ros.bridge import RosGraph, TransitionResult
@@ -169,8 +178,9 @@ class SharedGraph:
 
 
 @dataclass
-class SequenceStep(Step):
-    """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order."""
+class SequenceStep(Note):
+    """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order (a Note: the
+    lifecycle manager reads it from the plan)."""
 
     origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     nodes: tuple[str, ...] = ()
@@ -289,13 +299,17 @@ class Managed:
         return self.spec.required
 
 
-@dataclass
-class Outcome:
-    """A transition result, with why it was asked for (for reports and listeners)."""
+class Outcome(Event):
+    """A transition result, with why it was asked for: a record on the supervisor's stream."""
 
-    result: TransitionResult
-    reason: str  # autostart, sequence, respawn, event, shutdown
-    shutdown_on_failure: bool = False
+    __slots__ = ("reason", "result", "shutdown_on_failure")
+
+    def __init__(
+        self, result: TransitionResult, reason: str, shutdown_on_failure: bool = False
+    ) -> None:
+        self.result = result
+        self.reason = reason  # autostart, sequence, respawn, event, shutdown
+        self.shutdown_on_failure = shutdown_on_failure
 
 
 class LifecycleManager:
@@ -315,8 +329,6 @@ class LifecycleManager:
         self.sequences = list(sequences)
         self.nodes: dict[str, Managed] = {}
         self.outcomes: list[Outcome] = []
-        # Called in the loop thread with each Outcome (the smoke test listens here).
-        self.listeners: list[Callable[[Outcome], None]] = []
         self.activation_order: list[str] = []
         self.loop = LoopCall(supervisor.selector)
         self.graph = SharedGraph(_graph_environ(supervisor), f"_mlaunch_lifecycle_{os.getpid()}")
@@ -326,8 +338,7 @@ class LifecycleManager:
         self._in_sequence = {name for seq in self.sequences for name in seq.nodes}
         for spec in supervisor.plan.processes():
             self._track(spec)
-        supervisor.listeners.append(self._on_process)
-        self._hook_events()
+        supervisor.events.subscribe(self._on_event)
         self._check_sequences()
         if self.sequences:
             # First thing in the loop, after the plan's processes are started.
@@ -339,36 +350,15 @@ class LifecycleManager:
         for seq in self.sequences:
             for name in seq.nodes:
                 if name not in self.nodes:
-                    self.supervisor.printer.message(
+                    self._say(
                         "WARNING",
-                        SOURCE,
                         f"lifecycle sequence ({seq.origin}) names {name}, which no LifecycleNode"
                         f" of this launch has (they are: {', '.join(known) or 'none'});"
                         " waiting for it anyway",
                     )
 
-    @classmethod
-    def of(cls, supervisor: Supervisor) -> LifecycleManager | None:
-        """The manager attached to this supervisor, if any (it hooks ChangeState events)."""
-        for hook in supervisor.event_hooks.values():
-            owner = getattr(hook, "__self__", None)
-            if isinstance(owner, cls):
-                return owner
-        return None
-
-    def _hook_events(self) -> None:
-        from mlaunch.launch_ros.events import ChangeState
-
-        self.supervisor.event_hooks[ChangeState] = self._on_change_state
-        # Runs inside begin_shutdown, before it sends the first stop signal.
-        self.supervisor.handlers.append(
-            AddHandler(
-                origin="mlaunch.ros.lifecycle",
-                kind="shutdown",
-                body=Deferred([], _empty_context(), "mlaunch.ros.lifecycle", self._on_shutdown),
-                handler=self,
-            )
-        )
+    def _say(self, level: str, text: str) -> None:
+        self.supervisor.events.emit(Said(level, SOURCE, text))
 
     def _track(self, spec: ProcessSpec) -> Managed | None:
         info = spec.node
@@ -384,13 +374,28 @@ class LifecycleManager:
             self.nodes[fqn] = managed
         return managed
 
-    # --- process events (loop thread) ----------------------------------------------------------
+    # --- the supervisor's events (loop thread) -------------------------------------------------
 
-    def _on_process(self, what: str, process: Process) -> None:
+    def _on_event(self, event: Event) -> None:
+        """The subscription: processes starting and exiting, ChangeState, the shutdown."""
+        if isinstance(event, Started):
+            self._on_process(False, event.process)
+        elif isinstance(event, Exited):
+            self._on_process(True, event.process)
+        elif isinstance(event, ShutdownBegun):
+            self._on_shutdown()
+        elif isinstance(event, LaunchEvent):
+            from mlaunch.launch_ros.events import ChangeState
+
+            if isinstance(event.event, ChangeState):
+                event.taken = True
+                self._on_change_state(event.event)
+
+    def _on_process(self, exited: bool, process: Process) -> None:
         managed = self._track(process.spec)
         if managed is None:
             return
-        if what == "exited":
+        if exited:
             managed.process = None
             managed.generation += 1
             managed.state = "gone"
@@ -516,7 +521,7 @@ class LifecycleManager:
         return outcome
 
     def _post_note(self, level: str, text: str) -> None:
-        self.loop.call_soon(lambda: self.supervisor.printer.message(level, SOURCE, text))
+        self.loop.call_soon(lambda: self._say(level, text))
 
     # --- results (loop thread) ------------------------------------------------------------------
 
@@ -526,21 +531,19 @@ class LifecycleManager:
         managed = self.nodes.get(result.node)
         if managed is not None and result.state:
             managed.state = result.state
-        printer = self.supervisor.printer
         if result.ok:
-            printer.message("INFO", SOURCE, result.detail)
+            self._say("INFO", result.detail)
         elif self.supervisor.shutting_down and outcome.reason != "shutdown":
-            printer.message("INFO", SOURCE, f"{result.detail} (the launch is shutting down)")
+            self._say("INFO", f"{result.detail} (the launch is shutting down)")
         else:
             why = f" [{outcome.reason}]" if outcome.reason else ""
-            printer.message("ERROR", SOURCE, f"transition failed{why}: {result.detail}")
+            self._say("ERROR", f"transition failed{why}: {result.detail}")
             if outcome.shutdown_on_failure and outcome.reason != "shutdown":
                 self.supervisor.exit_code = max(self.supervisor.exit_code, EXIT_FAILURE)
                 self.supervisor.begin_shutdown(
                     f"lifecycle node {result.node}: {result.transition} failed"
                 )
-        for listener in self.listeners:
-            listener(outcome)
+        self.supervisor.events.emit(outcome)  # the smoke checks see each result
 
     def _up(self, fqn: str, generation: int) -> None:
         managed = self.nodes.get(fqn)
@@ -570,38 +573,22 @@ class LifecycleManager:
             start_state=event.start_state,
             goal_state=event.goal_state,
         )
-        self._dispatch(managed.spec, transition)
-
-    def _dispatch(self, spec: ProcessSpec, event: Any) -> None:
-        for handler in list(self.supervisor.handlers):
-            if handler.kind != "state_transition":
-                continue
-            matches = getattr(handler.handler, "matches", None)
-            if matches is not None:
-                if not matches(event):
-                    continue
-            elif handler.matcher is not None and not handler.matcher(spec):
-                continue
-            if handler.once and handler in self.supervisor.handlers:
-                self.supervisor.handlers.remove(handler)
-            if handler.body is not None:
-                self.supervisor.fire(handler.body, event)
+        # OnStateTransition handlers fire on it (mlaunch.run.handlers).
+        self.supervisor.events.emit(Transition(managed.spec, transition))
 
     def _on_change_state(self, event: Any) -> None:
         """``EmitEvent(event=ChangeState(...))``: the transition, for each matched running node."""
         label = TRANSITION_LABELS.get(event.transition_id)
-        printer = self.supervisor.printer
         if label is None:
-            printer.message(
+            self._say(
                 "WARNING",
-                SOURCE,
                 f"{event!r}: transition {event.transition_id} cannot be requested from a node;"
                 f" valid ids: {', '.join(f'{k} ({v})' for k, v in TRANSITION_LABELS.items())}",
             )
             return
         matched = [m for m in self.nodes.values() if m.process is not None and _matches(event, m)]
         if not matched:
-            printer.message("WARNING", SOURCE, f"{event!r} matched no running lifecycle node")
+            self._say("WARNING", f"{event!r} matched no running lifecycle node")
             return
         for managed in matched:
             self._spawn(self._change, managed, label)
@@ -620,8 +607,11 @@ class LifecycleManager:
 
     # --- shutdown ----------------------------------------------------------------------------
 
-    def _on_shutdown(self, event: Any, context: Any) -> list[Any]:
-        """Hold the active nodes' processes back from the stop ladder while they deactivate."""
+    def _on_shutdown(self) -> None:
+        """Hold the active nodes' processes back from the stop ladder while they deactivate.
+
+        On ShutdownBegun: the ladder starts at the StoppingAll that follows it.
+        """
         targets = [
             self.nodes[fqn]
             for fqn in reversed(self.activation_order)
@@ -629,7 +619,7 @@ class LifecycleManager:
         ]
         held = [m.process for m in targets if m.process is not None and m.process.running]
         if not held or not self.graph.started:
-            return []
+            return
         # They keep running until _release() hands them to the ladder.
         for process in held:
             self.supervisor.hold_stop(process)
@@ -638,7 +628,6 @@ class LifecycleManager:
         bound = self.deactivate_timeout * len(held) + 1.0
         self.supervisor.schedule(bound, self._release, cancel_on_shutdown=False)
         self._spawn(self._deactivate_all, [m.fqn for m in targets])
-        return []
 
     def _deactivate_all(self, names: list[str]) -> None:
         from mlaunch.ros.bridge import GraphNotRunning
@@ -678,12 +667,6 @@ def _matches(event: Any, managed: Managed) -> bool:
         except Exception:
             continue
     return False
-
-
-def _empty_context() -> Any:
-    from mlaunch.launch.launch_context import LaunchContext
-
-    return LaunchContext(environment={})
 
 
 def _graph_environ(supervisor: Supervisor) -> dict[str, str]:

@@ -1,14 +1,29 @@
 """The launch file's event handlers (RegisterEventHandler, on_exit, OnProcessIO) while it runs.
 
-The supervisor tells this module what happened to a process (started, output, exited) and that
-the launch is shutting down; matching handlers resolve their bodies then (with the same resolve
-code as the launch file) and the supervisor executes what they give.
+LaunchHandlers subscribes to the supervisor's EventStream: each record of a process starting,
+printing or exiting, of the launch shutting down, or of a managed node's transition becomes
+the launch event launch_ros's handlers expect (mlaunch.launch.events), and every matching
+handler fires. The events a launch file emits (EmitEvent: Shutdown, ShutdownProcess,
+SignalProcess) are acted on here too. A handler's body is resolved when it fires, with the
+same resolve code as the launch file (``Supervisor.fire``), and what it gives is carried out.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from mlaunch.launch import events as ev
 from mlaunch.launch.event_handlers import returned_entities
+from mlaunch.run.events import (
+    Event,
+    Exited,
+    LaunchEvent,
+    Output,
+    ShutdownBegun,
+    Started,
+    Transition,
+    Unclaimed,
+)
 from mlaunch.run.plan import AddHandler, Deferred
 from mlaunch.run.process import Process
 
@@ -31,6 +46,90 @@ class LaunchHandlers:
 
     def remove(self, handler: object) -> None:
         self.handlers[:] = [h for h in self.handlers if h.handler is not handler]
+
+    def __call__(self, event: Event) -> None:
+        """The subscription: the records launch has events for."""
+        if isinstance(event, Output):
+            if self.handlers:
+                self.output(event.process, event.stream, event.data)
+        elif isinstance(event, Started):
+            self._started(event.process)
+        elif isinstance(event, Exited):
+            self._exited(event.process, event.code)
+        elif isinstance(event, ShutdownBegun):
+            sigint = event.due_to_signal == 2  # SIGINT, without importing signal for it
+            self.dispatch("shutdown", None, ev.Shutdown(reason=event.reason, due_to_sigint=sigint))
+        elif isinstance(event, Transition):
+            self._transition(event)
+        elif isinstance(event, LaunchEvent):
+            self._launch_event(event)
+
+    def _launch_event(self, record: LaunchEvent) -> None:
+        """launch's own events: Shutdown, ShutdownProcess, SignalProcess.
+
+        Others are for later subscribers (lifecycle takes ChangeState); the Unclaimed that
+        follows is said by the printer if none did.
+        """
+        event, supervisor = record.event, self.supervisor
+        if isinstance(event, ev.Shutdown):
+            supervisor.begin_shutdown(event.reason)
+        elif isinstance(event, ev.ShutdownProcess):
+            for p in self._running(event.process_matcher):
+                supervisor.stop(p)
+        elif isinstance(event, ev.SignalProcess):
+            for p in self._running(event.process_matcher):
+                p.signal_group(int(event.signal_number))
+        else:
+            supervisor.events.emit(Unclaimed(record))
+            return
+        record.taken = True
+
+    def _running(self, matcher: Callable[[Any], bool] | None) -> list[Process]:
+        processes = self.supervisor.processes
+        return [p for p in processes if p.running and (matcher is None or matcher(p))]
+
+    def _started(self, process: Process) -> None:
+        spec = process.spec
+        event = ev.ProcessStarted(
+            action=spec.action,
+            name=spec.label,
+            cmd=list(spec.argv),
+            cwd=spec.cwd,
+            env=spec.env,
+            pid=process.pid,
+        )
+        self.dispatch("process_start", process, event)
+
+    def _exited(self, process: Process, code: int) -> None:
+        spec = process.spec
+        event = ev.ProcessExited(
+            action=spec.action,
+            name=spec.label,
+            cmd=list(spec.argv),
+            cwd=spec.cwd,
+            env=spec.env,
+            pid=process.pid,
+            returncode=code,
+        )
+        self.dispatch("process_exit", process, event)
+        if spec.on_exit is not None:
+            self.supervisor.fire(spec.on_exit, event)
+
+    def _transition(self, record: Transition) -> None:
+        """OnStateTransition handlers: their own matcher on the event, else on the node's spec."""
+        for handler in list(self.handlers):
+            if handler.kind != "state_transition":
+                continue
+            matches = getattr(handler.handler, "matches", None)
+            if matches is not None:
+                if not matches(record.event):
+                    continue
+            elif handler.matcher is not None and not handler.matcher(record.spec):
+                continue
+            if handler.once and handler in self.handlers:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, record.event)
 
     def dispatch(self, kind: str, process: Process | None, event: Any) -> None:
         """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec."""

@@ -16,8 +16,33 @@ import sys
 import time
 from collections.abc import Callable, Mapping
 
+from mlaunch.run.events import (
+    Escalated,
+    Event,
+    Exited,
+    FailedToStart,
+    GaveUp,
+    Interrupted,
+    NotStarted,
+    Output,
+    RespawnScheduled,
+    Said,
+    ShutdownBegun,
+    Started,
+    StartsSkipped,
+    StoppingAll,
+    StrayEnded,
+    Unclaimed,
+)
 from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile
+from mlaunch.run.process import describe_status, signal_name
 from mlaunch.run.screen import Screen
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.run.process import Process
 
 # Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
 # which mlaunch always writes so every process has its log).
@@ -53,7 +78,10 @@ def prefix_lines(prefix: bytes, data: bytes) -> bytes:
 
 
 class Printer:
-    """Owns the terminal and the log files of a run.
+    """Owns the terminal and the log files of a run, and every word mlaunch says about it.
+
+    A Printer is a subscriber of the supervisor's EventStream (``__call__``): each record
+    becomes its line (``_SAYS`` at the end of this module lists which).
 
     ``out`` receives every byte meant for the screen; None means the real terminal through a
     Screen (non-blocking, bounded), whose flow control the supervisor drives (``waiting_fd``,
@@ -90,7 +118,7 @@ class Printer:
         self._prefix: dict[str, bytes] = {}
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
-        self.hooks: list[Callable[[str, str, bytes], None]] = []
+        self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
         if self.log_dir:
             self._launch_log = self._open("launch.log", lazy=False)
 
@@ -202,8 +230,6 @@ class Printer:
                 prefix_lines(b"%.7f [%s] " % (self.clock(), label.encode()), data)
             )
             self._dirty.add(self._launch_log)
-        for hook in self.hooks:
-            hook(label, stream, data)
 
     def flush(self) -> None:
         """Push buffered lines to disk and screen (called when the supervisor is about to wait)."""
@@ -225,6 +251,147 @@ class Printer:
         if close is not None:
             close()
 
+    # --- the run's events, in words -------------------------------------------------------------
+
+    def __call__(self, event: Event) -> None:
+        """The printer's subscription to the supervisor's EventStream: each record in words."""
+        method = _SAYS.get(type(event))
+        if method is not None:
+            method(self, event)
+
+    def _output(self, event: Output) -> None:
+        process = event.process
+        self.output(process.label, event.stream, process.spec.output, event.data)
+
+    def _started(self, event: Started) -> None:
+        process = event.process
+        spec = process.spec
+        self.register(spec.label, process.index)
+        if spec.standin and process.restarts == 0:
+            self.message(
+                "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
+            )
+        self.message("INFO", spec.label, f"process started with pid [{process.pid}]")
+
+    def _failed_to_start(self, event: FailedToStart) -> None:
+        spec = event.process.spec
+        self.register(spec.label, event.process.index)
+        if spec.standin and event.process.restarts == 0:
+            self.message(
+                "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
+            )
+        self.message("ERROR", spec.label, f"failed to start {spec.argv[0]!r}: {event.reason}")
+
+    def _not_started(self, event: NotStarted) -> None:
+        self.message("WARNING", event.spec.label, "not started: the launch is shutting down")
+
+    def _starts_skipped(self, event: StartsSkipped) -> None:
+        self.message(
+            "WARNING",
+            "launch",
+            f"{event.count} processes not started: the launch is shutting down",
+        )
+
+    def _exited(self, event: Exited) -> None:
+        process, code = event.process, event.code
+        label, pid = process.label, process.pid
+        if not pid:
+            return  # never started: "failed to start" said it all
+        if code == 0:
+            self.message("INFO", label, f"process has finished cleanly [pid {pid}]")
+            return
+        if process.stopping and code < 0 and -code in process.signals_sent:
+            self.message("INFO", label, f"process stopped by {signal_name(-code)} [pid {pid}]")
+            return
+        what = describe_status(code)
+        if process.core_dumped:
+            what += " (core dumped)"
+        # ROS 2's format; a newline inside an argument (python -c code) is shown escaped so that
+        # the message stays one line.
+        cmd = " ".join(process.argv).replace("\n", "\\n")
+        self.message(
+            "ERROR", label, f"process has died [pid {pid}, exit code {code}, cmd '{cmd}']: {what}"
+        )
+        if code < 0 and not process.stopping:
+            hint = self._core_hint(process, -code)
+            if hint:
+                self.message("INFO", label, hint)
+
+    def _core_hint(self, process: Process, signal_number: int) -> str | None:
+        from mlaunch.run.process import core_dump_hint, core_limit, read_core_pattern
+
+        if self._core is None:
+            pattern, uses_pid = read_core_pattern()
+            self._core = (pattern, uses_pid, core_limit())
+        pattern, uses_pid, limit = self._core
+        spec = process.spec
+        return core_dump_hint(
+            pid=process.pid,
+            signal_number=signal_number,
+            dumped=process.core_dumped,
+            executable="/bin/sh" if spec.shell else spec.argv[0],
+            cwd=spec.cwd or os.getcwd(),
+            pattern=pattern,
+            uses_pid=uses_pid,
+            limit=limit,
+        )
+
+    def _escalated(self, event: Escalated) -> None:
+        process = event.process
+        self.message(
+            "WARNING",
+            process.label,
+            f"failed to terminate {event.waited:g} s after {signal_name(event.previous)},"
+            f" escalating to {signal_name(event.signal)} [pid {process.pid}]",
+        )
+
+    def _respawn(self, event: RespawnScheduled) -> None:
+        limit = "" if event.max_retries < 0 else f"/{event.max_retries}"
+        self.message(
+            "WARNING",
+            event.process.label,
+            f"{describe_status(event.code)}, restart {event.attempt}{limit}"
+            f" in {_seconds(event.delay)} s",
+        )
+
+    def _gave_up(self, event: GaveUp) -> None:
+        self.message(
+            "ERROR",
+            event.process.label,
+            f"giving up after {event.restarts} restarts ({describe_status(event.code)})",
+        )
+
+    def _stray(self, event: StrayEnded) -> None:
+        self.message(
+            "WARNING",
+            "launch",
+            f"ending stray descendant {event.name} [pid {event.pid}]"
+            f" with {signal_name(event.signal)}",
+        )
+
+    def _interrupted(self, event: Interrupted) -> None:
+        self.message(
+            "WARNING",
+            "launch",
+            f"user interrupted with {signal_name(event.signal)}; stopping (again to kill)",
+        )
+
+    def _stopping(self, event: StoppingAll) -> None:
+        if event.kill:
+            self.message("WARNING", "launch", "stopping now: SIGKILL to every process")
+
+    def _shutdown(self, event: ShutdownBegun) -> None:
+        if event.reason != "idle":
+            self.message("INFO", "launch", f"shutting down: {event.reason}")
+
+    def _unclaimed(self, event: Unclaimed) -> None:
+        if not event.launch_event.taken:
+            name = type(event.launch_event.event).__name__
+            self.message("WARNING", "launch", f"event {name} has no handler in mlaunch; ignored")
+
+    def _said(self, event: Said) -> None:
+        self.message(event.level, event.source, event.text)
+
 
 def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
     if environ.get("NO_COLOR"):
@@ -232,3 +399,28 @@ def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
     if environ.get("FORCE_COLOR") or environ.get("RCUTILS_COLORIZED_OUTPUT") == "1":
         return True
     return sys.stdout.isatty() and environ.get("TERM") != "dumb"
+
+
+def _seconds(value: float) -> str:
+    """``4.0``, ``0.5``, ``0.05``: one decimal unless that would round a short delay away."""
+    return f"{value:.2f}" if 0 < value < 0.1 else f"{value:.1f}"
+
+
+# Which words each record of the event stream becomes (records not listed are not said).
+_SAYS: dict[type, Callable[[Printer, Any], None]] = {
+    Output: Printer._output,
+    Started: Printer._started,
+    FailedToStart: Printer._failed_to_start,
+    NotStarted: Printer._not_started,
+    StartsSkipped: Printer._starts_skipped,
+    Exited: Printer._exited,
+    Escalated: Printer._escalated,
+    RespawnScheduled: Printer._respawn,
+    GaveUp: Printer._gave_up,
+    StrayEnded: Printer._stray,
+    Interrupted: Printer._interrupted,
+    StoppingAll: Printer._stopping,
+    ShutdownBegun: Printer._shutdown,
+    Unclaimed: Printer._unclaimed,
+    Said: Printer._said,
+}

@@ -320,6 +320,14 @@ class EmitEvent(Step):
         self.event = event
 
 
+class Note(Step):
+    """A step the supervisor carries nothing out for, read from the plan by what attaches to it.
+
+    A lifecycle sequence, a smoke-test expectation. Any other step kind the supervisor does not
+    know is an error, not skipped.
+    """
+
+
 class ArgumentInfo(Record):
     """A declared launch argument, for --show-args and CLI checks."""
 

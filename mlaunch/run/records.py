@@ -7,6 +7,7 @@ peak memory and CPU time (from wait4's rusage, so nothing is sampled), and how i
 from __future__ import annotations
 
 from mlaunch.run.plan import ProcessSpec
+from mlaunch.run.process import Process, describe_status, signal_name
 
 # ProcessRecord.state values.
 RUNNING = "running"
@@ -81,3 +82,37 @@ class ProcessRecord:
             f"ProcessRecord(label={self.label!r}, state={self.state!r}, pid={self.pid},"
             f" restarts={self.restarts}, outcome={self.outcome!r})"
         )
+
+    def failed_to_start(self, reason: str) -> None:
+        self.state, self.failed, self.returncode = FAILED, True, 127
+        self.outcome = f"failed to start: {reason}"
+
+    def ended(self, process: Process) -> None:
+        """Add up a reaped instance of this label: its status, run time, memory, CPU, signals."""
+        code = process.returncode if process.returncode is not None else 0
+        self.returncode = code
+        self.run_time += max(0.0, process.ended_at - process.started_at)
+        self.peak_rss = max(self.peak_rss, process.peak_rss)
+        self.cpu_time += process.cpu_time
+        self.signals.extend(process.signals_sent)
+        self.failed = False
+        if process.stopping:
+            self.outcome = _stopped_outcome(process, code)
+        elif code == 0:
+            self.outcome = "finished cleanly"
+        else:
+            self.failed = True
+            self.outcome = describe_status(code) + (" (core dumped)" if process.core_dumped else "")
+        self.state = FAILED if self.failed else FINISHED
+
+    def not_restarting(self) -> None:
+        """A pending restart was cancelled (the launch shuts down): it ended as it last did."""
+        self.state, self.restart_at = (FAILED if self.failed else FINISHED), None
+
+
+def _stopped_outcome(process: Process, code: int) -> str:
+    if code < 0 and -code in process.signals_sent:
+        return f"stopped by {signal_name(-code)}"
+    if code == 0:
+        return "stopped, exited cleanly"
+    return f"stopped, {describe_status(code)}"

@@ -23,6 +23,7 @@ import os
 import time
 from collections.abc import Callable, Iterable
 
+from mlaunch.run.events import Event, Output
 from mlaunch.run.records import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -170,7 +171,7 @@ class StatusView:
         self._closed = False
         self._psutil: dict[int, Any] = {}
         self.screen = self.printer.set_screen(self)
-        self.printer.hooks.append(self._saw_output)
+        supervisor.events.subscribe(self._saw_output)
         supervisor.schedule(0.0, self._tick, keeps_alive=False, cancel_on_shutdown=False)
 
     # --- the screen, as the Printer sees it ----------------------------------------------------
@@ -221,15 +222,17 @@ class StatusView:
         self._redraw = True
         self.flush()
         self.printer.set_screen(self.screen)
-        if self._saw_output in self.printer.hooks:
-            self.printer.hooks.remove(self._saw_output)
+        self.supervisor.events.unsubscribe(self._saw_output)
 
     # --- what it shows --------------------------------------------------------------------------
 
-    def _saw_output(self, label: str, stream: str, data: bytes) -> None:
+    def _saw_output(self, event: Event) -> None:
+        if not isinstance(event, Output):
+            return
+        data = event.data
         end = len(data) - 1  # data is complete lines: it ends with a newline
         start = data.rfind(b"\n", 0, end) + 1
-        self.last_line[label] = data[start : min(end, start + LAST_LINE)]
+        self.last_line[event.process.label] = data[start : min(end, start + LAST_LINE)]
 
     def _tick(self) -> None:
         if self._closed:

@@ -5,17 +5,23 @@ through ``signal.set_wakeup_fd``); the loop acts on them. Every child runs in it
 the stop ladder (SIGINT, then SIGTERM after sigterm_timeout, then SIGKILL after sigkill_timeout,
 each with SIGCONT so a stopped process wakes up to die) reaches its whole process group.
 
+The supervisor writes no words. It emits a record of everything that happens on its
+EventStream (mlaunch.run.events) and acts on policy: this module is where a process's exit
+becomes, in order, an ``Exited`` record (the printer turns it into the log line, the launch
+file's handlers fire on it, lifecycle driving and smoke checks see it), the required-process
+shutdown, and the respawn decision (``_exited``). Its own reaction to the stream is starting the
+stop ladder (``_react``); launch's own events (ShutdownProcess ...) are mlaunch.run.handlers'.
+
 Nothing is left behind: descendants that leave their group are found and ended at shutdown
 (mlaunch.run.strays); a guard process (mlaunch.run.guard, a constructor seam) ends the run if
 mlaunch itself is killed; if the loop itself fails, every group is killed before the error
 propagates.
 
 The children's pipes and the terminal share the loop's selector (mlaunch.run.pipes): a slow
-terminal holds the children's pipes unread instead of losing lines.
-
-The per-label ProcessRecord (mlaunch.run.records) is what the status view and the exit summary
-read. Signals are recorded by mlaunch.run.signals, timers are mlaunch.run.timers, the respawn
-policy is mlaunch.run.respawn, and the launch file's event handlers are mlaunch.run.handlers.
+terminal holds the children's pipes unread instead of losing lines. The per-label ProcessRecord
+(mlaunch.run.records) is what the status view and the exit summary read. Signals are recorded
+by mlaunch.run.signals, timers are mlaunch.run.timers, the respawn policy is
+mlaunch.run.respawn, and the launch file's event handlers are mlaunch.run.handlers.
 """
 
 from __future__ import annotations
@@ -28,8 +34,26 @@ import time
 from collections.abc import Callable
 
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, exit_for_signal
-from mlaunch.launch import events as ev
 from mlaunch.run import guard as guards
+from mlaunch.run.events import (
+    Escalated,
+    Event,
+    EventStream,
+    Exited,
+    FailedToStart,
+    GaveUp,
+    Interrupted,
+    LaunchEvent,
+    NotStarted,
+    Output,
+    RespawnScheduled,
+    Said,
+    ShutdownBegun,
+    Started,
+    StartsSkipped,
+    StoppingAll,
+    StrayEnded,
+)
 from mlaunch.run.handlers import LaunchHandlers
 from mlaunch.run.output import Printer
 from mlaunch.run.pipes import Pipes
@@ -38,6 +62,7 @@ from mlaunch.run.plan import (
     Deferred,
     EmitEvent,
     Log,
+    Note,
     Plan,
     ProcessSpec,
     RemoveHandler,
@@ -46,23 +71,8 @@ from mlaunch.run.plan import (
     StartTimer,
     Step,
 )
-from mlaunch.run.process import (
-    Process,
-    core_dump_hint,
-    core_limit,
-    describe_status,
-    read_core_pattern,
-    signal_name,
-)
-from mlaunch.run.records import (
-    FAILED,
-    FINISHED,
-    GAVE_UP,
-    RESTARTING,
-    RUNNING,
-    STOPPING,
-    ProcessRecord,
-)
+from mlaunch.run.process import Process, describe_status, signal_name
+from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
 from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve_deferred
 from mlaunch.run.respawn import GIVE_UP, NO_RESTART, next_restart
 from mlaunch.run.signals import SignalWatch
@@ -81,6 +91,10 @@ POLL = 0.05
 
 class Supervisor:
     """Runs a Plan. Seams (printer, clock, guard, run id) are constructor arguments.
+
+    The printer is subscribed to ``events`` first (after the supervisor's own reactions), then
+    the launch file's handlers; whatever else attaches to the run subscribes after them. The
+    printer is also the terminal whose flow control the loop drives.
 
     ``adopt``: become the subreaper and end every descendant at shutdown; an embedder with
     children of its own passes False (the run's processes are still found by their marker).
@@ -117,35 +131,39 @@ class Supervisor:
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
-        self.launch_handlers = LaunchHandlers(self)
-        self.handlers = self.launch_handlers.handlers
         self.records: dict[str, ProcessRecord] = {}
         self.timers = Timers(clock)
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
             self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
         )
+        self.pipes = Pipes(self.selector, printer, self._deliver)
+        self.launch_handlers = LaunchHandlers(self)
+        self.events = EventStream()
+        self.events.subscribe(self._react)
+        self.events.subscribe(printer)
+        self.events.subscribe(self.launch_handlers)
         self._index = itertools.count()
         self.shutting_down = False
         self._held: set[Process] = set()
         self.shutdown_reason = ""
         self.exit_code = EXIT_OK
         self._stop_presses = 0
+        self._skipped = 0  # starts a description asked for while shutting down
         self._kill_now = False
         self._marker_env = {guards.MARKER: self.run_id}
-        self._core: tuple[str, bool, int] | None = None
-        self.event_hooks: dict[type, Callable[[Any], None]] = {}
-        self.listeners: list[Callable[[str, Process], None]] = []
-        self.pipes = Pipes(self.selector, printer, self._deliver)
+
+    @property
+    def handlers(self) -> list[AddHandler]:
+        """The launch file's registered event handlers, newest first."""
+        return self.launch_handlers.handlers
 
     # --- the loop ------------------------------------------------------------------------------
 
     def run(self) -> int:
         self.signals.start(self.selector)
         try:
-            for warning in self.plan.warnings:
-                self.printer.message("WARNING", "launch", warning)
-            self.execute(self.plan.steps)
+            self.execute(self.plan.steps, self.plan.warnings)
             if self.guard is not None:
                 self.guard.flush()  # the first spawns' groups, in one write
             # After the first spawns, not before: ctypes costs milliseconds and the first child
@@ -211,11 +229,7 @@ class Supervisor:
         skip = self.guard.pid if self.guard is not None else None
         alive, sent = self.strays.sweep(self.by_pid, skip, now_kill=self._kill_now)
         for name, pid, sig in sent:
-            self.printer.message(
-                "WARNING",
-                "launch",
-                f"ending stray descendant {name} [pid {pid}] with {signal_name(sig)}",
-            )
+            self.events.emit(StrayEnded(name, pid, sig))
         return alive
 
     def _next_timeout(self) -> float | None:
@@ -242,38 +256,58 @@ class Supervisor:
 
     # --- plan steps ------------------------------------------------------------------------------
 
-    def execute(self, steps: list[Step]) -> None:
-        skipped = 0
-        for step in steps:
-            if self.signals.pending:
-                # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
-                # after the last one started. Exits wait for the loop, as in ROS 2.
-                self._handle_stop_signals()
-            if isinstance(step, Spawn) and step.spec is not None:
-                if self.shutting_down:
-                    skipped += 1  # said once below, not once per process
-                    continue
+    def execute(self, steps: list[Step], warnings: list[str] | tuple[str, ...] = ()) -> None:
+        """Carry out a visited description's steps.
+
+        What they cause is queued on the event stream until every step has been carried out,
+        as launch handles events only after the description was visited: a handler
+        registered after a process in the same description still sees it start.
+        """
+        self.events.hold()
+        try:
+            for warning in warnings:
+                self.events.say_now(Said("WARNING", "launch", warning))
+            for step in steps:
+                if self.signals.pending:
+                    # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
+                    # after the last one started. Exits wait for the loop, as in ROS 2.
+                    self._handle_stop_signals()
+                self._step(step)
+            if self._skipped:
+                self.events.emit(StartsSkipped(self._skipped))  # once, not once per process
+                self._skipped = 0
+        finally:
+            self.events.release()
+
+    def _step(self, step: Step) -> None:
+        if isinstance(step, Spawn):
+            if step.spec is not None and self.shutting_down:
+                self._skipped += 1
+            elif step.spec is not None:
                 self.start(step.spec)
-            elif isinstance(step, Log):
-                self.printer.message(step.level, step.source, step.message)
-            elif isinstance(step, StartTimer) and step.body is not None:
+        elif isinstance(step, Log):
+            # LogInfo is no event in launch: it is said as it is visited.
+            self.events.say_now(Said(step.level, step.source, step.message))
+        elif isinstance(step, StartTimer):
+            if step.body is not None:
                 body = step.body
                 self.schedule(
                     step.period,
                     lambda body=body: self.fire(body, None),  # type: ignore[misc]
                     cancel_on_shutdown=step.cancel_on_shutdown,
                 )
-            elif isinstance(step, AddHandler):
-                self.launch_handlers.add(step)
-            elif isinstance(step, RemoveHandler):
-                self.launch_handlers.remove(step.handler)
-            elif isinstance(step, RequestShutdown):
-                self.begin_shutdown(step.reason)
-            elif isinstance(step, EmitEvent):
-                self.emit(step.event)
-        if skipped:
-            self.printer.message(
-                "WARNING", "launch", f"{skipped} processes not started: the launch is shutting down"
+        elif isinstance(step, AddHandler):
+            self.launch_handlers.add(step)
+        elif isinstance(step, RemoveHandler):
+            self.launch_handlers.remove(step.handler)
+        elif isinstance(step, RequestShutdown):
+            self.begin_shutdown(step.reason)
+        elif isinstance(step, EmitEvent):
+            self.events.emit(LaunchEvent(step.event))
+        elif not isinstance(step, Note):
+            raise TypeError(
+                f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"
+                " whatever adds this kind of step must also handle it"
             )
 
     def fire(self, body: Deferred, event: Any) -> None:
@@ -283,71 +317,43 @@ class Supervisor:
         except MlaunchError as e:
             self.handler_failed(str(e))
             return
-        for warning in plan.warnings:
-            self.printer.message("WARNING", "launch", warning)
-        self.execute(plan.steps)
+        self.execute(plan.steps, plan.warnings)
 
     def handler_failed(self, message: str) -> None:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
-        self.printer.message("ERROR", "launch", message)
+        self.events.emit(Said("ERROR", "launch", message))
         self.exit_code = max(self.exit_code, EXIT_USAGE)
         self.begin_shutdown("an event handler failed")
 
-    def _dispatch(self, kind: str, process: Process | None, event: Any) -> None:
-        self.launch_handlers.dispatch(kind, process, event)
-
-    def emit(self, event: Any) -> None:
-        """Events a launch file emits: ShutdownProcess, SignalProcess, or a hook's (lifecycle)."""
-        if isinstance(event, ev.Shutdown):
-            self.begin_shutdown(event.reason)
-            return
-        if isinstance(event, ev.ShutdownProcess):
-            for p in self._matching(event.process_matcher):
-                self.stop(p)
-            return
-        if isinstance(event, ev.SignalProcess):
-            for p in self._matching(event.process_matcher):
-                p.signal_group(int(event.signal_number))
-            return
-        hook = self.event_hooks.get(type(event))
-        if hook is None:
-            self.printer.message(
-                "WARNING",
-                "launch",
-                f"event {type(event).__name__} has no handler in mlaunch; ignored",
-            )
-            return
-        hook(event)
-
-    def _matching(self, matcher: Callable[[Any], bool] | None) -> list[Process]:
-        return [p for p in self.processes if p.running and (matcher is None or matcher(p))]
+    def _react(self, event: Event) -> None:
+        """The supervisor's own subscription: the stop ladder begins at StoppingAll."""
+        if isinstance(event, StoppingAll) and not event.kill:
+            self._stop_all()
 
     # --- processes ---------------------------------------------------------------------------
 
     def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
         if self.shutting_down:
-            self.printer.message("WARNING", spec.label, "not started: the launch is shutting down")
+            self.events.emit(NotStarted(spec))
             return None
         process = self.spawner(spec, next(self._index), restarts)
-        self.printer.register(spec.label, process.index)
         record = self.records.get(spec.label)
         if record is None:
             record = self.records[spec.label] = ProcessRecord(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
-        if spec.standin and restarts == 0:
-            self.printer.message(
-                "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
-            )
         try:
             process.spawn(self.clock, self._marker_env)
         except OSError as e:
             reason = e.strerror or str(e)
-            self.printer.message("ERROR", spec.label, f"failed to start {spec.argv[0]!r}: {reason}")
             process.returncode = 127
             self.processes.append(process)
-            record.state, record.failed, record.returncode = FAILED, True, 127
-            record.outcome = f"failed to start: {reason}"
-            self._after_exit(process)
+            record.failed_to_start(reason)
+            self.events.hold()
+            try:
+                self.events.emit(FailedToStart(process, reason))
+                self._exited(process)
+            finally:
+                self.events.release()
             return process
         if self.guard is not None:
             self.guard.watch(process.pid, spec.sigkill_timeout)
@@ -355,27 +361,12 @@ class Supervisor:
         self.by_pid[process.pid] = process
         record.state, record.pid, record.started_at = RUNNING, process.pid, process.started_at
         self.pipes.watch(process)
-        self.printer.message("INFO", spec.label, f"process started with pid [{process.pid}]")
-        self._notify("started", process)
-        self._dispatch(
-            "process_start",
-            process,
-            ev.ProcessStarted(
-                action=spec.action,
-                name=spec.label,
-                cmd=list(spec.argv),
-                cwd=spec.cwd,
-                env=spec.env,
-                pid=process.pid,
-            ),
-        )
+        self.events.emit(Started(process))
         return process
 
     def _deliver(self, process: Process, stream: str, data: bytes) -> None:
-        """Complete lines of a child: to the printer, then to OnProcessIO handlers."""
-        self.printer.output(process.label, stream, process.spec.output, data)
-        if self.handlers:
-            self.launch_handlers.output(process, stream, data)
+        """Complete lines of a child, onto the stream (the printer, then OnProcessIO handlers)."""
+        self.events.emit(Output(process, stream, data))
 
     def _reap(self) -> None:
         while True:
@@ -389,102 +380,38 @@ class Supervisor:
             if process is None:
                 continue  # an orphaned grandchild we adopted as subreaper, or the guard
             process.reaped(status, self.clock, rusage)
-            # Its last words first: what is still in the pipes, then the partial last line.
-            self.pipes.drain(process)
-            if process.check_group():
-                self.lingering.append(process)
-            elif self.guard is not None:
-                self.guard.forget(process.pid)
-            self._record_exit(process)
-            self._after_exit(process)
+            # One record after another, handled once all are queued: its last words first
+            # (what is still in the pipes, then the partial last line), then its exit.
+            self.events.hold()
+            try:
+                self.pipes.drain(process)
+                if process.check_group():
+                    self.lingering.append(process)
+                elif self.guard is not None:
+                    self.guard.forget(process.pid)
+                self.records[process.label].ended(process)
+                self._exited(process)
+            finally:
+                self.events.release()
 
-    def _record_exit(self, process: Process) -> None:
-        record = self.records[process.label]
-        code = process.returncode if process.returncode is not None else 0
-        record.returncode = code
-        record.run_time += max(0.0, process.ended_at - process.started_at)
-        record.peak_rss = max(record.peak_rss, process.peak_rss)
-        record.cpu_time += process.cpu_time
-        record.signals.extend(process.signals_sent)
-        record.failed = False
-        if process.stopping:
-            record.outcome = _stopped_outcome(process, code)
-        elif code == 0:
-            record.outcome = "finished cleanly"
-        else:
-            record.failed = True
-            record.outcome = describe_status(code) + (
-                " (core dumped)" if process.core_dumped else ""
-            )
-        record.state = FAILED if record.failed else FINISHED
+    def _exited(self, process: Process) -> None:
+        """Where a process's exit becomes a log line, handler calls, a shutdown, a respawn.
 
-    def _after_exit(self, process: Process) -> None:
+        Called with the stream held, so every subscriber sees ``Exited`` before what follows
+        from it: the printer says it, the launch file's OnProcessExit and on_exit handlers
+        fire (mlaunch.run.handlers), lifecycle driving and smoke checks take note. A required
+        process decides the run first, so the shutdown names it (its on_exit=Shutdown() then
+        has nothing to do). Then the respawn policy (mlaunch.run.respawn) decides.
+        """
         spec = process.spec
         code = process.returncode if process.returncode is not None else 0
-        self._report_exit(process, code)
-        self._notify("exited", process)
+        self.events.emit(Exited(process, code))
         if spec.required and not process.stopping:
             # A required process decides the run: it ends it, and its failure is the run's.
-            # First, so the shutdown names it (its on_exit=Shutdown() then has nothing to do).
             if code != 0:
                 self.exit_code = max(self.exit_code, EXIT_FAILURE)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
-        event = ev.ProcessExited(
-            action=spec.action,
-            name=spec.label,
-            cmd=list(spec.argv),
-            cwd=spec.cwd,
-            env=spec.env,
-            pid=process.pid,
-            returncode=code,
-        )
-        self._dispatch("process_exit", process, event)
-        if spec.on_exit is not None:
-            self.fire(spec.on_exit, event)
         self._maybe_respawn(process, code)
-
-    def _report_exit(self, process: Process, code: int) -> None:
-        label, pid = process.label, process.pid
-        if not pid:
-            return  # never started: "failed to start" said it all
-        if code == 0:
-            self.printer.message("INFO", label, f"process has finished cleanly [pid {pid}]")
-            return
-        if process.stopping and code < 0 and -code in process.signals_sent:
-            self.printer.message(
-                "INFO", label, f"process stopped by {signal_name(-code)} [pid {pid}]"
-            )
-            return
-        what = describe_status(code)
-        if process.core_dumped:
-            what += " (core dumped)"
-        # ROS 2's format; a newline inside an argument (python -c code) is shown escaped so that
-        # the message stays one line.
-        cmd = " ".join(process.argv).replace("\n", "\\n")
-        self.printer.message(
-            "ERROR", label, f"process has died [pid {pid}, exit code {code}, cmd '{cmd}']: {what}"
-        )
-        if code < 0 and not process.stopping:
-            hint = self._core_hint(process, -code)
-            if hint:
-                self.printer.message("INFO", label, hint)
-
-    def _core_hint(self, process: Process, signal_number: int) -> str | None:
-        if self._core is None:
-            pattern, uses_pid = read_core_pattern()
-            self._core = (pattern, uses_pid, core_limit())
-        pattern, uses_pid, limit = self._core
-        spec = process.spec
-        return core_dump_hint(
-            pid=process.pid,
-            signal_number=signal_number,
-            dumped=process.core_dumped,
-            executable="/bin/sh" if spec.shell else spec.argv[0],
-            cwd=spec.cwd or os.getcwd(),
-            pattern=pattern,
-            uses_pid=uses_pid,
-            limit=limit,
-        )
 
     def _maybe_respawn(self, process: Process, code: int) -> None:
         if self.shutting_down or process.stopping:
@@ -498,19 +425,10 @@ class Supervisor:
         if delay == GIVE_UP:
             record.state = GAVE_UP
             record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
-            self.printer.message(
-                "ERROR",
-                process.label,
-                f"giving up after {record.restarts} restarts ({describe_status(code)})",
-            )
+            self.events.emit(GaveUp(process, code, record.restarts))
             return
         attempt = record.restarts + 1
-        limit = "" if policy.max_retries < 0 else f"/{policy.max_retries}"
-        self.printer.message(
-            "WARNING",
-            process.label,
-            f"{describe_status(code)}, restart {attempt}{limit} in {_seconds(delay)} s",
-        )
+        self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
         record.state, record.restart_at = RESTARTING, self.clock() + delay
         self.schedule(delay, lambda: self._respawn(process, attempt))
 
@@ -523,21 +441,23 @@ class Supervisor:
     # --- stopping ----------------------------------------------------------------------------
 
     def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None:
+        """Shut the launch down, in two phases on the stream.
+
+        ShutdownBegun: the printer says why, OnShutdown handlers run (and may ``hold_stop``
+        a process); then StoppingAll: every process not held gets its stop ladder.
+        """
         if self.shutting_down:
             return
         self.shutting_down = True
         self.shutdown_reason = reason
-        if reason != "idle":
-            self.printer.message("INFO", "launch", f"shutting down: {reason}")
         self.timers.shutting_down()  # pending respawns and TimerActions included
         for record in self.records.values():
             if record.state == RESTARTING:
-                record.state, record.restart_at = (FAILED if record.failed else FINISHED), None
-        self._dispatch(
-            "shutdown",
-            None,
-            ev.Shutdown(reason=reason, due_to_sigint=due_to_signal == signal.SIGINT),
-        )
+                record.not_restarting()
+        self.events.emit(ShutdownBegun(reason, due_to_signal))
+        self.events.emit(StoppingAll())
+
+    def _stop_all(self) -> None:
         for process in self.processes:
             if process.running and process not in self._held:
                 self.stop(process)
@@ -549,8 +469,8 @@ class Supervisor:
         """Keep ``process`` out of the stop ladder until ``release_stop`` (or a second Ctrl-C).
 
         For work that must happen while a process still runs at shutdown, such as deactivating
-        a lifecycle node before it is signalled. Call it from a shutdown handler: the ladder
-        starts for every process not held right after those handlers run.
+        a lifecycle node before it is signalled. Call it on ShutdownBegun: the ladder starts
+        for every process not held at the StoppingAll that follows it.
         """
         self._held.add(process)
 
@@ -574,13 +494,9 @@ class Supervisor:
         def escalate(sig: int, waited: float, next_step: Callable[[], None] | None) -> None:
             if not (process.running or process.check_group()):
                 return
-            self.printer.message(
-                "WARNING",
-                process.label,
-                f"failed to terminate {waited:g} s after {signal_name(process.signals_sent[-1])},"
-                f" escalating to {signal_name(sig)} [pid {process.pid}]",
-            )
+            previous = process.signals_sent[-1]
             process.signal_group(sig, wake=True)
+            self.events.emit(Escalated(process, sig, previous, waited))
             if next_step is not None:
                 next_step()
 
@@ -599,12 +515,12 @@ class Supervisor:
 
     def kill_everything(self) -> None:
         """A second Ctrl-C: SIGKILL every group and every stray at once."""
-        self.printer.message("WARNING", "launch", "stopping now: SIGKILL to every process")
         self._kill_now = True
         for process in self.processes + self.lingering:
             if process.running or process.check_group():
                 process.stopping = True
                 process.signal_group(signal.SIGKILL)
+        self.events.emit(StoppingAll(kill=True))
         self.begin_shutdown("killed")
 
     def _emergency_stop(self) -> None:
@@ -646,28 +562,7 @@ class Supervisor:
         self._stop_presses += 1
         if self._stop_presses == 1:
             self.exit_code = max(self.exit_code, exit_for_signal(sig))
-            self.printer.message(
-                "WARNING",
-                "launch",
-                f"user interrupted with {signal_name(sig)}; stopping (again to kill)",
-            )
+            self.events.emit(Interrupted(sig))
             self.begin_shutdown(f"{signal_name(sig)} received", due_to_signal=sig)
         else:
             self.kill_everything()
-
-    def _notify(self, what: str, process: Process) -> None:
-        for listener in self.listeners:
-            listener(what, process)
-
-
-def _seconds(value: float) -> str:
-    """``4.0``, ``0.5``, ``0.05``: one decimal unless that would round a short delay away."""
-    return f"{value:.2f}" if 0 < value < 0.1 else f"{value:.1f}"
-
-
-def _stopped_outcome(process: Process, code: int) -> str:
-    if code < 0 and -code in process.signals_sent:
-        return f"stopped by {signal_name(-code)}"
-    if code == 0:
-        return "stopped, exited cleanly"
-    return f"stopped, {describe_status(code)}"

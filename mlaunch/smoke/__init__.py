@@ -61,7 +61,8 @@ from typing import TYPE_CHECKING, Any
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, LaunchFileError, UsageError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import perform
-from mlaunch.run.plan import Step
+from mlaunch.run.events import Event, Exited, Output, Started
+from mlaunch.run.plan import Note
 
 if TYPE_CHECKING:
     from mlaunch.ros.lifecycle import LifecycleManager, Outcome, SharedGraph
@@ -216,8 +217,8 @@ def _rate(text: str, target: str, origin: str) -> float:
 
 
 @dataclass
-class ExpectStep(Step):
-    """Plan step of an Expect action (the supervisor passes over steps it does not know)."""
+class ExpectStep(Note):
+    """Plan step of an Expect action (a Note: the smoke run reads it from the plan)."""
 
     origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     expectation: Expectation | None = None
@@ -597,9 +598,9 @@ def supervise(
     def attach(_opts: Any, supervisor: Supervisor) -> SmokeRun:
         from mlaunch.ros.lifecycle import LifecycleManager
 
-        smoke = SmokeRun(
-            supervisor, expectations, settings, lifecycle=LifecycleManager.of(supervisor)
-        )
+        owners = (getattr(s, "__self__", None) for s in supervisor.events.subscribers)
+        lifecycle = next((o for o in owners if isinstance(o, LifecycleManager)), None)
+        smoke = SmokeRun(supervisor, expectations, settings, lifecycle=lifecycle)
         runs.append(smoke)
         return smoke
 
@@ -628,7 +629,7 @@ def supervise(
 class SmokeRun:
     """Attached to the supervisor: decides ready / failed, then shuts the launch down.
 
-    Process and output checks run in the supervisor's loop thread (listeners, printer hooks);
+    Process and output checks run in the supervisor's loop thread (its event stream);
     ROS graph checks run in one checker thread that hands its findings to the loop.
     """
 
@@ -659,10 +660,7 @@ class SmokeRun:
         )
         self._own_graph = lifecycle is None
         self._checker: threading.Thread | None = None
-        supervisor.printer.hooks.append(self._on_output)
-        supervisor.listeners.append(self._on_process)
-        if lifecycle is not None:
-            lifecycle.listeners.append(self._on_transition)
+        supervisor.events.subscribe(self._on_event)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
         if any(e.kind in GRAPH_KINDS for e in expectations):
             self._checker = threading.Thread(
@@ -675,7 +673,20 @@ class SmokeRun:
 
     # --- loop thread ---------------------------------------------------------------------------
 
-    def _on_output(self, label: str, stream: str, data: bytes) -> None:
+    def _on_event(self, event: Event) -> None:
+        """The subscription: output, starts and exits, and the lifecycle manager's results."""
+        from mlaunch.ros.lifecycle import Outcome
+
+        if isinstance(event, Output):
+            self._on_output(event.process.label, event.data)
+        elif isinstance(event, Started):
+            self._on_process(False, event.process)
+        elif isinstance(event, Exited):
+            self._on_process(True, event.process)
+        elif isinstance(event, Outcome):
+            self._on_transition(event)
+
+    def _on_output(self, label: str, data: bytes) -> None:
         lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
         ring = self.rings.get(label)
         if ring is None:
@@ -694,13 +705,13 @@ class SmokeRun:
                     break
         self._maybe_ready()
 
-    def _on_process(self, what: str, process: Process) -> None:
+    def _on_process(self, exited: bool, process: Process) -> None:
         label = process.label
         e = next((x for x in self.expectations if x.key() == ("process", label)), None)
         if e is None:
             e = Expectation("process", label, origin="started later", labels=[label])
             self.expectations.insert(len(self.expectations) - 1, e)
-        if what == "started":
+        if not exited:
             if e.status == "pending":
                 self._met(e, f"running (pid {process.pid})")
             return

@@ -1,0 +1,166 @@
+"""The engine's event stream: records handled in order, one at a time, after a description's visit.
+
+Pure tests of EventStream, then supervisor runs of real short-lived children whose order of
+records and lines is compared with what launch does (and, where the reference ros2 launch is
+built on this machine, with its own output).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from test_supervision import Harness, plan_from
+
+from mlaunch.run.events import (
+    Event,
+    EventStream,
+    Exited,
+    Output,
+    Said,
+    ShutdownBegun,
+    Started,
+    StoppingAll,
+)
+from mlaunch.run.plan import Plan, Step
+
+PY = sys.executable
+REFERENCE_ENV = Path.home() / ".cache" / "ros2-launch-jazzy" / "env.sh"
+
+
+def test_records_emitted_while_one_is_handled_wait_for_it_to_finish() -> None:
+    stream = EventStream()
+    seen: list[str] = []
+
+    def first(event: Event) -> None:
+        seen.append(f"first {event!r}")
+        if isinstance(event, Said) and event.text == "a":
+            stream.emit(Said("INFO", "t", "b"))  # queued: "a" reaches `second` before "b"
+
+    stream.subscribe(first)
+    stream.subscribe(lambda event: seen.append(f"second {event!r}"))
+    stream.emit(Said("INFO", "t", "a"))
+    assert [s.split("text=")[1] for s in seen] == ["'a')", "'a')", "'b')", "'b')"]
+    assert [s.split()[0] for s in seen] == ["first", "second", "first", "second"]
+    assert stream.pending == 0
+
+
+def test_a_held_stream_queues_until_released_but_say_now_is_said_at_once() -> None:
+    stream = EventStream()
+    seen: list[str] = []
+    stream.subscribe(lambda event: seen.append(getattr(event, "text", type(event).__name__)))
+    stream.hold()
+    stream.emit(Said("INFO", "t", "queued"))
+    stream.hold()  # holds nest: a handler's body visited inside a description's visit
+    stream.say_now(Said("INFO", "t", "now"))
+    stream.release()
+    assert seen == ["now"] and stream.pending == 1
+    stream.release()
+    assert seen == ["now", "queued"] and stream.pending == 0
+
+
+def test_a_subscriber_that_raises_leaves_the_stream_usable() -> None:
+    stream = EventStream()
+    seen: list[Event] = []
+
+    def fails(event: Event) -> None:
+        if isinstance(event, StoppingAll):
+            raise RuntimeError("boom")
+
+    stream.subscribe(fails)
+    stream.subscribe(seen.append)
+    with pytest.raises(RuntimeError, match="boom"):
+        stream.emit(StoppingAll())
+    stream.emit(ShutdownBegun("after"))
+    assert [type(e) for e in seen] == [ShutdownBegun]
+
+
+def test_the_supervisor_refuses_a_step_kind_it_does_not_know() -> None:
+    class Mystery(Step):
+        __slots__ = ()
+
+    h = Harness(Plan(steps=[Mystery(origin="x.launch.py:3")]))
+    with pytest.raises(TypeError, match=r"Mystery step \(x.launch.py:3\)"):
+        h.sup.run()
+
+
+LATE_HANDLERS = """
+    import sys
+    from launch import LaunchDescription
+    from launch.actions import ExecuteProcess, LogInfo, RegisterEventHandler
+    from launch.event_handlers import OnProcessExit, OnProcessStart
+
+
+    def generate_launch_description():
+        p = ExecuteProcess(
+            cmd=[sys.executable, '-c', 'print("hello")'], name='p', output='screen')
+        return LaunchDescription([
+            p,
+            LogInfo(msg='visited'),
+            RegisterEventHandler(
+                OnProcessStart(target_action=p, on_start=[LogInfo(msg='saw start')])),
+            RegisterEventHandler(
+                OnProcessExit(target_action=p, on_exit=[LogInfo(msg='saw exit')])),
+        ])
+"""
+# What ros2 launch prints for LATE_HANDLERS (launch 3.4.3), pids and paths aside.
+LATE_EXPECTED = [
+    "[INFO] [launch.user]: visited",
+    "[INFO] [p-1]: process started with pid [PID]",
+    "[INFO] [launch.user]: saw start",
+    "[p-1] hello",
+    "[INFO] [p-1]: process has finished cleanly [pid PID]",
+    "[INFO] [launch.user]: saw exit",
+]
+
+
+def _lines(text: str) -> list[str]:
+    """Lines of a launch's output without timestamps, pids and launch's own preamble."""
+    out = []
+    for line in text.splitlines():
+        line = re.sub(r"^\[\d+\.\d+\] ", "", line)
+        line = re.sub(r"pid \[\d+\]", "pid [PID]", line)
+        line = re.sub(r"pid \d+", "pid PID", line)
+        if "[launch]:" not in line:
+            out.append(line)
+    return out
+
+
+def test_a_handler_registered_after_its_target_sees_the_start(tmp_path: Path) -> None:
+    """launch starts processes after visiting the whole description (issue 12, item 1)."""
+    path = tmp_path / "late.launch.py"
+    path.write_text(textwrap.dedent(LATE_HANDLERS))
+    h = Harness(plan_from(path, tmp_path))
+    records: list[str] = []
+    h.sup.events.subscribe(
+        lambda e: (
+            records.append(type(e).__name__) if isinstance(e, (Started, Output, Exited)) else None
+        )
+    )
+    assert h.run() == 0
+    assert _lines(h.text) == LATE_EXPECTED
+    assert records == ["Started", "Output", "Exited"]
+
+
+@pytest.mark.skipif(
+    not REFERENCE_ENV.exists(), reason="the reference ros2 launch is not built on this machine"
+)
+def test_late_handlers_print_what_the_reference_ros2_launch_prints(tmp_path: Path) -> None:
+    path = tmp_path / "late.launch.py"
+    path.write_text(textwrap.dedent(LATE_HANDLERS))
+    env = {k: v for k, v in os.environ.items() if not k.startswith("MLAUNCH")}
+    env["ROS_LOG_DIR"] = str(tmp_path / "logs")
+    done = subprocess.run(
+        ["bash", "-c", f"source {REFERENCE_ENV} && ros2 launch {path}"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert _lines(done.stdout + done.stderr) == LATE_EXPECTED
