@@ -52,6 +52,7 @@ class Options:
         quiet: bool = False,
         color: bool | None = None,
         log_max_bytes: int | None = None,
+        log_keep: int | None = None,
     ) -> None:
         self.target = target
         self.second = second
@@ -69,6 +70,7 @@ class Options:
         self.quiet = quiet
         self.color = color
         self.log_max_bytes = log_max_bytes
+        self.log_keep = log_keep
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -182,12 +184,25 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
     parser.add_argument(
         "--log-max-bytes", type=int, default=None, help="rotate log files at this size"
     )
+    parser.add_argument(
+        "--log-keep",
+        default=None,
+        metavar="N|all",
+        help="rotated parts kept per log file (default 3; all: never drop a line)",
+    )
     return parser
 
 
 # Options that take a value: the token after them is theirs even if it contains ":=".
 VALUE_OPTIONS = frozenset(
-    {"--package-path", "--launch-prefix", "--launch-prefix-filter", "--color", "--log-max-bytes"}
+    {
+        "--package-path",
+        "--launch-prefix",
+        "--launch-prefix-filter",
+        "--color",
+        "--log-max-bytes",
+        "--log-keep",
+    }
 )
 
 
@@ -231,6 +246,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         quiet=ns.quiet,
         color={"auto": None, "always": True, "never": False}[ns.color],
         log_max_bytes=ns.log_max_bytes,
+        log_keep=_log_keep(ns.log_keep),
     )
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
@@ -252,6 +268,21 @@ def parse_options(argv: Sequence[str]) -> Options:
     if ns.show_all_subprocesses_output:
         os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
     return opts
+
+
+def _log_keep(value: str | None) -> int | None:
+    """--log-keep: a count of rotated parts, or ``all`` (logfiles.ALL)."""
+    if value is None:
+        return None
+    if value == "all":
+        return -1
+    if value.isdigit():
+        return int(value)
+    from mlaunch.errors import UsageError
+
+    raise UsageError(
+        f"--log-keep is {value!r}; valid: a number of rotated files (0 or more), or all"
+    )
 
 
 def find_launch_file(opts: Options) -> str:
@@ -402,7 +433,7 @@ def supervise(
     life: Lifeline,
 ) -> int:
     from mlaunch.errors import UsageError
-    from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
+    from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
     from mlaunch.run.output import Printer, stdout_is_color_terminal
     from mlaunch.run.supervisor import Supervisor
 
@@ -413,7 +444,14 @@ def supervise(
     guard, run_id = life.guard, life.run_id
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
-    printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet, rotate_bytes=rotate)
+    keep = getattr(opts, "log_keep", None)
+    printer = Printer(
+        color=color,
+        log_dir=log_dir,
+        quiet=opts.quiet,
+        rotate_bytes=rotate,
+        rotate_keep=DEFAULT_ROTATE_KEEP if keep is None else keep,
+    )
     printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
     spawner = _spawner(plan, labels, run_id)
     supervisor = Supervisor(

@@ -607,7 +607,12 @@ def test_log_files_rotate_at_the_size_limit(tmp_path: Path) -> None:
     kept = b"".join((tmp_path / n).read_bytes() for n in ["rot.log.2", "rot.log.1", "rot.log"])
     numbers = [int(line.split()[2]) for line in kept.splitlines()]
     assert numbers[-1] == 2999 and numbers == list(range(numbers[0], 3000))
-    assert (tmp_path / "launch.log.1").exists()  # launch.log rotates too
+    # launch.log never rotates (mlaunch's own messages are never dropped); past the limit it
+    # stops copying the process's lines, and says so once.
+    assert not (tmp_path / "launch.log.1").exists()
+    launch_log = (tmp_path / "launch.log").read_text()
+    assert launch_log.count("launch.log has reached 20000 bytes") == 1
+    assert "process has finished cleanly" in launch_log
 
 
 def test_a_log_file_that_cannot_be_written_is_reported_once_and_the_run_goes_on(

@@ -1,7 +1,10 @@
 """The run's log folder and its files: ``launch.log`` and one rotating file per process.
 
 Log files get every line (the screen may drop some for a stalled reader, never these). A file is
-opened on its first write, buffered, and rotated at a size limit.
+opened on its first write, buffered, and rotated at a size limit: ``name`` is the newest part,
+``name.1`` the one before, and so on; ``keep`` says how many rotated parts stay (``ALL``: every
+one, so nothing is ever dropped). What is kept is the user's choice (``--log-max-bytes``,
+``--log-keep``) and the README says exactly what it is.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ if TYPE_CHECKING:
 
 DEFAULT_ROTATE_BYTES = 64 * 1024 * 1024
 DEFAULT_ROTATE_KEEP = 3
+ALL = -1  # keep: every rotated part stays
 # Per log file: a hundred processes must not pin a hundred large buffers.
 LOG_BUFFER = 64 * 1024
 
@@ -43,6 +47,7 @@ class LogFile:
         self.on_error = on_error
         self.error: OSError | None = None
         self.size = 0
+        self.rotated = 0  # parts made by rotation so far (with keep=ALL, all still on disk)
         self._file: IO[bytes] | None = None
         if not lazy:
             self._open()
@@ -92,14 +97,17 @@ class LogFile:
     def rotate(self) -> None:
         if self._file is not None:
             self._file.close()
-        for i in range(self.keep - 1, 0, -1):
+        # The oldest kept part is overwritten (dropped) by the one before it; with ALL, none is.
+        last = self.rotated + 1 if self.keep == ALL else self.keep
+        for i in range(last - 1, 0, -1):
             older = f"{self.path}.{i}"
             if os.path.exists(older):
                 os.replace(older, f"{self.path}.{i + 1}")
-        if self.keep > 0:
+        if self.keep != 0:
             os.replace(self.path, f"{self.path}.1")
         else:
             os.unlink(self.path)
+        self.rotated += 1
         self._open()
         self.size = 0
 

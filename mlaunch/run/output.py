@@ -114,22 +114,25 @@ class Printer:
             self._screen = out if isinstance(out, Screen) else None
             self._write = out
         self._launch_log: LogFile | None = None
+        # launch.log stops copying process lines past rotate_bytes (they stay in <label>.log);
+        # mlaunch's own messages always go in, so launch.log never rotates and loses none.
+        self._launch_log_full = False
         self._own: dict[str, LogFile] = {}
         self._prefix: dict[str, bytes] = {}
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
         if self.log_dir:
-            self._launch_log = self._open("launch.log", lazy=False)
+            self._launch_log = self._open("launch.log", lazy=False, rotate=False)
 
     def __repr__(self) -> str:
         return f"Printer(log_dir={self.log_dir!r}, color={self.color}, quiet={self.quiet})"
 
-    def _open(self, name: str, *, lazy: bool = True) -> LogFile:
+    def _open(self, name: str, *, lazy: bool = True, rotate: bool = True) -> LogFile:
         assert self.log_dir is not None
         return LogFile(
             os.path.join(self.log_dir, name),
-            rotate_bytes=self.rotate_bytes,
+            rotate_bytes=self.rotate_bytes if rotate else 0,
             keep=self.rotate_keep,
             lazy=lazy,
             on_error=self._log_failed,
@@ -166,10 +169,11 @@ class Printer:
             return None
         return screen.fd
 
-    def holding(self) -> bool:
-        """The terminal is far behind: stop reading the children until it catches up."""
+    def holding(self, label: str | None = None) -> bool:
+        """The terminal is far behind (everyone's output, or ``label``'s own): stop reading the
+        children (that one) until it catches up."""
         screen = self._screen
-        return screen is not None and screen.holding()
+        return screen is not None and screen.holding(label)
 
     def flush_screen(self) -> None:
         """Hand the terminal what it takes now (its fd was reported writable)."""
@@ -220,16 +224,38 @@ class Printer:
         """Complete lines from a process (bytes ending in newline)."""
         data = clean(data)
         if stream in SCREEN_STREAMS.get(mode, ()) and not self.quiet:
-            self._write(prefix_lines(self._prefix[label], data))
+            if self._write is self._screen:
+                # Counted per process, for per-process flow control (Screen.holding).
+                self._screen.write(prefix_lines(self._prefix[label], data), source=label)
+            else:
+                self._write(prefix_lines(self._prefix[label], data))
         own = self._own.get(label)
         if own is not None:
             own.write(data)
             self._dirty.add(own)
         if self._launch_log is not None and mode in LAUNCH_LOG_MODES:
-            self._launch_log.write(
-                prefix_lines(b"%.7f [%s] " % (self.clock(), label.encode()), data)
+            self._copy_to_launch_log(label, data)
+
+    def _copy_to_launch_log(self, label: str, data: bytes) -> None:
+        """A process's lines into launch.log too, until it has ``rotate_bytes`` (then said once)."""
+        log = self._launch_log
+        assert log is not None
+        if self._launch_log_full:
+            return
+        lines = prefix_lines(b"%.7f [%s] " % (self.clock(), label.encode()), data)
+        room = self.rotate_bytes - log.size
+        if not self.rotate_bytes or len(lines) <= room:
+            log.write(lines)
+        else:
+            log.write(lines[: lines.rfind(b"\n", 0, max(0, room)) + 1])  # whole lines that fit
+            self._launch_log_full = True
+            note = (
+                f"[INFO] [launch]: launch.log has reached {self.rotate_bytes} bytes: from here on"
+                " it keeps mlaunch's own messages only; each process's lines stay in its"
+                " <label>.log\n"
             )
-            self._dirty.add(self._launch_log)
+            log.write(b"%.7f " % self.clock() + note.encode())
+        self._dirty.add(log)
 
     def flush(self) -> None:
         """Push buffered lines to disk and screen (called when the supervisor is about to wait)."""

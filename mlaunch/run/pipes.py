@@ -3,8 +3,11 @@
 While the terminal has a backlog, its fd is in the selector for writability, so the backlog is
 written as fast as the reader takes it; while the backlog is above its high-water mark
 (``Printer.holding()``), a child's pipe that becomes readable is taken out of the selector until
-the terminal catches up, so the children block on their own pipes instead of losing lines. A
-reader that has stalled (nothing taken for ~1 s) holds nobody: the Screen drops, and says so.
+the terminal catches up, so the children block on their own pipes instead of losing lines. The
+same holds per process: a child with more than its share queued (``Printer.holding(label)``,
+32 KiB) is not read until the terminal has taken most of it, while the others are still read,
+so one flooding child cannot stall every other child's lines. A reader that has stalled
+(nothing taken for ~1 s) holds nobody: the Screen drops, and says so.
 """
 
 from __future__ import annotations
@@ -63,7 +66,7 @@ class Pipes:
                     # A regular file or /dev/null (never blocks), a closed fd, or one already
                     # in the selector: flushed each turn instead.
                     self._out_unselectable.add(fd)
-        if self.paused and not self.printer.holding():
+        if self.paused:
             self._resume_reading()
         if fd is None:
             # A screen of another kind (a test's) with a backlog.
@@ -76,13 +79,18 @@ class Pipes:
 
     def _writable(self, fd: int) -> None:
         self.printer.flush_screen()
-        if self.paused and not self.printer.holding():
+        if self.paused:
             self._resume_reading()
 
     def _resume_reading(self) -> None:
-        """The terminal caught up (or stalled): read the held pipes again."""
-        paused, self.paused = self.paused, {}
-        for fd, process in paused.items():
+        """Read the held pipes again whose process the terminal no longer holds (it caught up
+        with everyone's output or with that process's, or it stalled)."""
+        if self.printer.holding():
+            return
+        for fd, process in list(self.paused.items()):
+            if self.printer.holding(process.label):
+                continue
+            del self.paused[fd]
             if fd in process.streams:
                 self._select(process, fd)
 
@@ -98,8 +106,9 @@ class Pipes:
         process.close_stream(fd)
 
     def _readable(self, process: Process, fd: int) -> None:
-        """A child's pipe has data: read it, unless the terminal is too far behind."""
-        if self.printer.holding():
+        """A child's pipe has data: read it, unless the terminal is too far behind with
+        everyone's output or with this process's own."""
+        if self.printer.holding(process.label):
             # Leave it in the pipe: the child blocks on a full pipe until the terminal catches
             # up. Out of the selector meanwhile, or every turn would find it ready again.
             if fd in process.streams:

@@ -29,6 +29,11 @@ LOW_WATER = 256 * 1024
 STALL = 1.0
 # Queued screen output is written once this much has gathered, else when the loop goes idle.
 SCREEN_CHUNK = 256 * 1024
+# Per process: above SOURCE_HIGH_WATER queued bytes of its own, that one process is not read
+# until it is below SOURCE_LOW_WATER. A flooding child waits for the reader; the others are
+# still read, and their lines queue behind at most this much of the flood (head-of-line).
+SOURCE_HIGH_WATER = 32 * 1024
+SOURCE_LOW_WATER = 8 * 1024
 
 
 class Screen:
@@ -39,6 +44,13 @@ class Screen:
     the fd is writable (``waiting``/``fd``) and stops reading its children while ``holding()``:
     from ``high_water`` queued bytes until the queue is below ``low_water``. So a slow reader
     (a slow ssh link, ``| less``) slows the children down and loses nothing.
+
+    Flow control is per process too: output written with a ``source`` (the process's label) is
+    counted per source, and ``holding(source)`` holds a process with ``source_high_water`` bytes
+    queued until it is down to ``source_low_water``. One flooding child is then throttled to
+    the reader's pace while the quiet ones are still read, their lines behind at most that much
+    of the flood instead of the whole backlog. The queue stays one FIFO, so every line keeps
+    its place relative to mlaunch's messages about its process.
 
     A reader that makes no progress at all for ``stall`` seconds (a terminal paused with
     Ctrl-S, a pipe nobody reads) holds nobody any longer: the queue grows to ``limit`` bytes and
@@ -55,6 +67,8 @@ class Screen:
         stall: float = STALL,
         high_water: int = HIGH_WATER,
         low_water: int = LOW_WATER,
+        source_high_water: int = SOURCE_HIGH_WATER,
+        source_low_water: int = SOURCE_LOW_WATER,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.fd = fd
@@ -63,6 +77,8 @@ class Screen:
         # A small limit (a test's) scales the marks down, so that holding starts before dropping.
         self.high_water = min(high_water, max(1, limit // 2))
         self.low_water = min(low_water, self.high_water // 4)
+        self.source_high_water = min(source_high_water, max(1, self.high_water // 4))
+        self.source_low_water = min(source_low_water, self.source_high_water // 4)
         self.clock = clock
         # Totals over the run; the notices say what was dropped since the previous notice.
         self.dropped_lines = 0
@@ -75,6 +91,10 @@ class Screen:
         self._offset = 0  # bytes of the queue's head already written
         self._size = 0
         self._held = False
+        # Per source: bytes queued, and who wrote the queue's bytes, in order ((source, bytes)).
+        self._by_source: dict[str, int] = {}
+        self._owners: deque[tuple[str | None, int]] = deque()
+        self._held_sources: set[str] = set()
         self._progress_at = 0.0  # the last write the reader took, or when output began waiting
         try:
             self._regular = stat.S_ISREG(os.fstat(fd).st_mode)
@@ -89,8 +109,9 @@ class Screen:
         """Bytes queued for the terminal."""
         return self._size
 
-    def write(self, data: bytes, *, urgent: bool = False) -> None:
-        """Queue ``data``; beyond the limit it is dropped (counted) unless ``urgent``."""
+    def write(self, data: bytes, *, urgent: bool = False, source: str | None = None) -> None:
+        """Queue ``data`` (from process ``source``, if given); beyond the limit it is dropped
+        (counted) unless ``urgent``."""
         if self.gone:
             return
         if self._size + len(data) > self.limit and not urgent:
@@ -102,15 +123,44 @@ class Screen:
         if self.dropped_bytes != self._noted_bytes and not urgent:
             # Room again after a gap: say so right where the lines are missing.
             self._append(self._drop_notice())
-        self._append(data)
+        self._append(data, source)
         if self._size >= SCREEN_CHUNK:
             self.flush()
 
-    def _append(self, data: bytes) -> None:
+    def _append(self, data: bytes, source: str | None = None) -> None:
         self._queue.append(data)
         self._size += len(data)
         if self._size > self.peak:
             self.peak = self._size
+        owners = self._owners
+        if owners and owners[-1][0] == source:
+            owners[-1] = (source, owners[-1][1] + len(data))
+        else:
+            owners.append((source, len(data)))
+        if source is not None:
+            self._by_source[source] = self._by_source.get(source, 0) + len(data)
+
+    def _taken(self, n: int) -> None:
+        """The reader took the queue's first ``n`` bytes: count them off their sources."""
+        owners, by_source = self._owners, self._by_source
+        while n and owners:
+            source, size = owners[0]
+            take = min(n, size)
+            n -= take
+            if source is not None:
+                left = by_source[source] - take
+                if left:
+                    by_source[source] = left
+                else:
+                    del by_source[source]
+            if take < size:
+                owners[0] = (source, size - take)
+            else:
+                owners.popleft()
+
+    def queued(self, source: str) -> int:
+        """Bytes of ``source`` waiting for the terminal."""
+        return self._by_source.get(source, 0)
 
     def urgent(self, data: bytes) -> None:
         """mlaunch's own messages (an exit, an escalation) are few and small: never dropped."""
@@ -127,19 +177,32 @@ class Screen:
         """Output waits and the reader has taken nothing for ``stall`` seconds."""
         return self.blocked and self.clock() - self._progress_at >= self.stall
 
-    def holding(self) -> bool:
-        """Whether the producers should wait for the reader (the supervisor asks before reads).
+    def holding(self, source: str | None = None) -> bool:
+        """Whether the producers (or process ``source``) should wait for the reader.
 
-        From ``high_water`` queued bytes until below ``low_water``, unless the reader stalled.
+        Everyone from ``high_water`` queued bytes until below ``low_water``; one source from
+        ``source_high_water`` of its own until below ``source_low_water``. Nobody once the
+        reader has stalled.
         """
         if self._held:
             if self._size < self.low_water or self.gone:
                 self._held = False
+            else:
+                return not self.stalled()
+        elif self._size >= self.high_water and not self.gone:
+            self._held = True
+            return not self.stalled()
+        if source is None or self.gone:
+            return False
+        queued = self._by_source.get(source, 0)
+        if source in self._held_sources:
+            if queued < self.source_low_water:
+                self._held_sources.discard(source)
                 return False
-        elif self._size < self.high_water or self.gone:
+        elif queued < self.source_high_water:
             return False
         else:
-            self._held = True
+            self._held_sources.add(source)
         return not self.stalled()
 
     def flush(self) -> None:
@@ -183,10 +246,13 @@ class Screen:
             except OSError:
                 self.gone = True
                 queue.clear()
+                self._owners.clear()
+                self._by_source.clear()
                 self._size = self._offset = 0
                 return
             if n > 0:
                 self._progress_at = self.clock()
+                self._taken(n)
             self._size -= n
             self._offset += n
             if self._offset < len(head):
