@@ -35,8 +35,7 @@ ROOTS: dict[str, str] = {
 SYNONYMS: dict[str, str] = {
     "launch.action": "mlaunch.launch.launch_description",
     "launch.launch_description_entity": "mlaunch.launch.launch_description",
-    "launch.substitution": "mlaunch.launch.substitutions",
-    "launch.some_substitutions_type": "mlaunch.launch.substitutions",
+    "launch.some_substitutions_type": "mlaunch.launch.substitution",
     "launch.condition": "mlaunch.launch.conditions",
     "launch.event_handler": "mlaunch.launch.event_handlers",
     "launch.event": "mlaunch.launch.events",

@@ -1,7 +1,9 @@
 """Substitutions: lazily evaluated pieces of text, with the names and semantics of ROS 2 launch.
 
 A substitution is data until ``perform(context)`` is called while resolving; ``describe()`` shows
-it unresolved (``--print`` of deferred actions, ``--show-args`` defaults).
+it unresolved (``--print`` of deferred actions, ``--show-args`` defaults). The base class and
+helpers are mlaunch.launch.substitution's, the boolean substitutions
+mlaunch.launch.boolean_substitutions'; every name is served from here too, as ROS 2 does.
 """
 
 from __future__ import annotations
@@ -9,107 +11,41 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable
 
-from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
-
-# pathlib is not imported: it costs milliseconds at start-up, and os.PathLike covers Path.
-Path = os.PathLike
+from mlaunch.errors import SubstitutionFailure
+from mlaunch.launch.boolean_substitutions import (
+    AllSubstitution,
+    AndSubstitution,
+    AnySubstitution,
+    EqualsSubstitution,
+    IfElseSubstitution,
+    NotEqualsSubstitution,
+    NotSubstitution,
+    OrSubstitution,
+    evaluate_condition_expression,
+    to_bool,
+)
+from mlaunch.launch.substitution import (
+    Path,
+    SomeSubstitutionsType,
+    SomeSubstitutionsType_types_tuple,
+    Subs,
+    Substitution,
+    TextSubstitution,
+    describe,
+    is_substitution_like,
+    normalize,
+    perform,
+    perform_substitutions,
+)
 
 # typing (~4 ms) and subprocess (~3 ms, with selectors and threading) are not imported at start-up:
 # annotations are strings, and only Command() runs a program. mypy treats this name as
 # typing.TYPE_CHECKING.
 TYPE_CHECKING = False
 if TYPE_CHECKING:
-    from collections.abc import Sequence
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-
-
-class Substitution:
-    """Base class: something that becomes a string when the launch is resolved."""
-
-    def perform(self, context: LaunchContext) -> str:
-        raise NotImplementedError
-
-    def describe(self) -> str:
-        return type(self).__name__ + "(...)"
-
-    def __repr__(self) -> str:
-        return self.describe()
-
-
-# What ROS 2's launch files annotate arguments with; a union of classes, no typing needed.
-SomeSubstitutionsType = str | Path | Substitution | Iterable[str | Path | Substitution]
-SomeSubstitutionsType_types_tuple = (str, Path, Substitution)
-Subs = tuple[Substitution, ...]
-
-
-def normalize(value: Any) -> Subs:
-    """Turn a str, Path, Substitution or iterable of those into a tuple of substitutions.
-
-    Lists concatenate when performed, as in ROS 2 (``['a', LaunchConfiguration('b')]`` is one
-    string).
-    """
-    if isinstance(value, Substitution):
-        return (value,)
-    if isinstance(value, str):
-        return (TextSubstitution(text=value),)
-    if isinstance(value, os.PathLike):
-        return (TextSubstitution(text=os.fspath(value)),)
-    if isinstance(value, (int, float, bool)):
-        return (TextSubstitution(text=str(value)),)
-    if isinstance(value, Iterable):
-        out: list[Substitution] = []
-        for item in value:
-            out.extend(normalize(item))
-        return tuple(out)
-    raise TypeError(
-        f"expected a str, a Substitution or a list of them, got {type(value).__name__}: {value!r}"
-    )
-
-
-def is_substitution_like(value: Any) -> bool:
-    if isinstance(value, (str, Path, Substitution)):
-        return True
-    return isinstance(value, (list, tuple)) and all(
-        isinstance(v, (str, Path, Substitution)) for v in value
-    )
-
-
-def perform_substitutions(context: LaunchContext, subs: Sequence[Substitution]) -> str:
-    """Perform each substitution and concatenate the results."""
-    if len(subs) == 1:
-        return subs[0].perform(context)
-    return "".join(s.perform(context) for s in subs)
-
-
-def perform(context: LaunchContext, value: Any) -> str:
-    """Perform any SomeSubstitutionsType value (str, Substitution, list) to a string."""
-    if isinstance(value, str):
-        return value
-    return perform_substitutions(context, normalize(value))
-
-
-def describe(value: Any) -> str:
-    """Describe an unresolved value: text in quotes, substitutions by their describe()."""
-    subs = normalize(value)
-    return " + ".join(s.describe() for s in subs) if subs else "''"
-
-
-# --- text and configuration -----------------------------------------------------------------
-
-
-class TextSubstitution(Substitution):
-    """Literal text."""
-
-    def __init__(self, *, text: str) -> None:
-        self.text = str(text)
-
-    def perform(self, context: LaunchContext) -> str:
-        return self.text
-
-    def describe(self) -> str:
-        return repr(self.text)
 
 
 class LaunchConfiguration(Substitution):
@@ -449,168 +385,6 @@ class PythonExpression(Substitution):
         return f"PythonExpr({describe(self.expression)})"
 
 
-# --- booleans --------------------------------------------------------------------------------
-
-_TRUE_WORDS = frozenset({"true", "yes", "on", "1", "y"})
-_FALSE_WORDS = frozenset({"false", "no", "off", "0", "n"})
-
-
-def to_bool(text: str, what: str) -> bool:
-    """YAML-style boolean, as the boolean substitutions accept (true/yes/on/1 ...)."""
-    lowered = text.strip().lower()
-    if lowered in _TRUE_WORDS:
-        return True
-    if lowered in _FALSE_WORDS:
-        return False
-    raise SubstitutionFailure(f"{what} got {text!r}, which is not a boolean (true/false/1/0)")
-
-
-def evaluate_condition_expression(text: str) -> bool:
-    """The strict rule of IfCondition/UnlessCondition: only true, false, 1 and 0."""
-    lowered = text.strip().lower()
-    if lowered in ("true", "1"):
-        return True
-    if lowered in ("false", "0"):
-        return False
-    raise InvalidConditionExpressionError(
-        f"condition expression is {text!r}; valid values are true, false, 1, 0"
-    )
-
-
-def _bool_text(value: bool) -> str:
-    return "true" if value else "false"
-
-
-class NotSubstitution(Substitution):
-    def __init__(self, value: SomeSubstitutionsType) -> None:
-        self.value = normalize(value)
-
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(not to_bool(perform_substitutions(context, self.value), "not"))
-
-    def describe(self) -> str:
-        return f"Not({describe(self.value)})"
-
-
-class _Many(Substitution):
-    name = ""
-
-    def __init__(self, *args: SomeSubstitutionsType) -> None:
-        self.args = tuple(normalize(a) for a in args)
-
-    def _values(self, context: LaunchContext) -> list[bool]:
-        return [to_bool(perform_substitutions(context, a), self.name) for a in self.args]
-
-    def describe(self) -> str:
-        return f"{type(self).__name__}(" + ", ".join(describe(a) for a in self.args) + ")"
-
-
-class AndSubstitution(_Many):
-    name = "and"
-
-    def __init__(self, left: SomeSubstitutionsType, right: SomeSubstitutionsType) -> None:
-        super().__init__(left, right)
-
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(all(self._values(context)))
-
-
-class OrSubstitution(_Many):
-    name = "or"
-
-    def __init__(self, left: SomeSubstitutionsType, right: SomeSubstitutionsType) -> None:
-        super().__init__(left, right)
-
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(any(self._values(context)))
-
-
-class AnySubstitution(_Many):
-    name = "any"
-
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(any(self._values(context)))
-
-
-class AllSubstitution(_Many):
-    name = "all"
-
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(all(self._values(context)))
-
-
-def _equal(left: str, right: str) -> bool:
-    """Bool-aware, then float-aware, else textual comparison (EqualsSubstitution's rule)."""
-    bools = {"true": True, "false": False}
-    lb, rb = bools.get(left.strip().lower()), bools.get(right.strip().lower())
-    if lb is not None or rb is not None:
-        if lb is None and left.strip() in ("0", "1"):
-            lb = left.strip() == "1"
-        if rb is None and right.strip() in ("0", "1"):
-            rb = right.strip() == "1"
-        if lb is not None and rb is not None:
-            return lb == rb
-    import math
-
-    try:
-        return math.isclose(float(left), float(right))
-    except ValueError:
-        return left == right
-
-
-def _equals_operand(value: Any) -> Subs:
-    if value is None:
-        return (TextSubstitution(text=""),)
-    if isinstance(value, bool):
-        return (TextSubstitution(text=_bool_text(value)),)
-    return normalize(value)
-
-
-class EqualsSubstitution(Substitution):
-    def __init__(self, left: Any, right: Any) -> None:
-        self.left = _equals_operand(left)
-        self.right = _equals_operand(right)
-
-    def perform(self, context: LaunchContext) -> str:
-        left = perform_substitutions(context, self.left)
-        right = perform_substitutions(context, self.right)
-        return _bool_text(_equal(left, right))
-
-    def describe(self) -> str:
-        return f"Equals({describe(self.left)}, {describe(self.right)})"
-
-
-class NotEqualsSubstitution(EqualsSubstitution):
-    def perform(self, context: LaunchContext) -> str:
-        return _bool_text(not to_bool(super().perform(context), "not-equals"))
-
-    def describe(self) -> str:
-        return f"NotEquals({describe(self.left)}, {describe(self.right)})"
-
-
-class IfElseSubstitution(Substitution):
-    """``if_value`` when the condition holds, else ``else_value``."""
-
-    def __init__(
-        self, condition: SomeSubstitutionsType, if_value: Any = None, else_value: Any = None
-    ) -> None:
-        if if_value is None and else_value is None:
-            raise TypeError("IfElseSubstitution needs at least one of if_value and else_value")
-        self.condition = normalize(condition)
-        self.if_value = normalize("" if if_value is None else if_value)
-        self.else_value = normalize("" if else_value is None else else_value)
-
-    def perform(self, context: LaunchContext) -> str:
-        chosen = evaluate_condition_expression(perform_substitutions(context, self.condition))
-        return perform_substitutions(context, self.if_value if chosen else self.else_value)
-
-    def describe(self) -> str:
-        return (
-            f"IfElse({describe(self.condition)}, {describe(self.if_value)},"
-            f" {describe(self.else_value)})"
-        )
-
-
 __all__ = [
     "AllSubstitution",
     "AndSubstitution",
@@ -628,13 +402,23 @@ __all__ = [
     "NotEqualsSubstitution",
     "NotSubstitution",
     "OrSubstitution",
+    "Path",
     "PathJoinSubstitution",
     "PathSubstitution",
     "PythonExpression",
     "SomeSubstitutionsType",
+    "SomeSubstitutionsType_types_tuple",
+    "Subs",
     "Substitution",
     "SubstitutionFailure",
     "TextSubstitution",
     "ThisLaunchFile",
     "ThisLaunchFileDir",
+    "describe",
+    "evaluate_condition_expression",
+    "is_substitution_like",
+    "normalize",
+    "perform",
+    "perform_substitutions",
+    "to_bool",
 ]

@@ -1,0 +1,122 @@
+"""The Substitution base class, the values launch accepts in its place, and how they are
+normalized, performed and described (ROS 2's ``launch.substitution`` and
+``launch.some_substitutions_type``). The substitutions themselves are mlaunch.launch.substitutions'.
+
+A substitution is data until ``perform(context)`` is called while resolving; ``describe()`` shows
+it unresolved (``--print`` of deferred actions, ``--show-args`` defaults).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+
+# pathlib is not imported: it costs milliseconds at start-up, and os.PathLike covers Path.
+Path = os.PathLike
+
+# typing (~4 ms) and subprocess (~3 ms, with selectors and threading) are not imported at start-up:
+# annotations are strings, and only Command() runs a program. mypy treats this name as
+# typing.TYPE_CHECKING.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+
+
+class Substitution:
+    """Base class: something that becomes a string when the launch is resolved."""
+
+    def perform(self, context: LaunchContext) -> str:
+        raise NotImplementedError
+
+    def describe(self) -> str:
+        return type(self).__name__ + "(...)"
+
+    def __repr__(self) -> str:
+        return self.describe()
+
+
+# What ROS 2's launch files annotate arguments with; a union of classes, no typing needed.
+SomeSubstitutionsType = str | Path | Substitution | Iterable[str | Path | Substitution]
+SomeSubstitutionsType_types_tuple = (str, Path, Substitution)
+Subs = tuple[Substitution, ...]
+
+
+def normalize(value: Any) -> Subs:
+    """Turn a str, Path, Substitution or iterable of those into a tuple of substitutions.
+
+    Lists concatenate when performed, as in ROS 2 (``['a', LaunchConfiguration('b')]`` is one
+    string).
+    """
+    if isinstance(value, Substitution):
+        return (value,)
+    if isinstance(value, str):
+        return (TextSubstitution(text=value),)
+    if isinstance(value, os.PathLike):
+        return (TextSubstitution(text=os.fspath(value)),)
+    if isinstance(value, (int, float, bool)):
+        return (TextSubstitution(text=str(value)),)
+    if isinstance(value, Iterable):
+        out: list[Substitution] = []
+        for item in value:
+            out.extend(normalize(item))
+        return tuple(out)
+    raise TypeError(
+        f"expected a str, a Substitution or a list of them, got {type(value).__name__}: {value!r}"
+    )
+
+
+def is_substitution_like(value: Any) -> bool:
+    if isinstance(value, (str, Path, Substitution)):
+        return True
+    return isinstance(value, (list, tuple)) and all(
+        isinstance(v, (str, Path, Substitution)) for v in value
+    )
+
+
+def perform_substitutions(context: LaunchContext, subs: Sequence[Substitution]) -> str:
+    """Perform each substitution and concatenate the results."""
+    if len(subs) == 1:
+        return subs[0].perform(context)
+    return "".join(s.perform(context) for s in subs)
+
+
+def perform(context: LaunchContext, value: Any) -> str:
+    """Perform any SomeSubstitutionsType value (str, Substitution, list) to a string."""
+    if isinstance(value, str):
+        return value
+    return perform_substitutions(context, normalize(value))
+
+
+def describe(value: Any) -> str:
+    """Describe an unresolved value: text in quotes, substitutions by their describe()."""
+    subs = normalize(value)
+    return " + ".join(s.describe() for s in subs) if subs else "''"
+
+
+class TextSubstitution(Substitution):
+    """Literal text."""
+
+    def __init__(self, *, text: str) -> None:
+        self.text = str(text)
+
+    def perform(self, context: LaunchContext) -> str:
+        return self.text
+
+    def describe(self) -> str:
+        return repr(self.text)
+
+
+__all__ = [
+    "SomeSubstitutionsType",
+    "SomeSubstitutionsType_types_tuple",
+    "Substitution",
+    "TextSubstitution",
+    "describe",
+    "is_substitution_like",
+    "normalize",
+    "perform",
+    "perform_substitutions",
+]
