@@ -16,12 +16,10 @@ See benchmarks/README.md for what is measured and how.
 from __future__ import annotations
 
 import argparse
-import fcntl
 import hashlib
 import json
 import os
 import platform
-import random
 import re
 import shutil
 import signal
@@ -41,9 +39,11 @@ REPO = HERE.parent
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
+sys.path.append(str(REPO / "tests"))  # the ROS-domain lock the tests take (tests/ros_domain.py)
 import launchgen as gen  # noqa: E402
 import probes as pr  # noqa: E402
 from probes import BenchError  # noqa: E402
+from ros_domain import private_domain  # noqa: E402
 
 GROUPS = ("startup", "print", "output", "memory", "sim", "importtime")  # what --only selects
 # The table's sections: shutdown and memory are measured in the start-up runs.
@@ -278,25 +278,12 @@ def plain_venv() -> Venv | str:
 
 @contextmanager
 def ros_domain(requested: int | None) -> Iterator[int]:
-    """A ROS_DOMAIN_ID no test or other benchmark holds (the lock files tests/conftest.py uses)."""
+    """A ROS_DOMAIN_ID no test or other benchmark holds (tests/ros_domain.py: the one lock)."""
     if requested is not None:
         yield requested
         return
-    ids = list(range(101, 200))
-    random.shuffle(ids)
-    for domain in ids:
-        fd = os.open(f"/tmp/mlaunch-ros-domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            continue
-        try:
-            yield domain
-        finally:
-            os.close(fd)
-        return
-    raise BenchError("no free ROS_DOMAIN_ID in 101..199")
+    with private_domain() as domain:
+        yield domain
 
 
 # --- the harness ----------------------------------------------------------------------------

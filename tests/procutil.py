@@ -1,4 +1,5 @@
-"""Helpers for tests that run mlaunch as a real process: read its output with deadlines."""
+"""The tests' shared helpers: run mlaunch as a real process and read its output with deadlines,
+and wait for a condition with a deadline (wait_until, wait_for), never a bare sleep."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TypeVar
 
+T = TypeVar("T")
 REPO = Path(__file__).resolve().parent.parent
 
 
@@ -104,14 +107,32 @@ def run_mlaunch(
     )
 
 
-def wait_until(predicate: Callable[[], bool], timeout: float, interval: float = 0.02) -> bool:
-    """Poll a condition until it holds or the deadline passes (the wait itself, not a sync sleep)."""
+def wait_until(
+    predicate: Callable[[], object], timeout: float = 10.0, interval: float = 0.02
+) -> bool:
+    """Poll a condition until it holds or the deadline passes (the wait itself, not a sync sleep).
+
+    The one polling helper of the tests: False when the deadline passed (the caller asserts).
+    """
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if predicate():
             return True
         time.sleep(interval)
-    return predicate()
+    return bool(predicate())
+
+
+def wait_for(predicate: Callable[[], T], timeout: float, what: str, interval: float = 0.05) -> T:
+    """Poll until ``predicate()`` is truthy and return it; an AssertionError naming ``what`` when
+    the deadline passes."""
+    deadline = time.monotonic() + timeout
+    while True:
+        value = predicate()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        time.sleep(interval)
 
 
 def pid_alive(pid: int) -> bool:

@@ -13,11 +13,11 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import IO
 
 import pytest
+from procutil import wait_until
 
 from mlaunch.run import guard as guards
 
@@ -35,15 +35,6 @@ ESCAPER = (
     "import subprocess, sys\n"
     f"subprocess.Popen([sys.executable, '-c', {SLEEPER!r}], start_new_session=True)\n" + SLEEPER
 )
-
-
-def wait_until(predicate: Callable[[], bool], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return predicate()
 
 
 def alive(pid: int) -> bool:

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import pytest
 from conftest import REPO, requires_rclpy
+from procutil import wait_until
 
 from mlaunch.ros.bridge import (
     INSTALL_HINT,
@@ -36,16 +37,6 @@ from mlaunch.ros.bridge import (
 
 NODES = Path(__file__).resolve().parent / "nodes"
 STARTUP = 15.0  # generous: two rclpy interpreters starting at once on 2 busy cores
-
-
-def wait_until(predicate: Callable[[], bool], timeout: float) -> bool:
-    """Poll predicate every 20 ms until it holds or the deadline passes."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.02)
-    return True
 
 
 @dataclass

@@ -11,13 +11,13 @@ import json
 import subprocess
 import sys
 import textwrap
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 from conftest import requires_rclpy
+from procutil import wait_for
 
 pytestmark = [requires_rclpy, pytest.mark.timeout(60)]
 
@@ -177,14 +177,6 @@ def spawn(ros_env: dict[str, str], tmp_path: Path) -> Iterator[Callable[..., Pro
             proc.stop()
 
 
-def wait_until(pred: Callable[[], bool], timeout: float, what: str) -> None:
-    deadline = time.monotonic() + timeout
-    while not pred():
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.05)
-
-
 def standin(module: str, *args: str) -> list[str]:
     return [sys.executable, "-m", f"mlaunch.standins.{module}", *args]
 
@@ -237,7 +229,7 @@ def test_rsp_latches_description_for_a_late_subscriber(
         },
     )
     rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
-    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
+    wait_for(started(rsp, "Robot initialized"), 15, "rsp to start")
     # Subscribed only now, after the one publication: it still arrives (transient local).
     lines = probe(
         spawn,
@@ -262,7 +254,7 @@ def test_rsp_namespace_moves_the_topic(spawn: Callable[..., Proc], tmp_path: Pat
     params = params_file(tmp_path, {"robot_description": URDF})
     argv = standin("rsp", "--ros-args", "-r", "__ns:=/r1", "--params-file", params)
     rsp = spawn([*argv, "-p", "use_sim_time:=True"], "rsp")
-    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
+    wait_for(started(rsp, "Robot initialized"), 15, "rsp to start")
     lines = probe(
         spawn,
         {
@@ -280,10 +272,10 @@ def test_rsp_namespace_moves_the_topic(spawn: Callable[..., Proc], tmp_path: Pat
 def test_rsp_names_unknown_joints_once(spawn: Callable[..., Proc], tmp_path: Path) -> None:
     params = params_file(tmp_path, {"robot_description": URDF})
     rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
-    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
+    wait_for(started(rsp, "Robot initialized"), 15, "rsp to start")
     batches = [["left_wheel_joint", "mystery_joint"], ["sentinel_joint"]]
     probe(spawn, {"publish_joints": "/joint_states", "batches": batches})
-    wait_until(lambda: "'sentinel_joint'" in rsp.stderr(), 10, "rsp to name the sentinel joint")
+    wait_for(lambda: "'sentinel_joint'" in rsp.stderr(), 10, "rsp to name the sentinel joint")
     warnings = [line for line in rsp.stderr().splitlines() if "mystery_joint" in line]
     assert len(warnings) == 1, warnings
     assert "not in robot 'probe_bot'" in warnings[0]
@@ -328,7 +320,7 @@ def test_jsp_publishes_default_positions_for_movable_joints(
         node="joint_state_publisher",
     )
     jsp = spawn(standin("jsp", "--ros-args", "--params-file", params), "jsp")
-    wait_until(started(jsp, "publishing joints"), 15, "jsp to start")
+    wait_for(started(jsp, "publishing joints"), 15, "jsp to start")
     (line,) = probe(spawn, {"joint_states": "/joint_states"})
     # fixed laser_joint left out; document order; arm limited to [0.5, 1.5] starts mid-range
     assert line["name"] == ["left_wheel_joint", "right_wheel_joint", "arm_joint"]
@@ -346,7 +338,7 @@ def test_jsp_reads_the_description_topic_and_waits_for_sim_time(
     spawn(standin("rsp", "--ros-args", "--params-file", rsp_params), "rsp")
     argv = standin("jsp", "--ros-args", "-p", "use_sim_time:=True", "-r", "__node:=jsp")
     jsp = spawn(argv, "jsp")
-    wait_until(started(jsp, "robot 'probe_bot': publishing joints"), 20, "jsp to read the URDF")
+    wait_for(started(jsp, "robot 'probe_bot': publishing joints"), 20, "jsp to read the URDF")
     assert "use_sim_time is true: waiting for /clock" in jsp.stderr()
     lines = probe(
         spawn,

@@ -9,12 +9,12 @@ import math
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
 from conftest import requires_rclpy
+from procutil import wait_until
 
 from mlaunch.standins.sim import SimUsageError, free_name, parse_sim_args, parse_spawn_request
 from mlaunch.standins.spawn import SpawnError, parse_spawn_args, spawn_request
@@ -298,15 +298,6 @@ def test_spawn_request_validation() -> None:
 
 
 # ---------------------------------------------------------------- processes
-
-
-def wait_until(pred: Callable[[], bool], timeout: float) -> bool:
-    deadline = time.monotonic() + timeout
-    while not pred():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.02)
-    return True
 
 
 class Sim:

@@ -18,6 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from procutil import wait_until
 
 from mlaunch.run import guard as guards
 from mlaunch.run.events import Event, Exited, Output, Started
@@ -37,15 +38,6 @@ from mlaunch.run.screen import Screen
 from mlaunch.run.supervisor import Supervisor
 
 PY = sys.executable
-
-
-def wait_until(predicate: Callable[[], bool], timeout: float = 10.0) -> bool:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return True
-        time.sleep(0.01)
-    return predicate()
 
 
 def make_spec(

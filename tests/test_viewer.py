@@ -16,14 +16,14 @@ import signal
 import subprocess
 import sys
 import textwrap
-import time
 import urllib.request
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 from conftest import requires_rclpy
+from procutil import wait_for
 
 from mlaunch.standins.viewer import (
     DisplayConfig,
@@ -336,17 +336,6 @@ class Child:
             self.popen.stdin.close()
 
 
-def wait_until(pred: Callable[[], Any], timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while True:
-        value = pred()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-        time.sleep(0.05)
-
-
 def fetch_state(url: str) -> dict[str, Any]:
     with urllib.request.urlopen(url + "state.json", timeout=5) as reply:
         return json.loads(reply.read())
@@ -373,7 +362,7 @@ def scene(ros_env: dict[str, str], tmp_path: Path) -> Iterator[tuple[str, Child,
             match = re.search(r"^viewer: open (http://127\.0\.0\.1:\d+/)$", viewer.stdout(), re.M)
             return match.group(1) if match else None
 
-        url = wait_until(listening, 15, "the viewer's 'open' line")
+        url = wait_for(listening, 15, "the viewer's 'open' line")
         yield url, viewer, children[0]
     finally:
         for child in children:
@@ -394,7 +383,7 @@ def move_to(robot: Child, url: str, pose: tuple[float, float, float]) -> dict[st
         ringed = points and all(abs(math.dist(q, laser) - 1.0) < 1e-3 for q in points)
         return state if at_pose and ringed and state["robot"] else None
 
-    return wait_until(arrived, 20, f"the viewer to show the robot at {pose}")
+    return wait_for(arrived, 20, f"the viewer to show the robot at {pose}")
 
 
 @requires_rclpy

@@ -1,0 +1,41 @@
+"""A private ROS_DOMAIN_ID for one test or benchmark run: the one lock both take.
+
+A lock file per id (``/tmp/mlaunch-ros-domain-<id>.lock``) held with flock while the domain is
+in use, so overlapping pytest runs, CI and a benchmark never share a DDS domain and never see
+each other's nodes. benchmarks/run.py imports this module too.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import random
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+FIRST, LAST = 101, 199  # inside ROS 2's valid range, away from the default 0
+
+
+def claim() -> tuple[int, int]:
+    """(domain, fd): a domain no other run holds; it stays held until ``fd`` is closed."""
+    ids = list(range(FIRST, LAST + 1))
+    random.shuffle(ids)
+    for domain in ids:
+        fd = os.open(f"/tmp/mlaunch-ros-domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            continue
+        return domain, fd
+    raise RuntimeError(f"no free ROS_DOMAIN_ID in {FIRST}..{LAST}")
+
+
+@contextmanager
+def private_domain() -> Iterator[int]:
+    """``with private_domain() as domain_id:`` a domain held for the block."""
+    domain, fd = claim()
+    try:
+        yield domain
+    finally:
+        os.close(fd)
