@@ -20,8 +20,11 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescription, LaunchDescriptionEntity
     from mlaunch.ros.search import PackageSearch
     from mlaunch.run.lifeline import Lifeline
+    from mlaunch.run.plan import ArgumentInfo, Plan
+    from mlaunch.run.resolve import LabelCounter, ResolveOptions
 
 # The private params folder of a run; other commands (export, LaunchService) make one too.
 from mlaunch.run.lifeline import private_temp_dir, remove_private_dir  # noqa: E402, F401
@@ -330,7 +333,7 @@ def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
     return PackageSearch(opts.package_path, launch_file, os.environ)
 
 
-def load_target(opts: Options) -> tuple[str, object]:
+def load_target(opts: Options) -> tuple[str, LaunchDescription]:
     """The launch file the command line names (a path, or PKG FILE) and its description."""
     from mlaunch.ros.search import searching
 
@@ -349,8 +352,13 @@ def load_target(opts: Options) -> tuple[str, object]:
 
 
 def resolve_for_run(
-    opts: Options, path: str, description: object, *, temp_dir: str, log_dir: str
-) -> tuple[Any, Any, Any]:
+    opts: Options,
+    path: str,
+    description: LaunchDescriptionEntity,
+    *,
+    temp_dir: str,
+    log_dir: str,
+) -> tuple[Plan, ResolveOptions, LabelCounter]:
     """(plan, resolve options, label counter) for a run of ``description`` as opts say."""
     from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
@@ -360,7 +368,7 @@ def resolve_for_run(
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions import with_use_sim_time
 
-        description = with_use_sim_time(description, opts.use_sim_time)  # type: ignore[arg-type]
+        description = with_use_sim_time(description, opts.use_sim_time)
     labels = LabelCounter()
     plan = resolve(
         description,
@@ -406,7 +414,7 @@ def check_target(opts: Options) -> int:
         return report(find_launch_file(opts), sys.stdout)
 
 
-def launch(opts: Options, path: str, description: object, life: Lifeline) -> int:
+def launch(opts: Options, path: str, description: LaunchDescriptionEntity, life: Lifeline) -> int:
     log_dir = ""
     if not opts.print_plan:
         from mlaunch.run.logfiles import make_run_log_dir
@@ -426,9 +434,9 @@ def launch(opts: Options, path: str, description: object, life: Lifeline) -> int
 
 def supervise(
     opts: Options,
-    plan: object,
-    options: object,
-    labels: object,
+    plan: Plan,
+    options: ResolveOptions,
+    labels: LabelCounter,
     log_dir: str,
     life: Lifeline,
 ) -> int:
@@ -455,10 +463,10 @@ def supervise(
     printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
     spawner = _spawner(plan, labels, run_id)
     supervisor = Supervisor(
-        plan,  # type: ignore[arg-type]
+        plan,
         printer,
-        options=options,  # type: ignore[arg-type]
-        labels=labels,  # type: ignore[arg-type]
+        options=options,
+        labels=labels,
         guard=guard,
         run_id=run_id,
         cgroup=life.cgroup,
@@ -467,7 +475,7 @@ def supervise(
     extensions: list[object] = []
     try:
         if spawner is not None:
-            spawner.connect(plan.processes())  # type: ignore[attr-defined]
+            spawner.connect(plan.processes())
         extensions = _extensions(opts, supervisor)
         life.block()  # until the supervisor's own handlers are in
         try:
@@ -516,7 +524,7 @@ def _extensions(opts: Options, supervisor: object) -> list[object]:
     return attached
 
 
-def format_arguments(infos: Sequence[object]) -> str:
+def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
     """The --show-args table: name, default, description (and choices), conditional marked."""
     if not infos:
         return "No arguments.\n"
@@ -525,10 +533,10 @@ def format_arguments(infos: Sequence[object]) -> str:
     rows = []
     any_conditional = False
     for info in infos:
-        name = info.name + ("*" if info.conditional else "")  # type: ignore[attr-defined]
-        any_conditional |= info.conditional  # type: ignore[attr-defined]
-        default = "(required)" if info.default is None else repr(info.default)  # type: ignore[attr-defined]
-        rows.append((name, default, info.description))  # type: ignore[attr-defined]
+        name = info.name + ("*" if info.conditional else "")
+        any_conditional |= info.conditional
+        default = "(required)" if info.default is None else repr(info.default)
+        rows.append((name, default, info.description))
     w_name = max(len("name"), *(len(r[0]) for r in rows))
     w_def = min(36, max(len("default"), *(len(r[1]) for r in rows)))
     width = max(40, _terminal_width() - w_name - w_def - 6)

@@ -12,6 +12,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescription
+
 # suffix -> module with load(path) -> LaunchDescription. Longest suffix wins.
 FRONTENDS: dict[str, str] = {
     ".launch.py": "mlaunch.frontends.python",
@@ -55,7 +57,7 @@ def load_root(path: str) -> Any:
     return importlib.import_module(module_name).read_root(path)
 
 
-def load(path: str, hint: str | None = None) -> Any:
+def load(path: str, hint: str | None = None) -> LaunchDescription:
     """The LaunchDescription in the file at ``path`` (absolute), with every error located."""
     if not os.path.exists(path):
         raise LaunchFileError(f"launch file {path!r} does not exist")

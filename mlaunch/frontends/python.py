@@ -13,6 +13,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescription
+
 
 def set_launch_argv(target: str, second: str | None, arguments: list[str]) -> None:
     """Lay sys.argv out as ``ros2 launch`` does, for launch files that read it.
@@ -28,7 +30,7 @@ def set_launch_argv(target: str, second: str | None, arguments: list[str]) -> No
     sys.argv.extend(arguments)
 
 
-def load(path: str) -> Any:
+def load(path: str) -> LaunchDescription:
     from mlaunch import compat
     from mlaunch.launch.actions import LaunchDescription
 

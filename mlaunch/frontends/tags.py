@@ -32,11 +32,13 @@ TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescription
+
 
 # --- the dispatcher --------------------------------------------------------------------------
 
 
-def build_description(root: Entity) -> Any:
+def build_description(root: Entity) -> LaunchDescription:
     """The LaunchDescription of a root ``launch`` entity."""
     if root.tag != "launch":
         raise root.error(f"the root must be 'launch', not {root.tag!r}")

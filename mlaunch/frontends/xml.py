@@ -18,14 +18,14 @@ from mlaunch.frontends.tags import build_description
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
-    from typing import Any
+    from mlaunch.launch.launch_description import LaunchDescription
 
 # Attributes the root may carry for XML tooling (schema hints), not for launch.
 _ROOT_IGNORED = re.compile(r"^(xmlns(:.*)?|xsi:.*)$")
 _ATTRIBUTE = re.compile(rb"\s*([^\s=/>]+)\s*=\s*([\"'])")
 
 
-def load(path: str) -> Any:
+def load(path: str) -> LaunchDescription:
     """The LaunchDescription of the XML launch file at ``path``."""
     return build_description(read_root(path))
 

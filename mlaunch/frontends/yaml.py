@@ -22,6 +22,8 @@ TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescription
+
 try:
     _Base: Any = yaml.CSafeLoader
 except AttributeError:  # PyYAML built without libyaml
@@ -32,7 +34,7 @@ class _Loader(_Base):  # type: ignore[misc, valid-type]
     """The safe loader (C when available); composing with it keeps node marks."""
 
 
-def load(path: str) -> Any:
+def load(path: str) -> LaunchDescription:
     """The LaunchDescription of the YAML launch file at ``path``."""
     return build_description(read_root(path))
 

@@ -20,6 +20,8 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from types import ModuleType
 
+    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+
 # mlaunch.errors' table: a launch test's own errors (its file, its arguments) are bad input.
 EXIT_PASS = EXIT_OK
 EXIT_FAIL = EXIT_FAILURE
@@ -106,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
     return EXIT_PASS if all(r.wasSuccessful() for r in results.values()) else EXIT_FAIL
 
 
-def show_arguments(description: object, path: str) -> None:
+def show_arguments(description: LaunchDescriptionEntity, path: str) -> None:
     from mlaunch.cli import format_arguments
     from mlaunch.run.resolve import collect_arguments
 

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Mapping
     from typing import Any
 
+    from mlaunch.launch.launch_description import LaunchDescriptionEntity
     from mlaunch.ros.search import PackageSearch, searching
 
 
@@ -212,7 +213,7 @@ def _short(entity: Any) -> str:
 
 
 def resolve(
-    description: Any,
+    description: LaunchDescriptionEntity,
     *,
     path: str | None,
     arguments: Mapping[str, str],
@@ -305,7 +306,11 @@ def undeclared_argument_warnings(
 
 
 def collect_arguments(
-    description: Any, *, path: str | None, arguments: Mapping[str, str], environ: Mapping[str, str]
+    description: LaunchDescriptionEntity,
+    *,
+    path: str | None,
+    arguments: Mapping[str, str],
+    environ: Mapping[str, str],
 ) -> list[ArgumentInfo]:
     """Every DeclareLaunchArgument, following includes whose path can be resolved statically.
 
