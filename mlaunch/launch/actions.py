@@ -14,6 +14,7 @@ from mlaunch.errors import LaunchArgumentError, LaunchFileError
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
+    TextSubstitution,
     normalize,
     perform,
     perform_substitutions,
@@ -76,7 +77,7 @@ class DeclareLaunchArgument(Action):
         default = None
         if self.default_value is not None:
             default = " + ".join(
-                s.text if hasattr(s, "text") else s.describe()  # type: ignore[attr-defined]
+                s.text if isinstance(s, TextSubstitution) else s.describe()
                 for s in self.default_value
             )
         return ArgumentInfo(

@@ -39,7 +39,9 @@ class Substitution:
 
 
 # What ROS 2's launch files annotate arguments with; a union of classes, no typing needed.
-SomeSubstitutionsType = str | Path | Substitution | Iterable[str | Path | Substitution]
+SomeSubstitutionsType = (
+    str | os.PathLike[str] | Substitution | Iterable[str | os.PathLike[str] | Substitution]
+)
 SomeSubstitutionsType_types_tuple = (str, Path, Substitution)
 Subs = tuple[Substitution, ...]
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import os
 
-from mlaunch.run.plan import Record
+from mlaunch.record import Record
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

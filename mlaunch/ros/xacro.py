@@ -154,7 +154,7 @@ def _lookups(environ: Mapping[str, str], index: PackageIndex) -> Iterator[None]:
         return index.get(package).share_directory
 
     saved = (sa.os, sa._eval_find, sa._eval_dict["find"])
-    sa.os = _OsView(environ=dict(environ))  # type: ignore[assignment]
+    sa.os = _OsView(environ=dict(environ))
     sa._eval_find = find
     sa._eval_dict["find"] = find
     try:
