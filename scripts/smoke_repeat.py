@@ -12,7 +12,6 @@ prints one line per run and a tally, and exits 1 unless every run gave the expec
 from __future__ import annotations
 
 import argparse
-import fcntl
 import os
 import subprocess
 import sys
@@ -21,25 +20,17 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.append(str(ROOT / "tests"))
+import ros_domain  # noqa: E402  (the one ROS-domain lock)
+
 PAIR = [("launches/jtbot_sim.launch.py", 0), ("tests/launches/jtbot_crash.launch.py", 1)]
 RUN_TIMEOUT = 180.0
 
 
 def claim_domain() -> tuple[int, int]:
-    """A ROS_DOMAIN_ID nobody else on this machine holds: the lock files the test suite's
-    conftest uses, so a run never shares its DDS domain with another run or a test."""
-    for domain in range(101, 200):
-        fd = os.open(f"/tmp/mlaunch-ros-domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            continue
-        if _in_use(domain):  # a leftover node of someone's earlier run, without its lock
-            os.close(fd)
-            continue
-        return domain, fd
-    raise RuntimeError("no free ROS_DOMAIN_ID in 101..199")
+    """A ROS_DOMAIN_ID nobody else on this machine holds (tests/ros_domain.py, the lock the test
+    suite takes), and that no leftover process of an earlier run still uses."""
+    return ros_domain.claim(skip=_in_use)
 
 
 def _in_use(domain: int) -> bool:

@@ -2,7 +2,7 @@
 
 A lock file per id (``/tmp/mlaunch-ros-domain-<id>.lock``) held with flock while the domain is
 in use, so overlapping pytest runs, CI and a benchmark never share a DDS domain and never see
-each other's nodes. benchmarks/run.py imports this module too.
+each other's nodes. benchmarks/run.py and scripts/smoke_repeat.py import this module too.
 """
 
 from __future__ import annotations
@@ -10,14 +10,17 @@ from __future__ import annotations
 import fcntl
 import os
 import random
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 FIRST, LAST = 101, 199  # inside ROS 2's valid range, away from the default 0
 
 
-def claim() -> tuple[int, int]:
-    """(domain, fd): a domain no other run holds; it stays held until ``fd`` is closed."""
+def claim(skip: Callable[[int], bool] | None = None) -> tuple[int, int]:
+    """(domain, fd): a domain no other run holds; it stays held until ``fd`` is closed.
+
+    ``skip(domain)`` can refuse a free lock too (a leftover process still using the domain).
+    """
     ids = list(range(FIRST, LAST + 1))
     random.shuffle(ids)
     for domain in ids:
@@ -25,6 +28,9 @@ def claim() -> tuple[int, int]:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
+            os.close(fd)
+            continue
+        if skip is not None and skip(domain):
             os.close(fd)
             continue
         return domain, fd
