@@ -16,7 +16,8 @@ import time
 from pathlib import Path
 
 import pytest
-from test_faults import PY, Mlaunch, alive, assert_nothing_left, wait_until
+from procutil import wait_until
+from test_faults import PY, Mlaunch, alive, assert_nothing_left
 
 # Writes "<run id> <pid>" to argv[1], starts a grandchild in a session of its own that does the
 # same to argv[1] + ".grand", then waits: what a slow xacro or a daemon-starting command is.

@@ -22,7 +22,8 @@ import time
 from pathlib import Path
 
 import pytest
-from test_supervision import Harness, gone, make_spec, wait_until
+from procutil import wait_until
+from test_supervision import Harness, gone, make_spec
 
 from mlaunch.run import guard as guards
 from mlaunch.run.events import Event, Output

@@ -17,8 +17,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from procutil import wait_for
 from test_interfaces import requires_tf2_msgs
-from test_standin_nodes import URDF, Proc, params_file, spawn, standin, started, wait_until
+from test_standin_nodes import URDF, Proc, params_file, spawn, standin, started
 
 pytestmark = [requires_tf2_msgs, pytest.mark.timeout(60)]
 __all__ = ["spawn"]  # the fixture, used by name
@@ -93,7 +94,7 @@ def test_rsp_publishes_fixed_joints_static_and_moving_joints_from_joint_states(
 ) -> None:
     params = params_file(tmp_path, {"robot_description": URDF, "frame_prefix": "r1/"})
     rsp = spawn(standin("rsp", "--ros-args", "--params-file", params), "rsp")
-    wait_until(started(rsp, "Robot initialized"), 15, "rsp to start")
+    wait_for(started(rsp, "Robot initialized"), 15, "rsp to start")
     seen = tf_probe(
         spawn,
         {
@@ -132,7 +133,7 @@ def test_stp_flag_form_with_rpy_and_the_real_node_name(
 ) -> None:
     argv = ["--x", "1", "--y", "-2", "--yaw", str(math.pi / 2), "--frame-id", "map"]
     stp = spawn(standin("stp", *argv, "--child-frame-id", "odom"), "stp")
-    wait_until(started(stp, "Spinning until stopped"), 15, "stp to start")
+    wait_for(started(stp, "Spinning until stopped"), 15, "stp to start")
     seen = tf_probe(spawn, {"want": {"/tf_static": ["odom"]}})
     odom = seen["/tf_static"]["odom"]
     half = math.sqrt(0.5)
@@ -150,7 +151,7 @@ def test_stp_old_positional_forms_warn_and_publish(
         standin("stp", "0.5", "0", "0", "0", "0", "3.141592653589793", "base", "flip"), "e"
     )
     for proc in (quaternion, euler):
-        wait_until(started(proc, "Spinning until stopped"), 15, "stp to start")
+        wait_for(started(proc, "Spinning until stopped"), 15, "stp to start")
         assert "Old-style arguments are deprecated" in proc.stderr()
     seen = tf_probe(spawn, {"want": {"/tf_static": ["top", "flip"]}})
     assert close(seen["/tf_static"]["top"]["q"], [0.0, 0.0, 1.0, 0.0])
