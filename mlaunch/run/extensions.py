@@ -51,6 +51,17 @@ def _may_have_lifecycle_work(options: Any, plan: Any) -> bool:
     return deferred and "mlaunch.launch_ros.actions" in sys.modules
 
 
+def _components(options: Any, supervisor: Any) -> Any:
+    """Composable node loading; None unless the plan loads components (resolve made a step)."""
+    import sys
+
+    if "mlaunch.launch_ros.composition" not in sys.modules:
+        return None  # no container or LoadComposableNodes was built: nothing to load
+    from mlaunch.ros.components import attach
+
+    return attach(options, supervisor)
+
+
 def _status_view(options: Any, supervisor: Any) -> Any:
     """``--status``: the live table pinned below the output (rich and psutil, only then)."""
     if not getattr(options, "status", False):
@@ -83,4 +94,4 @@ def _exit_summary(options: Any, supervisor: Any) -> Any:
 
 
 # Closed in this order at the end: the status view leaves the screen before the summary prints.
-ATTACH: list[Callable[[Any, Any], Any]] = [_lifecycle, _status_view, _exit_summary]
+ATTACH: list[Callable[[Any, Any], Any]] = [_lifecycle, _components, _status_view, _exit_summary]

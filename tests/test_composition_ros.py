@@ -1,0 +1,162 @@
+"""Composable nodes loaded for real: the LoadNode driver against rclpy containers.
+
+A recording container (tests/nodes/recording_container.py) prints every request it receives:
+the Python, XML and YAML demo files must send exactly the requests of test_composition's
+EXPECTED, in order. mlaunch's container stand-in hosts robot_state_publisher's component and
+refuses an unknown plugin with its one-line reason, which the driver logs as launch_ros does.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import requires_rclpy
+from test_composition import EXPECTED, HERE, loads, plan_of
+from test_composition import prefix as prefix  # the fixture, used by name
+from test_standin_nodes import URDF, Proc, spawn, standin, wait_until
+
+from mlaunch import frontends
+from mlaunch.launch_ros.composition import LoadComponents
+from mlaunch.launch_ros.load_request import (
+    STRING,
+    LoadRequest,
+    TypedParameter,
+)
+
+requires_composition_interfaces = pytest.mark.skipif(
+    importlib.util.find_spec("composition_interfaces") is None,
+    reason="composition_interfaces is not built: run scripts/setup (it builds the interfaces)",
+)
+pytestmark = [requires_rclpy, requires_composition_interfaces, pytest.mark.timeout(90)]
+__all__ = ["spawn"]  # the fixture, used by name
+
+RECORDER = str(Path(__file__).parent / "nodes" / "recording_container.py")
+
+
+@pytest.fixture
+def loader(ros_env: dict[str, str]) -> Iterator[tuple[Any, list[tuple[str, str]]]]:
+    """A ComponentLoader on its own rclpy context in the test's domain, and its log lines."""
+    import rclpy
+
+    from mlaunch.ros.components import ComponentLoader
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    lines: list[tuple[str, str]] = []
+    driver = ComponentLoader(context, lambda level, message: lines.append((level, message)))
+    try:
+        yield driver, lines
+    finally:
+        driver.stop.set()
+        driver.join(5.0)
+        context.try_shutdown()
+
+
+def as_lists(request: LoadRequest) -> dict[str, Any]:
+    """A request as the recording container prints it (JSON: tuples are lists)."""
+    out = {name: getattr(request, name) for name in request._fields}
+    for key in ("parameters", "extra_arguments"):
+        out[key] = [[p.name, p.type, p.value] for p in out[key]]
+    loaded: dict[str, Any] = json.loads(json.dumps(out))
+    return loaded
+
+
+def recorded(proc: Proc, count: int) -> Callable[[], bool]:
+    def check() -> bool:
+        if proc.popen.poll() is not None:
+            raise AssertionError(f"container exited: {proc.stderr()[-2000:]}")
+        return len(proc.stdout().splitlines()) >= count
+
+    return check
+
+
+@pytest.mark.parametrize("suffix", ["py", "xml", "yaml"])
+def test_the_recording_container_receives_launch_ros_requests(
+    suffix: str, prefix: Path, spawn: Callable[..., Proc], loader: Any
+) -> None:
+    driver, lines = loader
+    container = spawn(
+        [
+            sys.executable,
+            RECORDER,
+            "--fail",
+            "composition::Server",
+            "--ros-args",
+            "-r",
+            "__node:=my_container",
+        ],
+        "recorder",
+    )
+    path = str(HERE / f"demo.launch.{suffix}")
+    plan = plan_of(frontends.load(path), path, prefix)
+    steps = [s for s in plan.steps if isinstance(s, LoadComponents)]
+    for step in steps:
+        driver.start(step)
+        assert driver.join(30.0), "the loads did not finish within 30 s"
+    want = [as_lists(r) for _, requests in EXPECTED for r in requests]
+    wait_until(recorded(container, len(want)), 10, "the recorded requests")
+    got = [json.loads(line) for line in container.stdout().splitlines()]
+    assert got == want
+    assert ("INFO", "Loaded node '/robot/client' in container '/my_container'") in lines
+    assert (
+        "ERROR",
+        "Failed to load node 'server' of type 'composition::Server' in container"
+        " '/my_container': refused by the recording container",
+    ) in lines
+    assert [r.success for r in driver.results] == [True, True, True, False]
+    assert len(loads(plan)) == 2
+
+
+def test_the_standin_container_hosts_robot_state_publisher_and_refuses_unknown_plugins(
+    spawn: Callable[..., Proc], loader: Any
+) -> None:
+    driver, lines = loader
+    spawn(standin("container", "--ros-args", "-r", "__node:=box"), "container")
+    rsp = LoadRequest(
+        "robot_state_publisher",
+        "robot_state_publisher::RobotStatePublisher",
+        parameters=(TypedParameter("robot_description", STRING, URDF),),
+    )
+    unknown = LoadRequest("composition", "composition::Talker", "talker", "/ns")
+    driver.start(LoadComponents("t", "/box", (rsp, unknown)))
+    assert driver.join(30.0), "the loads did not finish within 30 s"
+    ok, refused = driver.results
+    assert (ok.success, ok.full_node_name, ok.unique_id) == (True, "/robot_state_publisher", 1)
+    assert not refused.success
+    assert refused.error_message.startswith(
+        "mlaunch's container stand-in cannot load plugin 'composition::Talker' of package"
+        " 'composition'"
+    )
+    assert ("INFO", "Loaded node '/robot_state_publisher' in container '/box'") in lines
+    assert any(
+        level == "ERROR" and "'talker' of type 'composition::Talker'" in m for level, m in lines
+    )
+    names = list_nodes(driver.context, "/box")
+    assert names == ["/robot_state_publisher"]
+
+
+def list_nodes(context: Any, container: str) -> list[str]:
+    """The container's ListNodes answer (full node names)."""
+    from composition_interfaces.srv import ListNodes
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    node = Node("list_probe", context=context)
+    executor = SingleThreadedExecutor(context=context)
+    executor.add_node(node)
+    try:
+        client = node.create_client(ListNodes, f"{container}/_container/list_nodes")
+        assert client.wait_for_service(timeout_sec=10.0)
+        future = client.call_async(ListNodes.Request())
+        executor.spin_until_future_complete(future, timeout_sec=10.0)
+        assert future.done()
+        return list(future.result().full_node_names)
+    finally:
+        executor.shutdown()
+        node.destroy_node()
