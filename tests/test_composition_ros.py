@@ -160,3 +160,34 @@ def list_nodes(context: Any, container: str) -> list[str]:
     finally:
         executor.shutdown()
         node.destroy_node()
+
+
+@pytest.mark.slow
+def test_composed_jtbot_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: Path) -> None:
+    """jtbot with the state publisher as a component: the component is a node of the graph
+    (expected by default) and publishes the description; a refused plugin would fail it."""
+    import subprocess
+
+    from procutil import REPO, clean_env, mlaunch
+
+    env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    done = subprocess.run(
+        mlaunch(
+            "test",
+            str(REPO / "launches" / "jtbot_composed.launch.py"),
+            "rviz:=false",
+            "--expect-topic",
+            "/robot_description",
+            "--expect-topic",
+            "/joint_states",
+        ),
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    out = done.stdout + done.stderr
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+    assert "node /robot_state_publisher is in the ROS graph" in out
+    assert "Loaded node '/robot_state_publisher' in container '/jtbot_container'" in out

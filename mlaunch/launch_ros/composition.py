@@ -49,6 +49,11 @@ class LoadComponents(Step):
         """The LoadNode service of the container."""
         return f"{self.target}/_container/load_node"
 
+    def component_names(self) -> list[str]:
+        """Full names of the components to load whose name is given (``mlaunch test`` expects
+        them in the graph; a component named by its container is not known in advance)."""
+        return [r.full_name for r in self.requests if r.node_name]
+
     def describe_lines(self) -> list[str]:
         """--print: each component with its container, plugin, name, params and remaps."""
         from mlaunch.launch_ros.load_request import describe_request

@@ -532,12 +532,22 @@ def build_expectations(
         out.setdefault(("node", fqn), Expectation("node", fqn))
         if spec.node.lifecycle:
             out.setdefault(("lifecycle", fqn), Expectation("lifecycle", fqn))
+    components: dict[str, str] = {}  # composable node -> its container (LoadComponents steps)
+    for step in plan.steps:
+        for name in getattr(step, "component_names", list)():
+            components[name] = step.target  # type: ignore[attr-defined]
+            out.setdefault(("node", name), Expectation("node", name))
     if use_sim_time or collector.use_sim_time or any(_sim_time_argv(s.argv) for s in specs):
         out[("clock", "/clock")] = Expectation("clock", "/clock")
     for expectation in explicit:
         out[expectation.key()] = expectation
     for expectation in out.values():
         _involve(expectation, specs)
+        if expectation.kind == "node" and expectation.target in components:
+            container = components[expectation.target]
+            expectation.labels = [
+                s.label for s in specs if s.node and s.node.fully_qualified_name == container
+            ]
     found = list(out.values())
     found.append(Expectation("shutdown", "", status="pending", seen="the launch was not stopped"))
     return found
