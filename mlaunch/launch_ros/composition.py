@@ -21,7 +21,7 @@ from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import Substitution, describe, normalize, perform_substitutions
 from mlaunch.launch_ros.actions import Node, make_namespace_absolute
 from mlaunch.launch_ros.composable import ComposableNode
-from mlaunch.run.plan import Step
+from mlaunch.run.plan import Note
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -31,11 +31,14 @@ if TYPE_CHECKING:
     from mlaunch.run.resolve import Resolver
 
 
-class LoadComponents(Step):
-    """Load ``requests`` into the container ``target`` (a full node name), in order."""
+class LoadComponents(Note):
+    """Load ``requests`` into the container ``target`` (a full node name), in order.
+
+    A Note: the supervisor carries nothing out for it; the LoadNode driver (attached to the run
+    when the plan has such steps) sends the requests."""
 
     __slots__ = ("requests", "target")
-    _fields = (*Step._fields, "target", "requests")
+    _fields = (*Note._fields, "target", "requests")
 
     def __init__(
         self, origin: str = "", target: str = "", requests: tuple[LoadRequest, ...] = ()
