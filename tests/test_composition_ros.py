@@ -17,9 +17,10 @@ from typing import Any
 
 import pytest
 from conftest import requires_rclpy
+from procutil import wait_until
 from test_composition import EXPECTED, HERE, loads, plan_of
 from test_composition import prefix as prefix  # the fixture, used by name
-from test_standin_nodes import URDF, Proc, spawn, standin, wait_until
+from test_standin_nodes import URDF, Proc, spawn, standin
 
 from mlaunch import frontends
 from mlaunch.launch_ros.composition import LoadComponents
@@ -100,7 +101,7 @@ def test_the_recording_container_receives_launch_ros_requests(
         driver.start(step)
         assert driver.join(30.0), "the loads did not finish within 30 s"
     want = [as_lists(r) for _, requests in EXPECTED for r in requests]
-    wait_until(recorded(container, len(want)), 10, "the recorded requests")
+    assert wait_until(recorded(container, len(want)), 10), "the recorded requests"
     got = [json.loads(line) for line in container.stdout().splitlines()]
     assert got == want
     assert ("INFO", "Loaded node '/robot/client' in container '/my_container'") in lines
