@@ -65,7 +65,9 @@ class ComposableNode:
 
 
 def remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
-    """``[(from, to), ...]`` or a dict, each side normalized to substitutions."""
+    """``[(from, to), ...]`` or a dict, each side normalized to substitutions (Node's too)."""
+    if remappings is None:
+        return []
     items = list(remappings.items()) if isinstance(remappings, Mapping) else list(remappings)
     rules = []
     for item in items:

@@ -16,7 +16,7 @@ nothing of a resolution is kept on the action except the names launch_ros expose
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 
 from mlaunch import standins
 from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
@@ -28,6 +28,7 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros.composable import remap_rules as _remap_rules
 from mlaunch.launch_ros.parameter_descriptions import ParameterFile
 from mlaunch.launch_ros.scope import (
     global_params,
@@ -412,21 +413,6 @@ def _items(values: Any, what: str) -> list[Subs]:
             f" (write {what}=[...])"
         )
     return [normalize(v) for v in values]
-
-
-def _remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
-    if remappings is None:
-        return []
-    items = list(remappings.items()) if isinstance(remappings, Mapping) else list(remappings)
-    rules = []
-    for item in items:
-        if not isinstance(item, (tuple, list)) or len(item) != 2:
-            raise LaunchFileError(
-                f"a remapping must be a (from, to) pair, got {item!r:.80}"
-                " (write remappings=[('from', 'to'), ...])"
-            )
-        rules.append((normalize(item[0]), normalize(item[1])))
-    return rules
 
 
 __all__ = ["LifecycleNode", "Node", "NodeCommand", "NodeNames"]
