@@ -2,8 +2,7 @@
 
 One thread, one ``selectors`` loop. Signal handlers only record the signal (and wake the loop
 through ``signal.set_wakeup_fd``); the loop acts on them. Every child runs in its own session, so
-the stop ladder (SIGINT, then SIGTERM after sigterm_timeout, then SIGKILL after sigkill_timeout,
-each with SIGCONT so a stopped process wakes up to die) reaches its whole process group.
+the stop ladder (mlaunch.run.ladder) reaches its whole process group.
 
 The supervisor writes no words. It emits a record of everything that happens on its
 EventStream (mlaunch.run.events) and acts on policy: this module is where a process's exit
@@ -36,7 +35,6 @@ from collections.abc import Callable
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, exit_for_signal
 from mlaunch.run import guard as guards
 from mlaunch.run.events import (
-    Escalated,
     Event,
     EventStream,
     Exited,
@@ -55,6 +53,7 @@ from mlaunch.run.events import (
     StrayEnded,
 )
 from mlaunch.run.handlers import LaunchHandlers
+from mlaunch.run.ladder import StopLadder
 from mlaunch.run.output import Printer
 from mlaunch.run.pipes import Pipes
 from mlaunch.run.plan import (
@@ -72,7 +71,7 @@ from mlaunch.run.plan import (
     Step,
 )
 from mlaunch.run.process import Process, describe_status, signal_name
-from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
+from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, ProcessRecord
 from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve_deferred
 from mlaunch.run.respawn import GIVE_UP, NO_RESTART, next_restart
 from mlaunch.run.signals import SignalWatch
@@ -140,6 +139,12 @@ class Supervisor:
         self.pipes = Pipes(self.selector, printer, self._deliver)
         self.launch_handlers = LaunchHandlers(self)
         self.events = EventStream()
+        # Its steps outlive the shutdown's cancellation of timers.
+        self.ladder = StopLadder(
+            lambda delay, step: self.schedule(delay, step, cancel_on_shutdown=False),
+            self.events.emit,
+            self.records,
+        )
         self.events.subscribe(self._react)
         self.events.subscribe(printer)
         self.events.subscribe(self.launch_handlers)
@@ -481,45 +486,13 @@ class Supervisor:
             self.stop(process)
 
     def stop(self, process: Process) -> None:
-        """The ladder for one process group: SIGINT, SIGTERM, SIGKILL, each after its timeout."""
-        if process.stopping:
-            return
-        process.stopping = True
-        if process.running:
-            self.records[process.label].state = STOPPING
-        spec = process.spec
-        if not process.signal_group(signal.SIGINT, wake=True):
-            return
-
-        def escalate(sig: int, waited: float, next_step: Callable[[], None] | None) -> None:
-            if not (process.running or process.check_group()):
-                return
-            previous = process.signals_sent[-1]
-            process.signal_group(sig, wake=True)
-            self.events.emit(Escalated(process, sig, previous, waited))
-            if next_step is not None:
-                next_step()
-
-        def to_kill() -> None:
-            self.schedule(
-                spec.sigkill_timeout,
-                lambda: escalate(signal.SIGKILL, spec.sigkill_timeout, None),
-                cancel_on_shutdown=False,
-            )
-
-        self.schedule(
-            spec.sigterm_timeout,
-            lambda: escalate(signal.SIGTERM, spec.sigterm_timeout, to_kill),
-            cancel_on_shutdown=False,
-        )
+        """The stop ladder for one process group (mlaunch.run.ladder)."""
+        self.ladder.stop(process)
 
     def kill_everything(self) -> None:
         """A second Ctrl-C: SIGKILL every group and every stray at once."""
         self._kill_now = True
-        for process in self.processes + self.lingering:
-            if process.running or process.check_group():
-                process.stopping = True
-                process.signal_group(signal.SIGKILL)
+        self.ladder.kill(self.processes + self.lingering)
         self.events.emit(StoppingAll(kill=True))
         self.begin_shutdown("killed")
 
