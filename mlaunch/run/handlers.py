@@ -89,31 +89,13 @@ class LaunchHandlers:
         return [p for p in processes if p.running and (matcher is None or matcher(p))]
 
     def _started(self, process: Process) -> None:
-        spec = process.spec
-        event = ev.ProcessStarted(
-            action=spec.action,
-            name=spec.label,
-            cmd=list(spec.argv),
-            cwd=spec.cwd,
-            env=spec.env,
-            pid=process.pid,
-        )
-        self.dispatch("process_start", process, event)
+        self.dispatch("process_start", process, ev.ProcessStarted(**_details(process)))
 
     def _exited(self, process: Process, code: int) -> None:
-        spec = process.spec
-        event = ev.ProcessExited(
-            action=spec.action,
-            name=spec.label,
-            cmd=list(spec.argv),
-            cwd=spec.cwd,
-            env=spec.env,
-            pid=process.pid,
-            returncode=code,
-        )
+        event = ev.ProcessExited(**_details(process), returncode=code)
         self.dispatch("process_exit", process, event)
-        if spec.on_exit is not None:
-            self.supervisor.fire(spec.on_exit, event)
+        if process.spec.on_exit is not None:
+            self.supervisor.fire(process.spec.on_exit, event)
 
     def _transition(self, record: Transition) -> None:
         """OnStateTransition handlers: their own matcher on the event, else on the node's spec."""
@@ -182,3 +164,16 @@ class LaunchHandlers:
             if entities and handler.body is not None:
                 body = handler.body
                 self.supervisor.fire(Deferred(entities, body.context, body.origin), event)
+
+
+def _details(process: Process) -> dict[str, Any]:
+    """What launch's process events carry about the process (ExecuteProcess.process_details)."""
+    spec = process.spec
+    return {
+        "action": spec.action,
+        "name": spec.label,
+        "cmd": list(spec.argv),
+        "cwd": spec.cwd,
+        "env": spec.env,
+        "pid": process.pid,
+    }
