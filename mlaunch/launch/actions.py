@@ -380,6 +380,7 @@ class TimerAction(Action):
                 period=period,
                 body=resolver.defer(self.actions, self.origin),
                 cancel_on_shutdown=cancel,
+                action=self,
             )
         )
 

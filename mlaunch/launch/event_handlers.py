@@ -111,9 +111,10 @@ class OnShutdown(EventHandler):
 
 
 class OnExecutionComplete(EventHandler):
-    """Fires when the target action completes; for a process, when it exits."""
+    """Fires when the target action completes: a process when it exits for good, a timer when
+    it has fired; only for targets visited after the handler was registered (as in launch)."""
 
-    kind = "process_exit"
+    kind = "execution_complete"
 
     def __init__(
         self, *, target_action: Any = None, on_completion: Any, handle_once: bool = False

@@ -30,6 +30,19 @@ class Shutdown(Record, Event):
         self.due_to_sigint = due_to_sigint
 
 
+class ExecutionComplete(Record, Event):
+    """An action finished executing: a process exited for good, a timer fired (or was cancelled).
+
+    As in launch, it is only emitted for an action that a handler was waiting for when the
+    action was visited.
+    """
+
+    _fields = ("action",)
+
+    def __init__(self, action: Any = None) -> None:
+        self.action = action
+
+
 class ProcessEvent(Record, Event):
     """Fields of ROS 2's process events: the action, the label, argv, cwd, env and pid."""
 

@@ -217,6 +217,15 @@ class Transition(Event):
         self.event = event
 
 
+class Completed(Event):
+    """An action a handler waited for when it was visited finished executing (ExecutionComplete)."""
+
+    __slots__ = ("action",)
+
+    def __init__(self, action: object) -> None:
+        self.action = action
+
+
 class Said(Event):
     """A line whose words come from elsewhere: the plan's warnings, LogInfo, a handler's error."""
 

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from mlaunch.launch import events as ev
 from mlaunch.launch.event_handlers import returned_entities
 from mlaunch.run.events import (
+    Completed,
     Event,
     Exited,
     LaunchEvent,
@@ -63,6 +64,26 @@ class LaunchHandlers:
             self._transition(event)
         elif isinstance(event, LaunchEvent):
             self._launch_event(event)
+        elif isinstance(event, Completed):
+            self._completed(event.action)
+
+    def wants_completion(self, action: object) -> bool:
+        """Whether a handler registered now waits for ``action`` to complete.
+
+        launch asks this as it visits an action: ExecutionComplete is emitted for it (when it
+        completes) only if so, and then every matching handler of that moment handles it.
+        """
+        return any(_completes(h, action) for h in self.handlers)
+
+    def _completed(self, action: object) -> None:
+        event = ev.ExecutionComplete(action=action)
+        for handler in list(self.handlers):
+            if not _completes(handler, action):
+                continue
+            if handler.once:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, event)
 
     def _launch_event(self, record: LaunchEvent) -> None:
         """launch's own events: Shutdown, ShutdownProcess, SignalProcess.
@@ -164,6 +185,21 @@ class LaunchHandlers:
             if entities and handler.body is not None:
                 body = handler.body
                 self.supervisor.fire(Deferred(entities, body.context, body.origin), event)
+
+
+class _Target:
+    """An action in the place of a ProcessSpec, for handler matchers (they read ``.action``)."""
+
+    __slots__ = ("action",)
+
+    def __init__(self, action: object) -> None:
+        self.action = action
+
+
+def _completes(handler: AddHandler, action: object) -> bool:
+    if handler.kind != "execution_complete":
+        return False
+    return handler.matcher is None or bool(handler.matcher(_Target(action)))
 
 
 def _details(process: Process) -> dict[str, Any]:

@@ -250,8 +250,8 @@ class Log(Step):
 
 
 class StartTimer(Step):
-    __slots__ = ("body", "cancel_on_shutdown", "period")
-    _fields = (*Step._fields, "period", "body", "cancel_on_shutdown")
+    __slots__ = ("action", "body", "cancel_on_shutdown", "period")
+    _fields = (*Step._fields, "period", "body", "cancel_on_shutdown", "action")
 
     def __init__(
         self,
@@ -259,11 +259,13 @@ class StartTimer(Step):
         period: float = 0.0,
         body: Deferred | None = None,
         cancel_on_shutdown: bool = True,
+        action: Any = None,
     ) -> None:
         self.origin = origin
         self.period = period
         self.body = body
         self.cancel_on_shutdown = cancel_on_shutdown
+        self.action = action  # the TimerAction (OnExecutionComplete targets it)
 
 
 class AddHandler(Step):

@@ -35,6 +35,7 @@ from collections.abc import Callable
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, exit_for_signal
 from mlaunch.run import guard as guards
 from mlaunch.run.events import (
+    Completed,
     Event,
     EventStream,
     Exited,
@@ -157,6 +158,8 @@ class Supervisor:
         self._skipped = 0  # starts a description asked for while shutting down
         self._kill_now = False
         self._marker_env = {guards.MARKER: self.run_id}
+        # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
+        self._awaited: set[int] = set()
 
     @property
     def handlers(self) -> list[AddHandler]:
@@ -289,18 +292,14 @@ class Supervisor:
             if step.spec is not None and self.shutting_down:
                 self._skipped += 1
             elif step.spec is not None:
+                if self.launch_handlers.wants_completion(step.spec.action):
+                    self._awaited.add(id(step.spec))  # ExecutionComplete once it exits for good
                 self.start(step.spec)
         elif isinstance(step, Log):
             # LogInfo is no event in launch: it is said as it is visited.
             self.events.say_now(Said(step.level, step.source, step.message))
         elif isinstance(step, StartTimer):
-            if step.body is not None:
-                body = step.body
-                self.schedule(
-                    step.period,
-                    lambda body=body: self.fire(body, None),  # type: ignore[misc]
-                    cancel_on_shutdown=step.cancel_on_shutdown,
-                )
+            self._start_timer(step)
         elif isinstance(step, AddHandler):
             self.launch_handlers.add(step)
         elif isinstance(step, RemoveHandler):
@@ -314,6 +313,20 @@ class Supervisor:
                 f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"
                 " whatever adds this kind of step must also handle it"
             )
+
+    def _start_timer(self, step: StartTimer) -> None:
+        body, action = step.body, step.action
+        awaited = action is not None and self.launch_handlers.wants_completion(action)
+        if body is None and not awaited:
+            return
+
+        def expire() -> None:
+            if body is not None:
+                self.fire(body, None)
+            if awaited:
+                self.events.emit(Completed(action))
+
+        self.schedule(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
 
     def fire(self, body: Deferred, event: Any) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
@@ -417,6 +430,9 @@ class Supervisor:
                 self.exit_code = max(self.exit_code, EXIT_FAILURE)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
         self._maybe_respawn(process, code)
+        if id(spec) in self._awaited and self.records[spec.label].state != RESTARTING:
+            self._awaited.discard(id(spec))
+            self.events.emit(Completed(spec.action))
 
     def _maybe_respawn(self, process: Process, code: int) -> None:
         if self.shutting_down or process.stopping:
