@@ -164,3 +164,49 @@ def test_late_handlers_print_what_the_reference_ros2_launch_prints(tmp_path: Pat
     )
     assert done.returncode == 0, done.stderr
     assert _lines(done.stdout + done.stderr) == LATE_EXPECTED
+
+
+# --- what attaches to a run ------------------------------------------------------------------
+
+
+def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
+    from mlaunch.launch.actions import EmitEvent, ExecuteProcess, RegisterEventHandler, TimerAction
+    from mlaunch.launch.event_handlers import OnProcessExit
+    from mlaunch.launch_ros.events import ChangeState
+    from mlaunch.run.resolve import resolve
+
+    def needs(*entities: object) -> set[str]:
+        from mlaunch.launch.actions import LaunchDescription
+
+        return resolve(LaunchDescription(list(entities)), path=None, arguments={}, environ={}).needs
+
+    p = ExecuteProcess(cmd=["true"])
+    change = EmitEvent(event=ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=1))
+    assert needs(p, TimerAction(period=1.0, actions=[])) == set()
+    assert needs(change) == {"lifecycle"}
+    handler = RegisterEventHandler(OnProcessExit(target_action=p, on_exit=[change]))
+    assert needs(p, handler) == {"lifecycle"}  # deep in a handler that has not fired
+
+
+def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> None:
+    """A ChangeState from a handler written as a function: no need was visible before the run."""
+    from mlaunch.launch_ros.events import ChangeState
+    from mlaunch.options import Options
+    from mlaunch.ros.lifecycle import LifecycleManager
+    from mlaunch.run import pipeline
+    from mlaunch.run.events import LaunchEvent
+
+    h = Harness(Plan())
+    run = pipeline.Run(Options("x.launch.py"), h.sup.plan, h.sup)
+    watch = pipeline.lifecycle(run)
+    assert run.lifecycle is None
+    event = ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=3)
+    h.sup.events.emit(LaunchEvent(event))
+    try:
+        assert isinstance(run.lifecycle, LifecycleManager)
+        assert "has no handler" not in h.text
+        assert "matched no running lifecycle node" in h.text  # the manager took it
+    finally:
+        close = getattr(watch, "close", None)
+        assert close is not None
+        close()

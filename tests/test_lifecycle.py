@@ -22,8 +22,6 @@ from mlaunch.ros.lifecycle import (
     LifecycleSequence,
     LoopCall,
     SequenceStep,
-    attach,
-    plan_needs_lifecycle,
     sequence_from_arguments,
 )
 from mlaunch.run.resolve import resolve
@@ -101,17 +99,12 @@ def test_plain_plans_attach_nothing_and_lifecycle_plans_attach_without_rclpy() -
     from mlaunch.launch.actions import ExecuteProcess, TimerAction
 
     plain = _plan(ExecuteProcess(cmd=["true"]), TimerAction(period=1.0, actions=[]))
-    assert not plan_needs_lifecycle(plain)
-
-    class FakeSupervisor:
-        plan = plain
-
-    assert attach(None, FakeSupervisor()) is None  # type: ignore[arg-type]
+    assert "lifecycle" not in plain.needs
 
     code = f"""
 import sys
 from mlaunch.launch.actions import LaunchDescription, TimerAction
-from mlaunch.ros.lifecycle import attach, plan_needs_lifecycle
+from mlaunch.ros.lifecycle import attach
 from mlaunch.run.output import Printer
 from mlaunch.run.resolve import resolve
 from mlaunch.launch_ros.actions import LifecycleNode
@@ -119,8 +112,8 @@ from mlaunch.run.supervisor import Supervisor
 node = LifecycleNode(executable={sys.executable!r}, name="cam", namespace="r", autostart=True)
 ld = LaunchDescription([TimerAction(period=5.0, actions=[node])])
 plan = resolve(ld, path=None, arguments={{}}, environ={{}})
-assert plan_needs_lifecycle(plan), "a LifecycleNode inside a timer counts"
-manager = attach(None, Supervisor(plan, Printer(out=lambda b: None), install_signals=False))
+assert "lifecycle" in plan.needs, "a LifecycleNode inside a timer counts"
+manager = attach({{}}, Supervisor(plan, Printer(out=lambda b: None), install_signals=False))
 assert manager is not None
 manager.close()
 print("rclpy" in sys.modules)

@@ -16,8 +16,8 @@ from mlaunch.errors import MlaunchError, UsageError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.cli import Options
     from mlaunch.export.systemd import Export, Unit
+    from mlaunch.options import Options
     from mlaunch.run.plan import Deferred, Plan
 
 FORMATS = ("systemd",)
@@ -46,6 +46,8 @@ def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
 
 def main(args: Sequence[str]) -> int:
     """``mlaunch export ARGS``: through mlaunch's main, which prints errors and gives the status."""
+    # Through the one main that prints errors and gives the status: this runs the subcommand
+    # on its own (tests, a script), so it calls back up to the command line on purpose.
     from mlaunch import cli
 
     return cli.main(["export", *args])
@@ -53,7 +55,7 @@ def main(args: Sequence[str]) -> int:
 
 def command(args: Sequence[str]) -> int:
     """``mlaunch export``'s work; errors go up to mlaunch.cli.main."""
-    from mlaunch import cli
+    from mlaunch.options import parse_options
 
     try:
         settings, rest = parse(list(args))
@@ -65,24 +67,25 @@ def command(args: Sequence[str]) -> int:
     if not rest:
         raise UsageError(f"a launch file is needed: {USAGE}")
     try:
-        opts = cli.parse_options(rest)
+        opts = parse_options(rest)
     except SystemExit as e:
         return int(e.code or 0)
     return export_systemd(opts, settings, out_dir)
 
 
 def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) -> int:
-    from mlaunch import cli
     from mlaunch.export import systemd
+    from mlaunch.run import pipeline
+    from mlaunch.run.lifeline import private_temp_dir, remove_private_dir
     from mlaunch.run.resolve import resolve_deferred
 
     if os.path.isdir(out_dir) and os.listdir(out_dir) and not settings.force:
         raise UsageError(f"{out_dir!r} is not empty; choose an empty directory or pass --force")
-    path, description = cli.load_target(opts)
+    path, description = pipeline.load_target(opts)
     prefix = systemd.unit_name(settings.name or _stem(path))
-    temp_dir = cli.private_temp_dir()
+    temp_dir = private_temp_dir()
     try:
-        plan, options, labels = cli.resolve_for_run(
+        plan, options, labels = pipeline.resolve_for_run(
             opts, path, description, temp_dir=temp_dir, log_dir=""
         )
 
@@ -101,7 +104,7 @@ def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) ->
             raise MlaunchError(f"{path}: the launch starts no process; nothing to export")
         write_units(export, units, out_dir, settings, path, prefix)
     finally:
-        cli.remove_private_dir(temp_dir)
+        remove_private_dir(temp_dir)
     for warning in export.warnings:
         print(f"mlaunch export: warning: {warning}", file=sys.stderr)
     print(f"wrote {len(units)} services and {prefix}.target to {out_dir} (see its README.md)")

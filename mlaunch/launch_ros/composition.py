@@ -39,6 +39,7 @@ class LoadComponents(Note):
 
     __slots__ = ("requests", "target")
     _fields = (*Note._fields, "target", "requests")
+    needs = frozenset({"components"})  # the run attaches the LoadNode driver (Plan.needs)
 
     def __init__(
         self, origin: str = "", target: str = "", requests: tuple[LoadRequest, ...] = ()

@@ -52,6 +52,7 @@ class ChangeState(Event):
     """A request to move the matched lifecycle nodes through one transition."""
 
     name = "launch_ros.events.lifecycle.ChangeState"
+    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
     valid_transitions = TRANSITIONS
     valid_states = STATES
 
@@ -111,6 +112,7 @@ class OnStateTransition(EventHandler):
     """
 
     kind = "state_transition"
+    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
 
     def __init__(
         self,

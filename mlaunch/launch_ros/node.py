@@ -351,6 +351,7 @@ class LifecycleNode(Node):
     it once it is up (driving the transitions is the supervisor's lifecycle support)."""
 
     is_lifecycle = True
+    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
 
     def __init__(
         self,

@@ -109,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def show_arguments(description: LaunchDescriptionEntity, path: str) -> None:
-    from mlaunch.cli import format_arguments
+    from mlaunch.run.describe import format_arguments
     from mlaunch.run.resolve import collect_arguments
 
     infos = collect_arguments(description, path=path, arguments={}, environ=os.environ)

@@ -1,6 +1,6 @@
 """Managed (lifecycle) nodes in a running launch: bring-up, launch_ros's events, ordered sequences.
 
-What it does, attached to the supervisor when the plan has lifecycle nodes (extensions.ATTACH):
+What it does, attached to the supervisor by the pipeline when the plan needs it (Plan.needs):
 
 - ``LifecycleNode(..., autostart=True)`` (``lifecycle_node autostart="true"`` in YAML/XML) is
   driven to ``active`` once its process starts: its ``get_state``/``change_state`` services are
@@ -49,7 +49,7 @@ from mlaunch.run.events import (
     Started,
     Transition,
 )
-from mlaunch.run.plan import AddHandler, EmitEvent, Note, ProcessSpec, StartTimer
+from mlaunch.run.plan import SEQUENCE_ARGUMENT, Note, ProcessSpec
 
 if TYPE_CHECKING:
     from mlaunch.ros.bridge import RosGraph, TransitionResult
@@ -63,7 +63,6 @@ DEFAULT_TIMEOUT = 20.0
 STATE_ATTEMPT = 2.0
 # At shutdown each active node gets this long to deactivate before its stop ladder starts.
 DEACTIVATE_TIMEOUT = 3.0
-SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
 SOURCE = "lifecycle"
 # What a node needs, from each state, to become active.
 TO_ACTIVE: dict[str, tuple[str, ...]] = {
@@ -182,6 +181,8 @@ class SequenceStep(Note):
     """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order (a Note: the
     lifecycle manager reads it from the plan)."""
 
+    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
+
     origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     nodes: tuple[str, ...] = ()
     shutdown_on_failure: bool = True
@@ -195,6 +196,8 @@ class LifecycleSequence(Action):
     where the action stands. ``timeout`` bounds each node's wait for its services and each of its
     transitions. With ``shutdown_on_failure`` a failed transition ends the launch (status 1).
     """
+
+    needs = frozenset({"lifecycle"})  # seen in deferred bodies too (Plan.needs)
 
     def __init__(
         self,
@@ -338,7 +341,7 @@ class LifecycleManager:
         self._in_sequence = {name for seq in self.sequences for name in seq.nodes}
         for spec in supervisor.plan.processes():
             self._track(spec)
-        supervisor.events.subscribe(self._on_event)
+        supervisor.events.subscribe(self.on_event)
         self._check_sequences()
         if self.sequences:
             # First thing in the loop, after the plan's processes are started.
@@ -376,8 +379,11 @@ class LifecycleManager:
 
     # --- the supervisor's events (loop thread) -------------------------------------------------
 
-    def _on_event(self, event: Event) -> None:
-        """The subscription: processes starting and exiting, ChangeState, the shutdown."""
+    def on_event(self, event: Event) -> None:
+        """The subscription: processes starting and exiting, ChangeState, the shutdown.
+
+        A manager attached during the run is handed the record that showed it was needed.
+        """
         if isinstance(event, Started):
             self._on_process(False, event.process)
         elif isinstance(event, Exited):
@@ -677,62 +683,19 @@ def _graph_environ(supervisor: Supervisor) -> dict[str, str]:
     return dict(os.environ)
 
 
-# --- deciding whether to attach -------------------------------------------------------------------
+# --- attaching -----------------------------------------------------------------------------------
 
 
-def plan_needs_lifecycle(plan: Any) -> bool:
-    """Whether anything in the plan (deferred parts included) is about lifecycle nodes."""
-    for step in plan.steps:
-        if isinstance(step, SequenceStep):
-            return True
-        if isinstance(step, EmitEvent) and type(step.event).__name__ == "ChangeState":
-            return True
-        if isinstance(step, AddHandler) and step.kind == "state_transition":
-            return True
-        spec = getattr(step, "spec", None)
-        if spec is not None and spec.node is not None and spec.node.lifecycle:
-            return True
-        body = step.body if isinstance(step, (StartTimer, AddHandler)) else None
-        if body is not None and _mentions_lifecycle(body.entities, 0):
-            return True
-        on_exit = spec.on_exit if spec is not None else None
-        if on_exit is not None and _mentions_lifecycle(on_exit.entities, 0):
-            return True
-    return False
+def attach(arguments: Mapping[str, str], supervisor: Supervisor) -> LifecycleManager:
+    """The pipeline's lifecycle part: a manager with the plan's sequences (and the argument's).
 
-
-def _mentions_lifecycle(entities: Iterable[Any], depth: int) -> bool:
-    if depth > 20:
-        return False
-    for entity in entities:
-        if getattr(entity, "is_lifecycle", False) or isinstance(entity, LifecycleSequence):
-            return True
-        if type(getattr(entity, "event", None)).__name__ == "ChangeState":
-            return True
-        if getattr(getattr(entity, "event_handler", None), "kind", "") == "state_transition":
-            return True
-        children: list[Any] = []
-        get = getattr(entity, "get_sub_entities", None)
-        if get is not None:
-            children += list(get())
-        children += list(getattr(entity, "entities", []) or [])
-        handler = getattr(entity, "event_handler", None)
-        if handler is not None:
-            children += list(getattr(handler, "entities", []) or [])
-        if children and _mentions_lifecycle(children, depth + 1):
-            return True
-    return False
-
-
-def attach(options: Any, supervisor: Supervisor) -> LifecycleManager | None:
-    """extensions.ATTACH entry: a LifecycleManager when the plan has lifecycle work, else None."""
+    ``arguments``: the command line's launch arguments (``mlaunch_lifecycle_sequence:=...``).
+    """
     plan = supervisor.plan
     sequences = [s for s in plan.steps if isinstance(s, SequenceStep)]
-    from_argument = sequence_from_arguments(plan.arguments, getattr(options, "arguments", {}))
+    from_argument = sequence_from_arguments(plan.arguments, arguments)
     if from_argument is not None:
         sequences.append(from_argument)
-    if not sequences and not plan_needs_lifecycle(plan):
-        return None
     return LifecycleManager(supervisor, sequences=sequences)
 
 

@@ -82,6 +82,8 @@ def _format_for(opts: argparse.Namespace) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     """``mlaunch convert ...``: 0 written, 2 bad input (one line on stderr), through mlaunch's
     main, which prints errors and gives the status."""
+    # Through the one main that prints errors and gives the status: this runs the subcommand
+    # on its own (tests, a script), so it calls back up to the command line on purpose.
     from mlaunch import cli
 
     return cli.main(["convert", *(sys.argv[1:] if argv is None else argv)])

@@ -1,12 +1,14 @@
-"""--print: the resolved plan as text a person reads (and greps): what ros2 launch lacks."""
+"""--print and --show-args: the resolved plan and the arguments, as text a person reads."""
 
 from __future__ import annotations
 
 import os
 import shlex
+from collections.abc import Sequence
 
 from mlaunch.run.plan import (
     AddHandler,
+    ArgumentInfo,
     EmitEvent,
     Log,
     Plan,
@@ -165,3 +167,40 @@ def _rel(path: str) -> str:
     except ValueError:
         return path
     return rel if not rel.startswith("../../") else path
+
+
+def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
+    """The --show-args table: name, default, description (and choices), conditional marked."""
+    if not infos:
+        return "No arguments.\n"
+    import textwrap
+
+    rows = []
+    any_conditional = False
+    for info in infos:
+        name = info.name + ("*" if info.conditional else "")
+        any_conditional |= info.conditional
+        default = "(required)" if info.default is None else repr(info.default)
+        rows.append((name, default, info.description))
+    w_name = max(len("name"), *(len(r[0]) for r in rows))
+    w_def = min(36, max(len("default"), *(len(r[1]) for r in rows)))
+    width = max(40, _terminal_width() - w_name - w_def - 6)
+    out = ["Arguments (pass arguments as '<name>:=<value>'):", ""]
+    out.append(f"  {'name':<{w_name}}  {'default':<{w_def}}  description")
+    out.append(f"  {'-' * w_name}  {'-' * w_def}  {'-' * min(width, 40)}")
+    for name, default, description in rows:
+        lines = textwrap.wrap(description, width) or [""]
+        shown = default if len(default) <= w_def else default[: w_def - 3] + "..."
+        out.append(f"  {name:<{w_name}}  {shown:<{w_def}}  {lines[0]}")
+        pad = " " * (w_name + w_def + 6)
+        out.extend(pad + line for line in lines[1:])
+    if any_conditional:
+        out += ["", "* argument(s) which are only used if specific conditions occur"]
+    return "\n".join(out) + "\n"
+
+
+def _terminal_width() -> int:
+    try:
+        return os.get_terminal_size(1).columns
+    except OSError:
+        return 100

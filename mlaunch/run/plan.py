@@ -330,6 +330,25 @@ class Note(Step):
     """
 
 
+# What a run may need attached besides the supervisor (Plan.needs): "lifecycle" driving.
+NO_NEEDS: frozenset[str] = frozenset()
+# The YAML/XML form of a LifecycleSequence: a launch argument listing the nodes.
+SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
+
+
+def step_needs(step: Step) -> frozenset[str]:
+    """What a step needs attached to the run: a lifecycle node's spawn, a ChangeState, an
+    OnStateTransition handler and a LifecycleSequence need lifecycle driving."""
+    if isinstance(step, Spawn):
+        node = step.spec.node if step.spec is not None else None
+        return frozenset({"lifecycle"}) if node is not None and node.lifecycle else NO_NEEDS
+    if isinstance(step, AddHandler):
+        return frozenset(getattr(step.handler, "needs", NO_NEEDS))
+    if isinstance(step, EmitEvent):
+        return frozenset(getattr(step.event, "needs", NO_NEEDS))
+    return frozenset(getattr(step, "needs", NO_NEEDS))
+
+
 class ArgumentInfo(Record):
     """A declared launch argument, for --show-args and CLI checks."""
 
@@ -354,7 +373,10 @@ class ArgumentInfo(Record):
 
 
 class Plan(Record):
-    _fields = ("steps", "arguments", "warnings", "temp_dir")
+    """The resolved launch: its steps in order, its arguments, warnings, and ``needs``: what
+    must attach to the run (``"lifecycle"``), noted by resolve as it adds and defers steps."""
+
+    _fields = ("steps", "arguments", "warnings", "temp_dir", "needs")
     __slots__ = _fields
 
     def __init__(
@@ -363,11 +385,13 @@ class Plan(Record):
         arguments: dict[str, ArgumentInfo] | None = None,
         warnings: list[str] | None = None,
         temp_dir: str | None = None,
+        needs: set[str] | None = None,
     ) -> None:
         self.steps: list[Step] = [] if steps is None else steps
         self.arguments: dict[str, ArgumentInfo] = {} if arguments is None else arguments
         self.warnings: list[str] = [] if warnings is None else warnings
         self.temp_dir = temp_dir
+        self.needs: set[str] = set() if needs is None else needs
 
     def processes(self) -> list[ProcessSpec]:
         return [s.spec for s in self.steps if isinstance(s, Spawn) and s.spec is not None]

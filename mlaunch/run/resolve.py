@@ -16,7 +16,7 @@ from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
 from mlaunch.origin import user_location
 from mlaunch.record import Record
-from mlaunch.run.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step
+from mlaunch.run.plan import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step, step_needs
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -131,6 +131,9 @@ class Resolver:
 
     def add(self, step: Step) -> None:
         self.plan.steps.append(step)
+        needs = step_needs(step)
+        if needs:
+            self.plan.needs.update(needs)
 
     def spawn(self, spec: ProcessSpec) -> None:
         self.add(Spawn(origin=spec.origin, spec=spec))
@@ -142,8 +145,11 @@ class Resolver:
         return self.labels.next(base)
 
     def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
+        entities = list(entities)
+        # Resolved only when they fire: what they may need must be known before the run.
+        _note_needs(entities, self.plan.needs)
         return Deferred(
-            entities=list(entities),
+            entities=entities,
             context=self.context.snapshot(),
             origin=origin,
             callback=callback,
@@ -202,6 +208,33 @@ class Resolver:
             problem = "does not exist" if not os.path.exists(program) else "is not executable"
             raise PackageNotFoundError(f"program {program!r} {problem}{hint}", where=origin)
         raise PackageNotFoundError(f"program {program!r} not found on the PATH{hint}", where=origin)
+
+
+def _note_needs(entities: Iterable[Any], needs: set[str]) -> None:
+    """Add what ``entities`` (a timer's or handler's, not yet resolved) and theirs may need.
+
+    An entity says so with a ``needs`` attribute (LifecycleNode, LifecycleSequence), or its
+    event or event handler does (ChangeState, OnStateTransition). A handler written as a
+    function is opaque until it runs; the pipeline watches for what it starts instead.
+    """
+    stack = list(entities)
+    seen: set[int] = set()
+    while stack:
+        entity = stack.pop()
+        if id(entity) in seen:
+            continue  # a handler may list itself among what it registers
+        seen.add(id(entity))
+        handler = getattr(entity, "event_handler", None)
+        for owner in (entity, getattr(entity, "event", None), handler):
+            found = getattr(owner, "needs", None)
+            if found:
+                needs.update(found)
+        get = getattr(entity, "get_sub_entities", None)
+        if get is not None:
+            stack.extend(get())
+        stack.extend(getattr(entity, "entities", None) or ())
+        if handler is not None:
+            stack.extend(getattr(handler, "entities", None) or ())
 
 
 def _short(entity: Any) -> str:

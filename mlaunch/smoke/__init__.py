@@ -457,6 +457,8 @@ def parse_settings(args: Sequence[str]) -> Settings:
 
 def main(args: Sequence[str]) -> int:
     """``mlaunch test ARGS``: through mlaunch's main, which prints errors and gives the status."""
+    # Through the one main that prints errors and gives the status: this runs the subcommand
+    # on its own (tests, a script), so it calls back up to the command line on purpose.
     from mlaunch import cli
 
     return cli.main(["test", *args])
@@ -464,7 +466,8 @@ def main(args: Sequence[str]) -> int:
 
 def command(args: Sequence[str]) -> int:
     """``mlaunch test``'s work; errors go up to mlaunch.cli.main."""
-    from mlaunch import cli
+    from mlaunch.options import parse_options
+    from mlaunch.run import pipeline
 
     args = list(args)
     from mlaunch.launch_testing.launch_test import is_launch_test_file
@@ -477,13 +480,13 @@ def command(args: Sequence[str]) -> int:
     mine, rest = split_arguments(args)
     try:
         settings = parse_settings(mine)
-        opts = cli.parse_options(rest) if rest else None
+        opts = parse_options(rest) if rest else None
     except SystemExit as e:  # argparse: --help (0) or a usage error (2), already printed
         return int(e.code or 0)
     if opts is None:
         raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
     if opts.show_args or opts.print_plan:
-        return cli.run_cli(rest)
+        return pipeline.launch(opts, pipeline.standard_parts(opts))
     return run(opts, settings)
 
 
@@ -492,16 +495,16 @@ def command(args: Sequence[str]) -> int:
 
 def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
-    from mlaunch import cli
     from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.run import pipeline
     from mlaunch.run.lifeline import Lifeline
     from mlaunch.run.logfiles import make_run_log_dir
 
     with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
-        path, description = cli.load_target(opts)
+        path, description = pipeline.load_target(opts)
         collector = _CollectConfigurations()
         log_dir = make_run_log_dir(os.environ)
-        plan, options, labels = cli.resolve_for_run(
+        plan, options, labels = pipeline.resolve_for_run(
             opts,
             path,
             LaunchDescription([description, collector]),
@@ -594,31 +597,22 @@ def supervise(
     expectations: list[Expectation],
     life: Lifeline,
 ) -> int:
-    """Run the plan through ``mlaunch FILE``'s own supervise(), with the smoke checks attached.
+    """Run the plan as ``mlaunch FILE`` would (the same parts attached), plus the smoke checks.
 
-    The checks join extensions.ATTACH for this run only (last, so the lifecycle manager, if
-    any, already exists), which keeps every supervision detail (guard, printer, status view,
-    exit summary) exactly that of a normal run.
+    The checks attach last, so lifecycle driving, if the plan needs it, already exists and its
+    ROS graph is shared.
     """
-    from mlaunch import cli
-    from mlaunch.run import extensions
+    from mlaunch.run import pipeline
 
     runs: list[SmokeRun] = []
 
-    def attach(_opts: Any, supervisor: Supervisor) -> SmokeRun:
-        from mlaunch.ros.lifecycle import LifecycleManager
-
-        owners = (getattr(s, "__self__", None) for s in supervisor.events.subscribers)
-        lifecycle = next((o for o in owners if isinstance(o, LifecycleManager)), None)
-        smoke = SmokeRun(supervisor, expectations, settings, lifecycle=lifecycle)
+    def attach(run: pipeline.Run) -> SmokeRun:
+        smoke = SmokeRun(run.supervisor, expectations, settings, lifecycle=run.lifecycle)
         runs.append(smoke)
         return smoke
 
-    extensions.ATTACH.append(attach)
-    try:
-        code = cli.supervise(opts, plan, options, labels, log_dir, life)
-    finally:
-        extensions.ATTACH.remove(attach)
+    parts = [*pipeline.standard_parts(opts), attach]
+    code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
     if not runs:
         return code
     smoke = runs[0]
