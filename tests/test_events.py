@@ -80,6 +80,14 @@ def test_a_subscriber_that_raises_leaves_the_stream_usable() -> None:
     assert [type(e) for e in seen] == [ShutdownBegun]
 
 
+def test_notes_are_passed_over_and_other_unknown_steps_refused() -> None:
+    """A Note (a container's component loads) is for what attaches; nothing else is skipped."""
+    from mlaunch.launch_ros.composition import LoadComponents
+
+    h = Harness(Plan(steps=[LoadComponents(origin="c.launch.py:1", target="/container")]))
+    assert h.run() == 0
+
+
 def test_the_supervisor_refuses_a_step_kind_it_does_not_know() -> None:
     class Mystery(Step):
         __slots__ = ()
