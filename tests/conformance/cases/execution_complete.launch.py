@@ -9,7 +9,8 @@ def generate_launch_description():
     rec = ExecutableInPackage("recorder", "conf_pkg")
     timer = TimerAction(period=0.1, actions=[])
     early = ExecuteProcess(cmd=[rec, "early"], name="early")
-    late = ExecuteProcess(cmd=[rec, "late"], name="late")
+    # It lingers past the timer, so the two completions come in one order under any load.
+    late = ExecuteProcess(cmd=[rec, "late", "--linger", "0.5"], name="late")
     return LaunchDescription(
         [
             RegisterEventHandler(
