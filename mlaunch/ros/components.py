@@ -159,7 +159,7 @@ class ComponentLoader:
 
 
 class ComponentDriver:
-    """extensions.ATTACH part: loads the plan's LoadComponents steps once the run starts.
+    """The pipeline's components part: loads the plan's LoadComponents steps once the run starts.
 
     Lines go to the run's output from the supervisor's loop thread (the printer is not shared
     across threads). Loads of deferred parts (a LoadComposableNodes in a timer or an event
@@ -199,7 +199,7 @@ class ComponentDriver:
 
 
 def attach(options: Any, supervisor: Any) -> ComponentDriver | None:
-    """extensions.ATTACH entry: a driver when the plan loads composable nodes, else None."""
+    """The pipeline's components part: a driver when the plan loads composable nodes, else None."""
     steps = [s for s in supervisor.plan.steps if isinstance(s, LoadComponents)]
     if not steps:
         return None
