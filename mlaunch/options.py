@@ -93,7 +93,7 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         description="Run a ROS 2 launch file (Python, YAML, XML or ROS 1 XML) and supervise it.",
         epilog="Subcommands: 'mlaunch test FILE ...' (CI smoke run), 'mlaunch convert FILE' "
         "(ROS 1 -> ROS 2). Exit status: 0 ok, 1 a required process failed, 2 bad input, "
-        "130 interrupted.",
+        "70 an internal error of mlaunch, 128+N stopped by signal N (130 Ctrl-C).",
     )
     parser.add_argument(
         "target", help="launch file, or package name followed by a launch file name"
@@ -158,13 +158,32 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
     )
     parser.add_argument("--status", action="store_true", help="live status view of the processes")
     parser.add_argument(
-        "-q", "--quiet", action="store_true", help="only warnings and errors from mlaunch itself"
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="only warnings and errors from mlaunch itself, and the processes' stderr",
     )
-    parser.add_argument("--color", choices=("auto", "always", "never"), default="auto")
     parser.add_argument(
-        "--log-max-bytes", type=int, default=None, help="rotate log files at this size"
+        "--color",
+        choices=("auto", "always", "never"),
+        default="auto",
+        help="color the output (default: auto, when stdout is a terminal and NO_COLOR is unset)",
     )
+    parser.add_argument(
+        "--log-max-bytes",
+        type=int,
+        default=None,
+        metavar="N",
+        help="rotate each log file at N bytes, 0 never (default: 67108864, 64 MiB)",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     return parser
+
+
+def _version() -> str:
+    from mlaunch import __version__
+
+    return __version__
 
 
 # Options that take a value: the token after them is theirs even if it contains ":=".

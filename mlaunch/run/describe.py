@@ -190,10 +190,13 @@ def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
     out.append(f"  {'-' * w_name}  {'-' * w_def}  {'-' * min(width, 40)}")
     for name, default, description in rows:
         lines = textwrap.wrap(description, width) or [""]
-        shown = default if len(default) <= w_def else default[: w_def - 3] + "..."
-        out.append(f"  {name:<{w_name}}  {shown:<{w_def}}  {lines[0]}")
-        pad = " " * (w_name + w_def + 6)
-        out.extend(pad + line for line in lines[1:])
+        # A long default wraps in its column rather than being cut: it is often a path to copy.
+        defaults = [default[i : i + w_def] for i in range(0, len(default), w_def)]
+        for i in range(max(len(lines), len(defaults))):
+            left = name if i == 0 else ""
+            shown = defaults[i] if i < len(defaults) else ""
+            text = lines[i] if i < len(lines) else ""
+            out.append(f"  {left:<{w_name}}  {shown:<{w_def}}  {text}".rstrip())
     if any_conditional:
         out += ["", "* argument(s) which are only used if specific conditions occur"]
     return "\n".join(out) + "\n"
@@ -201,6 +204,6 @@ def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
 
 def _terminal_width() -> int:
     try:
-        return os.get_terminal_size(1).columns
+        return os.get_terminal_size(1).columns or 100  # 0 from some pseudo-terminals
     except OSError:
         return 100

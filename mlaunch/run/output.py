@@ -223,7 +223,8 @@ class Printer:
     def output(self, label: str, stream: str, mode: str, data: bytes) -> None:
         """Complete lines from a process (bytes ending in newline)."""
         data = clean(data)
-        if stream in SCREEN_STREAMS.get(mode, ()) and not self.quiet:
+        # -q quiets mlaunch's own messages and children's stdout; their stderr stays visible.
+        if stream in SCREEN_STREAMS.get(mode, ()) and (not self.quiet or stream == "stderr"):
             if self._write is self._screen:
                 # Counted per process, for per-process flow control (Screen.holding).
                 self._screen.write(prefix_lines(self._prefix[label], data), source=label)

@@ -320,10 +320,17 @@ def _package_search(options: ResolveOptions, context: LaunchContext) -> _NoSearc
     return searching(options.packages)
 
 
+# Launch configurations that launch itself reads (ExecuteProcess's prefix, set by
+# --launch-prefix/--launch-prefix-filter or as name:=value): given undeclared on purpose.
+BUILTIN_CONFIGURATIONS = frozenset({"launch-prefix", "launch-prefix-filter"})
+
+
 def undeclared_argument_warnings(
     given: Mapping[str, str], declared: Mapping[str, ArgumentInfo]
 ) -> list[str]:
-    undeclared = [name for name in given if name not in declared]
+    undeclared = [
+        name for name in given if name not in declared and name not in BUILTIN_CONFIGURATIONS
+    ]
     if not undeclared:  # the common case imports nothing more (start-up budget)
         return []
     from mlaunch.frontends.suggest import Suggester

@@ -129,11 +129,13 @@ class ExitSummary:
 
 
 def terminal_size(fd: int = 1) -> tuple[int, int]:
+    """(columns, lines) of the terminal; 80x24 when it reports 0x0 (some pseudo-terminals
+    and serial consoles do), so the table never draws into nothing."""
     try:
         size = os.get_terminal_size(fd)
-        return size.columns, size.lines
     except OSError:
         return 100, 30
+    return size.columns or 80, size.lines or 24
 
 
 class StatusView:

@@ -343,7 +343,8 @@ def build_parser() -> argparse.ArgumentParser:
         usage="mlaunch test FILE [name:=value ...] [options of mlaunch FILE] [test options]",
         description="Start a launch, wait until it is ready, hold it, stop it: exit 0 when"
         " every expectation held, 1 otherwise (with a table of expected vs seen).",
-        epilog=_HELP[_HELP.index("Ready means") :]
+        # The docstring's reStructuredText quoting means nothing on a terminal.
+        epilog=_HELP[_HELP.index("Ready means") :].replace("``", "")
         + "\nEvery option of 'mlaunch FILE' is accepted too (see mlaunch --help).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )

@@ -1,0 +1,112 @@
+"""What a new user's trial of every README feature found: each fix, pinned."""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from procutil import clean_env, run_mlaunch
+
+from mlaunch import __version__
+from mlaunch.run import describe, status
+from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
+from mlaunch.run.output import Printer
+
+PY = sys.executable
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+
+
+def test_launch_prefix_options_are_not_undeclared_arguments(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    path = tmp_path / "p.launch.py"
+    path.write_text(
+        textwrap.dedent(
+            f"""
+            from launch import LaunchDescription
+            from launch.actions import ExecuteProcess
+
+            def generate_launch_description():
+                return LaunchDescription([
+                    ExecuteProcess(cmd=[{PY!r}, '-c', 'pass'], name='child', output='screen'),
+                ])
+            """
+        )
+    )
+    done = run_mlaunch(
+        str(path), "--launch-prefix", "env", "--launch-prefix-filter", "python.*", env=env
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "not declared" not in done.stdout + done.stderr
+    # The prefix was applied: env ran the child.
+    assert re.search(r"process started with pid \[\d+\]", done.stdout), done.stdout
+    # An argument that really is undeclared still warns.
+    done = run_mlaunch(str(path), "--launch-prefix", "env", "speed:=1", env=env)
+    assert "argument 'speed' is not declared" in done.stdout
+
+
+def test_status_falls_back_to_80x24_on_a_0x0_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(status.os, "get_terminal_size", lambda fd: os.terminal_size((0, 0)))
+    assert status.terminal_size() == (80, 24)
+    monkeypatch.setattr(status.os, "get_terminal_size", lambda fd: os.terminal_size((132, 50)))
+    assert status.terminal_size() == (132, 50)
+
+
+class _Info:
+    def __init__(self, name: str, default: str | None, description: str) -> None:
+        self.name = name
+        self.default = default
+        self.description = description
+        self.conditional = False
+
+
+def test_show_args_wraps_long_defaults(monkeypatch: pytest.MonkeyPatch) -> None:
+    long_default = "/opt/ros/jazzy/share/some_robot_description/urdf/robot_with_sensors.urdf"
+    for columns in (80, 300, 0):
+        monkeypatch.setattr(
+            describe.os, "get_terminal_size", lambda fd, c=columns: os.terminal_size((c, 24))
+        )
+        text = describe.format_arguments([_Info("model", long_default, "the robot model")])
+        assert "..." not in text
+        # The default column (after "  model  ", 36 wide) holds every character, in order.
+        rows = text.splitlines()[4:]
+        column = "".join(row[9 : 9 + 36].strip() for row in rows)
+        assert column == repr(long_default)
+
+
+def test_quiet_keeps_childrens_stderr() -> None:
+    seen: list[bytes] = []
+    printer = Printer(out=seen.append, quiet=True)
+    printer.register("child-1", 0)
+    printer.output("child-1", "stdout", "screen", b"chatter\n")
+    printer.output("child-1", "stderr", "screen", b"it broke\n")
+    printer.message("INFO", "launch", "process started")
+    shown = b"".join(seen)
+    assert b"[child-1] it broke\n" in shown
+    assert b"chatter" not in shown and b"process started" not in shown
+    printer.close()
+
+
+def test_version_and_help_defaults(env: dict[str, str]) -> None:
+    done = run_mlaunch("--version", env=env)
+    assert done.returncode == 0
+    assert done.stdout.strip() == f"mlaunch {__version__}"
+    helped = run_mlaunch("--help", env={**env, "COLUMNS": "200"})
+    assert "(default: auto" in helped.stdout
+    mib = DEFAULT_ROTATE_BYTES // (1024 * 1024)
+    assert f"(default: {DEFAULT_ROTATE_BYTES}, {mib} MiB)" in helped.stdout
+
+
+@pytest.mark.parametrize("sub", [[], ["test"], ["convert"], ["export"]])
+def test_help_has_no_restructuredtext_quoting(sub: list[str], env: dict[str, str]) -> None:
+    done = run_mlaunch(*sub, "--help", env=env)
+    assert done.returncode == 0, done.stderr
+    assert "``" not in done.stdout
