@@ -32,7 +32,7 @@ from mlaunch.run.process import (
     expand_core_pattern,
     utf8_safe_cut,
 )
-from mlaunch.run.records import FAILED, GAVE_UP
+from mlaunch.run.records import FAILED, FINISHED, GAVE_UP
 from mlaunch.run.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.run.screen import Screen
 from mlaunch.run.supervisor import Supervisor
@@ -239,6 +239,23 @@ def test_child_ignoring_sigint_and_sigterm_is_killed_within_its_timeouts() -> No
     assert any("failed to terminate 0.3 s after SIGINT, escalating to SIGTERM" in m for m in msgs)
     assert any("failed to terminate 0.3 s after SIGTERM, escalating to SIGKILL" in m for m in msgs)
     assert any(m.startswith("process stopped by SIGKILL") for m in msgs)
+
+
+@pytest.mark.parametrize("status", [130, 1])
+def test_a_child_that_exits_on_mlaunchs_signal_is_stopped_not_dead(status: int) -> None:
+    code = f"""
+    import os, signal, time
+    signal.signal(signal.SIGINT, lambda *_: os._exit({status}))
+    print("up", flush=True)
+    time.sleep(60)
+    """
+    h = Harness([make_spec("handler", code)])
+    h.when(b"up", h.shutdown)
+    assert h.run() == 0
+    msgs = h.messages("handler")
+    assert f"process stopped after SIGINT [pid {h.pid('handler')}, exit code {status}]" in msgs
+    assert "[ERROR]" not in h.text and not any("has died" in m for m in msgs)
+    assert h.sup.records["handler"].state == FINISHED
     assert h.elapsed < 5
 
 

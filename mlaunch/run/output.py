@@ -327,8 +327,15 @@ class Printer:
         if code == 0:
             self.message("INFO", label, f"process has finished cleanly [pid {pid}]")
             return
-        if process.stopping and code < 0 and -code in process.signals_sent:
-            self.message("INFO", label, f"process stopped by {signal_name(-code)} [pid {pid}]")
+        if process.stopping and process.signals_sent:
+            # mlaunch asked it to stop: whatever status its signal handler chose (130, 1, ...)
+            # is the answer to that request, not a death.
+            if code < 0 and -code in process.signals_sent:
+                text = f"process stopped by {signal_name(-code)} [pid {pid}]"
+            else:
+                sent = signal_name(process.signals_sent[-1])
+                text = f"process stopped after {sent} [pid {pid}, exit code {code}]"
+            self.message("INFO", label, text)
             return
         what = describe_status(code)
         if process.core_dumped:
