@@ -149,5 +149,15 @@ SUBSTITUTIONS = (
     "var",
 )
 
+# Registered in Jazzy but failing there (observed under the reference): name -> what happens.
+BROKEN_ACTIONS = {
+    "set_use_sim_time": "its frontend passes text where it wants a boolean, so it fails when run"
+    " (\"Type 'Type.BOOL' and value ... do not agree\"); use set_parameter use_sim_time",
+}
+BROKEN_SUBSTITUTIONS = {
+    "any": "its parser passes the arguments wrongly, so the file fails to load",
+    "all": "its parser passes the arguments wrongly, so the file fails to load",
+}
+
 # on_exit: the only value Jazzy's frontends accept.
 ON_EXIT_WORDS = ("shutdown",)

@@ -114,6 +114,8 @@ class _Walker:
         if table is None:
             self.add(e, f"Jazzy has no tag {e.tag!r}: ros2 launch rejects the file")
             return
+        if e.tag in jazzy.BROKEN_ACTIONS:
+            self.add(e, f"Jazzy's {e.tag} is broken: {jazzy.BROKEN_ACTIONS[e.tag]}")
         self.attributes(e, table)
         if e.tag == "include":
             self.include(e)
@@ -179,7 +181,10 @@ class _Walker:
 
     def substitutions(self, e: Entity, attr: Attr, text: str) -> None:
         for match in _SUBSTITUTION.finditer(text):
-            if match.group(1) not in jazzy.SUBSTITUTIONS:
+            broken = jazzy.BROKEN_SUBSTITUTIONS.get(match.group(1))
+            if broken:
+                self.add(e, f"Jazzy's $({match.group(1)} ...) is broken: {broken}", attr)
+            elif match.group(1) not in jazzy.SUBSTITUTIONS:
                 self.add(
                     e,
                     f"Jazzy has no substitution $({match.group(1)} ...): ros2 launch rejects it",

@@ -65,6 +65,16 @@ BAD = {
         "launch:\n- lifecycle_node: {pkg: p, exec: e, name: n, namespace: ''}\n",
         "no tag 'lifecycle_node'",
     ),
+    "xml_broken_any": (
+        "a.launch.xml",
+        '<launch><log message="$(any true false)"/></launch>',
+        "$(any ...) is broken",
+    ),
+    "yaml_broken_set_use_sim_time": (
+        "a.launch.yaml",
+        "launch:\n- set_use_sim_time: {value: 'true'}\n",
+        "set_use_sim_time is broken",
+    ),
     "python_name_jazzy_lacks": (
         "a.launch.py",
         "from launch import LaunchDescription\n"
