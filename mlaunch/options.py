@@ -45,6 +45,7 @@ class Options:
         self.check = check
         self.debug = debug
         self.use_sim_time = use_sim_time
+        self.capture = False  # --capture-at-definition (mlaunch.run.binding)
         self.package_path: list[str] = [] if package_path is None else package_path
         self.standins = standins
         self.status = status
@@ -137,6 +138,13 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         default=None,
         help="set the parameter use_sim_time on every node (use_sim_time:=true is an ordinary"
         " launch argument, as in ros2 launch)",
+    )
+    parser.add_argument(
+        "--capture-at-definition",
+        action="store_true",
+        help="resolve timers and event handlers with the values from where they are written,"
+        " not (as ros2 launch) when they fire; per file: a comment"
+        " 'mlaunch: capture-at-definition'",
     )
     parser.add_argument(
         "--package-path",
@@ -233,6 +241,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         color={"auto": None, "always": True, "never": False}[ns.color],
         log_max_bytes=ns.log_max_bytes,
     )
+    opts.capture = ns.capture_at_definition
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
         opts.second = rest.pop(0)

@@ -30,8 +30,15 @@ from mlaunch.launch.conditions import IfCondition, UnlessCondition
 from mlaunch.launch.event_handlers import OnProcessExit
 from mlaunch.launch.launch_description_sources import PythonLaunchDescriptionSource
 from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
+from mlaunch.run.binding import PRAGMA
 from mlaunch.run.plan import AddHandler, Log, Plan, StartTimer
-from mlaunch.run.resolve import ResolveOptions, collect_arguments, resolve
+from mlaunch.run.resolve import (
+    LabelCounter,
+    ResolveOptions,
+    collect_arguments,
+    resolve,
+    resolve_deferred,
+)
 
 ENV = {"PATH": os.environ["PATH"], "HOME": "/home/u"}
 
@@ -252,26 +259,63 @@ def test_opaque_function_exception_is_located() -> None:
     assert err.value.where and "test_resolve.py" in err.value.where
 
 
-def test_timers_and_handlers_capture_their_context() -> None:
+def _timer_and_handler(capture: bool) -> tuple[StartTimer, AddHandler, Plan]:
     proc = ExecuteProcess(cmd=["true"])
-    plan = run(
-        LaunchDescription(
-            [
-                SetLaunchConfiguration("v", "early"),
-                TimerAction(period=1.5, actions=[LogInfo(msg=LaunchConfiguration("v"))]),
-                RegisterEventHandler(OnProcessExit(target_action=proc, on_exit=[LogInfo(msg="x")])),
-                SetLaunchConfiguration("v", "late"),
-                proc,
-            ]
-        )
+    description = LaunchDescription(
+        [
+            SetLaunchConfiguration("v", "early"),
+            TimerAction(period=1.5, actions=[LogInfo(msg=LaunchConfiguration("v"))]),
+            RegisterEventHandler(OnProcessExit(target_action=proc, on_exit=[LogInfo(msg="x")])),
+            SetLaunchConfiguration("v", "late"),
+            proc,
+        ]
     )
+    options = ResolveOptions(capture=capture)
+    plan = resolve(description, path=None, arguments={}, environ=ENV, options=options)
     timer = next(s for s in plan.steps if isinstance(s, StartTimer))
     handler = next(s for s in plan.steps if isinstance(s, AddHandler))
+    return timer, handler, plan
+
+
+def test_timers_and_handlers_resolve_when_they_fire_as_launch_does() -> None:
+    timer, handler, plan = _timer_and_handler(capture=False)
     assert timer.period == 1.5 and timer.body is not None
-    # Captured where written: fixes ROS 2's L#501 (on_exit saw the last value).
-    assert timer.body.context.launch_configurations["v"] == "early"
+    fired = resolve_deferred(timer.body, labels=LabelCounter(), options=ResolveOptions())
+    (log,) = fired.steps
+    assert isinstance(log, Log) and log.message == "late"  # ros2 launch's late binding
+    (warning,) = fired.warnings
+    assert "launch configuration 'v' is 'early' where written, 'late' when it fires" in warning
     assert handler.kind == "process_exit" and handler.matcher is not None
     assert handler.matcher(plan.processes()[0])
+
+
+def test_capture_at_definition_keeps_the_values_where_written() -> None:
+    timer, _, _ = _timer_and_handler(capture=True)
+    assert timer.body is not None
+    # The opt-in fix of ROS 2's L#501: the value where the timer was written.
+    fired = resolve_deferred(timer.body, labels=LabelCounter(), options=ResolveOptions())
+    (log,) = fired.steps
+    assert isinstance(log, Log) and log.message == "early" and not fired.warnings
+
+
+def test_a_comment_in_the_file_asks_for_capture(tmp_path: Path) -> None:
+    path = write(
+        tmp_path,
+        "c.launch.yaml",
+        f"# {PRAGMA}\n"
+        """\
+        launch:
+        - let: {name: v, value: early}
+        - timer: {period: 1.0, children: [{log: {message: $(var v)}}]}
+        - let: {name: v, value: late}
+        """,
+    )
+    plan = resolve(frontends.load(path), path=path, arguments={}, environ={})
+    (timer,) = [s for s in plan.steps if isinstance(s, StartTimer)]
+    assert timer.body is not None
+    fired = resolve_deferred(timer.body, labels=LabelCounter(), options=ResolveOptions())
+    (log,) = fired.steps
+    assert isinstance(log, Log) and log.message == "early"
 
 
 def write(tmp: Path, name: str, text: str) -> str:

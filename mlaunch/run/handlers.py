@@ -184,7 +184,8 @@ class LaunchHandlers:
             entities = returned_entities(result)
             if entities and handler.body is not None:
                 body = handler.body
-                self.supervisor.fire(Deferred(entities, body.context, body.origin), event)
+                deferred = Deferred(entities, body.context, body.origin, captured=body.captured)
+                self.supervisor.fire(deferred, event)
 
 
 class _Target:

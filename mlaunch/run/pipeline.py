@@ -102,7 +102,10 @@ def resolve_for_run(
     from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
     options = ResolveOptions(
-        standins=opts.standins, packages=package_search(opts, path), temp_dir=temp_dir
+        standins=opts.standins,
+        packages=package_search(opts, path),
+        temp_dir=temp_dir,
+        capture=opts.capture,
     )
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions import with_use_sim_time

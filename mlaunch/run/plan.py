@@ -184,9 +184,12 @@ class ProcessSpec(Record):
 
 
 class Deferred(Record):
-    """Entities to resolve later, with the context they were written in."""
+    """Entities to resolve later: with the run's live context when they fire (launch's rule;
+    ``captured`` then holds the values where they were written, to warn where those differ),
+    or with a ``context`` frozen where they were written (``captured`` None; mlaunch.run.binding).
+    """
 
-    _fields = ("entities", "context", "origin", "callback")
+    _fields = ("entities", "context", "origin", "callback", "captured")
     __slots__ = _fields
 
     def __init__(
@@ -195,11 +198,13 @@ class Deferred(Record):
         context: LaunchContext,
         origin: str = "",
         callback: Any = None,  # callable(event, context) -> entities, as ROS 2 handlers accept
+        captured: LaunchContext | None = None,
     ) -> None:
         self.entities = entities
         self.context = context
         self.origin = origin
         self.callback = callback
+        self.captured = captured
 
     def describe(self) -> str:
         if self.callback is not None:

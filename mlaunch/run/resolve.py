@@ -44,7 +44,7 @@ class ResolveOptions(Record):
     None for the default search); ``temp_dir`` is where params files are written.
     """
 
-    _fields = ("standins", "packages", "temp_dir")
+    _fields = ("standins", "packages", "temp_dir", "capture")
     __slots__ = _fields
 
     def __init__(
@@ -52,10 +52,13 @@ class ResolveOptions(Record):
         standins: bool = True,
         packages: PackageSearch | None = None,
         temp_dir: str | None = None,
+        capture: bool = False,
     ) -> None:
         self.standins = standins
         self.packages = packages
         self.temp_dir = temp_dir
+        # Timers and handlers take the values where they were written (mlaunch.run.binding).
+        self.capture = capture
 
 
 class Resolver:
@@ -145,15 +148,15 @@ class Resolver:
         return self.labels.next(base)
 
     def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
+        from mlaunch.run.binding import file_captures
+
         entities = list(entities)
         # Resolved only when they fire: what they may need must be known before the run.
         _note_needs(entities, self.plan.needs)
-        return Deferred(
-            entities=entities,
-            context=self.context.snapshot(),
-            origin=origin,
-            callback=callback,
-        )
+        snapshot = self.context.snapshot()
+        if self.options.capture or (origin and file_captures(origin)):
+            return Deferred(entities, snapshot, origin, callback)
+        return Deferred(entities, self.context, origin, callback, captured=snapshot)
 
     def float_value(self, value: Any, what: str, origin: str) -> float:
         text = value if isinstance(value, (int, float)) else perform(self.context, value)
@@ -284,19 +287,33 @@ def resolve_deferred(
     event: Any = None,
 ) -> Plan:
     """Resolve a timer's or handler's entities now, in the context captured when registered."""
-    context = deferred.context.snapshot()
     plan = Plan(temp_dir=options.temp_dir)
-    context._warn = plan.warnings.append
+    if deferred.captured is None:
+        context = deferred.context.snapshot()
+    else:
+        # launch's rule: the live state, which the body's own actions change for later ones.
+        context = deferred.context
+        from mlaunch.run.binding import differences, warn_once
+
+        diffs = differences(deferred.captured, context, deferred.entities, deferred.callback)
+        message = warn_once(deferred.captured, deferred.origin, diffs)
+        if message:
+            plan.warnings.append(message)
+    saved = context._locals, context._warn  # the live context's locals are the event's only now
+    context._locals, context._warn = dict(saved[0]), plan.warnings.append
     if event is not None:
         context.extend_locals({"event": event})
     resolver = Resolver(context, plan, labels=labels, options=options)
-    with _package_search(options, context):
-        entities = deferred.entities
-        if deferred.callback is not None:
-            from mlaunch.launch.event_handlers import returned_entities
+    try:
+        with _package_search(options, context):
+            entities = deferred.entities
+            if deferred.callback is not None:
+                from mlaunch.launch.event_handlers import returned_entities
 
-            entities = returned_entities(resolver.call_user(deferred.callback, event, context))
-        resolver.visit_all(entities)
+                entities = returned_entities(resolver.call_user(deferred.callback, event, context))
+            resolver.visit_all(entities)
+    finally:
+        context._locals, context._warn = saved
     return plan
 
 

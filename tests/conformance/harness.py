@@ -160,6 +160,8 @@ def run_case(
     records = work / "records"
     records.mkdir()
     env = base_environ(prefix, records, reference if launcher == "ros2" else None)
+    if launcher == "mlaunch" and "PYTHONPATH" in os.environ:
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]  # the mlaunch this test imports
     argv = launcher_argv(launcher, name, prefix, opts["args"], opts["pkg"])
     if launcher == "ros2":
         argv[0] = shutil.which("ros2", path=env["PATH"]) or "ros2"

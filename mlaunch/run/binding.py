@@ -1,0 +1,162 @@
+"""When the bodies of timers and event handlers take their values: when they fire, as launch does.
+
+ros2 launch resolves a timer's or handler's actions against the launch state at the moment it
+fires: a launch configuration, environment variable, ROS namespace, global parameter or remap set
+later in the file applies (and a scoped group's values are gone by then). That is mlaunch's
+default too, so files give the processes ros2 gives them.
+
+mlaunch can instead resolve them with the values from where they were written (ROS 2's L#501,
+a well-known complaint): ``--capture-at-definition`` on the command line, or a comment
+``mlaunch: capture-at-definition`` anywhere in a launch file for the timers and handlers written
+in that file (a comment, so the file still runs unchanged under ros2 launch). When a body fired
+with launch's rule would resolve differently with the captured values, mlaunch warns with the
+file:line of the timer or handler, saying what differs.
+"""
+
+from __future__ import annotations
+
+import re
+
+PRAGMA = "mlaunch: capture-at-definition"
+# A comment line of its own: '# ...' (Python, YAML) or '<!-- ... -->' (XML).
+_PRAGMA_LINE = re.compile(r"^[ \t]*(#|<!--)[ \t]*" + re.escape(PRAGMA), re.MULTILINE)
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+
+_PRAGMAS: dict[str, bool] = {}
+# The launch configurations launch_ros keeps the pushed namespace, parameters and remaps in.
+_ROS_STATE = {
+    "ros_namespace": "the ROS namespace",
+    "global_params": "the global parameters",
+    "ros_remaps": "the global remaps",
+}
+
+
+def file_captures(origin: str) -> bool:
+    """Whether the launch file of ``origin`` (``path:line``) asks for capture-at-definition."""
+    path = origin.rsplit(":", 1)[0] if origin[-1:].isdigit() else origin
+    if path not in _PRAGMAS:
+        try:
+            with open(path, encoding="utf-8", errors="replace") as f:
+                _PRAGMAS[path] = _PRAGMA_LINE.search(f.read()) is not None
+        except OSError:
+            _PRAGMAS[path] = False
+    return _PRAGMAS[path]
+
+
+class _Uses:
+    """What a body reads from the launch state, found by walking its actions."""
+
+    def __init__(self) -> None:
+        self.configs: set[str] = set()
+        self.env: set[str] = set()
+        self.processes = False
+        self.code = False
+
+
+def _text(parts: Any) -> str | None:
+    """The name a substitution list spells out without other substitutions, else None."""
+    if isinstance(parts, str):
+        return parts
+    if not isinstance(parts, (list, tuple)):
+        parts = [parts]
+    texts = [p if isinstance(p, str) else getattr(p, "text", None) for p in parts]
+    return "".join(str(t) for t in texts) if all(isinstance(t, str) for t in texts) else None
+
+
+def _walk(obj: Any, uses: _Uses, seen: set[int], depth: int = 0) -> None:
+    if depth > 60 or id(obj) in seen or obj is None or isinstance(obj, (str, bytes, int, float)):
+        return
+    seen.add(id(obj))
+    if isinstance(obj, (list, tuple, set, frozenset)):
+        for item in obj:
+            _walk(item, uses, seen, depth + 1)
+        return
+    if isinstance(obj, dict):
+        for key, value in obj.items():
+            _walk(key, uses, seen, depth + 1)
+            _walk(value, uses, seen, depth + 1)
+        return
+    if callable(obj) and not hasattr(obj, "visit") and not hasattr(obj, "perform"):
+        uses.code = True  # launch-file code (OpaqueFunction's function, a handler lambda)
+        return
+    module = type(obj).__module__
+    if not module.startswith("mlaunch.") or type(obj).__name__ == "LaunchContext":
+        return
+    from mlaunch.launch.actions import ExecuteProcess
+    from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
+
+    if isinstance(obj, LaunchConfiguration):
+        name = _text(obj.variable_name)
+        if name is not None:
+            uses.configs.add(name)
+    elif isinstance(obj, EnvironmentVariable):
+        name = _text(obj.name)
+        if name is not None:
+            uses.env.add(name)
+    elif isinstance(obj, ExecuteProcess):
+        uses.processes = True
+    fields = list(getattr(obj, "__dict__", {}).values())
+    for cls in type(obj).__mro__:
+        for slot in getattr(cls, "__slots__", ()):
+            fields.append(getattr(obj, slot, None))
+    for value in fields:
+        _walk(value, uses, seen, depth + 1)
+
+
+def differences(
+    captured: LaunchContext, live: LaunchContext, entities: list[Any], callback: Any
+) -> list[str]:
+    """What the body would see differently with the values captured where it was written."""
+    uses = _Uses()
+    _walk(entities, uses, set())
+    uses.code = uses.code or callback is not None
+    then, now = captured.launch_configurations, live.launch_configurations
+    out = []
+    for name in sorted(uses.configs):
+        if then.get(name) != now.get(name):
+            out.append(
+                f"launch configuration {name!r} is {_show(then.get(name))} where written,"
+                f" {_show(now.get(name))} when it fires"
+            )
+    env_then, env_now = captured.environment, live.environment
+    for name in sorted(uses.env):
+        if env_then.get(name) != env_now.get(name):
+            out.append(
+                f"environment variable {name!r} is {_show(env_then.get(name))} where written,"
+                f" {_show(env_now.get(name))} when it fires"
+            )
+    if uses.processes:
+        for key, what in _ROS_STATE.items():
+            if then.get(key) != now.get(key):
+                out.append(f"{what} of its nodes differ")
+        keys = set(env_then) | set(env_now)
+        changed = sorted(k for k in keys if env_then.get(k) != env_now.get(k))
+        if changed:
+            out.append(f"its processes' environment differs ({', '.join(changed[:5])})")
+    if uses.code and not out and (then != now or env_then != env_now):
+        out.append("the launch-file code in it sees other launch configurations or environment")
+    return out
+
+
+def _show(value: Any) -> str:
+    return "unset" if value is None else repr(value)
+
+
+_WARNED: set[int] = set()
+
+
+def warn_once(captured: LaunchContext, origin: str, diffs: list[str]) -> str | None:
+    """The warning for a body that resolves differently, once per timer or handler."""
+    if not diffs or id(captured) in _WARNED:
+        return None
+    _WARNED.add(id(captured))  # captured lives as long as its Deferred: the id stays unique
+    return (
+        f"{origin}: resolved when it fires, as ros2 launch does, and {'; '.join(diffs)}"
+        f" (--capture-at-definition, or a comment '{PRAGMA}' in the file, uses the values"
+        " from where it was written)"
+    )
