@@ -5,6 +5,10 @@ ROS 2 does differently (the mapping is in mlaunch's docs/ros1.md). Running the R
 file with mlaunch resolves to the same plan as this file.
 """
 
+# ROS 1 group parameters stay in their group under mlaunch (the comment below);
+# under ros2 launch a SetParameter in a group also reaches the nodes after it.
+# mlaunch: scoped-parameters
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess, GroupAction
 from launch.conditions import IfCondition, UnlessCondition

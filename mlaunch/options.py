@@ -46,6 +46,7 @@ class Options:
         self.debug = debug
         self.use_sim_time = use_sim_time
         self.capture = False  # --capture-at-definition (mlaunch.run.binding)
+        self.scoped_parameters = False  # --scoped-parameters (mlaunch.launch_ros.scope)
         self.package_path: list[str] = [] if package_path is None else package_path
         self.standins = standins
         self.status = status
@@ -147,6 +148,12 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         " 'mlaunch: capture-at-definition'",
     )
     parser.add_argument(
+        "--scoped-parameters",
+        action="store_true",
+        help="keep SetParameter and SetParametersFromFile inside their scoped group (ros2 launch"
+        " applies them after the group too); per file: a comment 'mlaunch: scoped-parameters'",
+    )
+    parser.add_argument(
         "--package-path",
         action="append",
         default=[],
@@ -242,6 +249,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         log_max_bytes=ns.log_max_bytes,
     )
     opts.capture = ns.capture_at_definition
+    opts.scoped_parameters = ns.scoped_parameters
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
         opts.second = rest.pop(0)

@@ -167,6 +167,14 @@ class _Walker:
         else:
             text = node
         self.substitutions(e, attr, text)
+        quoted = getattr(node, "tag", "") == _YAML_STR  # YAML text, not a YAML boolean
+        if kind == "bool" and e.tag == "group" and quoted and reads_as_bool(text):
+            self.add(
+                e,
+                f"Jazzy's group takes the text {text!r} as is, and any text is true there;"
+                f" write {name}: {text.lower()} (a YAML boolean, unquoted)",
+                attr,
+            )
         if kind == "respawn" and "$(" not in text and not reads_as_bool(text):
             self.add(
                 e,

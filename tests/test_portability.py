@@ -136,6 +136,13 @@ GOOD = {
 }
 
 
+# Accepted by Jazzy but read otherwise than mlaunch reads it: (text, finding, Jazzy's log line).
+QUOTED_FALSE = (
+    "launch:\n- let: {name: a, value: '1'}\n- group:\n    scoped: 'false'\n    children:\n"
+    "    - let: {name: a, value: '2'}\n- log: {message: 'a=$(var a)'}\n"
+)
+
+
 def _write(tmp_path: Path, name: str, text: str) -> Path:
     path = tmp_path / name
     path.write_text(text)
@@ -156,6 +163,17 @@ def test_finds_what_jazzy_rejects(case: str, tmp_path: Path) -> None:
 def test_passes_what_jazzy_accepts(case: str, tmp_path: Path) -> None:
     name, text = GOOD[case]
     assert portability.check(str(_write(tmp_path, name, text))) == []
+
+
+def test_finds_what_jazzy_reads_differently(tmp_path: Path) -> None:
+    (finding,) = portability.check(str(_write(tmp_path, "a.launch.yaml", QUOTED_FALSE)))
+    assert "any text is true" in finding.message and ":4:" in finding.where
+
+
+@requires_reference
+def test_jazzy_really_reads_quoted_false_as_true(tmp_path: Path) -> None:
+    run = _ros2([str(_write(tmp_path, "a.launch.yaml", QUOTED_FALSE))], tmp_path)
+    assert "[launch.user]: a=1" in run.stdout + run.stderr  # scoped after all; mlaunch: a=2
 
 
 def test_includes_are_checked_too(tmp_path: Path) -> None:

@@ -104,6 +104,10 @@ class LaunchContext:
         self.launch_configurations = configs
         self.environment = env
 
+    def shared_with_outer_scope(self, value: Any) -> bool:
+        """Whether ``value`` (a list in the configurations) is also an enclosing scope's."""
+        return any(value is v for configs, _ in self._scopes for v in configs.values())
+
     def scope(self, *, forwarding: bool = True, configs: Mapping[str, Any] | None = None) -> _Scope:
         """A scope whose configuration and environment changes are undone at exit.
 
@@ -125,7 +129,10 @@ class LaunchContext:
             environment=self.environment, argv=self.argv, log_dir=self.log_dir, warn=self._warn
         )
         copy.initial_environment = self.initial_environment
-        copy.launch_configurations = dict(self.launch_configurations)
+        # Lists (launch_ros's global parameters, extended in place as in launch) are copied too.
+        copy.launch_configurations = {
+            k: list(v) if isinstance(v, list) else v for k, v in self.launch_configurations.items()
+        }
         copy._locals = dict(self._locals)
         copy._globals = self._globals
         return copy

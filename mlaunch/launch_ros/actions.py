@@ -21,7 +21,7 @@ from mlaunch.launch.substitutions import (
 from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
 from mlaunch.launch_ros.scope import (
-    global_params,
+    add_global_params,
     make_namespace_absolute,
     namespace_problem,
     node_name_problem,
@@ -84,6 +84,9 @@ PushRosNamespace = PushROSNamespace
 class SetParameter(Action):
     """A global parameter for every node after it in this scope (``-p name:=value``)."""
 
+    # mlaunch's: True keeps it inside a scoped group even without --scoped-parameters.
+    keep_in_scope = False
+
     def __init__(self, name: SomeSubstitutionsType, value: Any, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.param_dict = params.normalize_dict({normalize(name): value})
@@ -91,7 +94,7 @@ class SetParameter(Action):
     def execute(self, resolver: Resolver) -> None:
         ctx = resolver.context
         entries = tuple(params.evaluate_dict(ctx, self.param_dict).items())
-        ctx.launch_configurations["global_params"] = (*global_params(ctx), *entries)
+        add_global_params(resolver, self, entries)
 
     def describe_short(self) -> str:
         (name,) = self.param_dict
@@ -111,7 +114,7 @@ class SetParametersFromFile(Action):
         if not os.path.isfile(path):
             # launch_ros asserts when a node uses it; failing here names the right line.
             raise LaunchFileError(f"parameters file {path!r} does not exist", where=self.origin)
-        ctx.launch_configurations["global_params"] = (*global_params(ctx), path)
+        add_global_params(resolver, self, (path,))
 
     def describe_short(self) -> str:
         return f"SetParametersFromFile({describe(self.filename)})"

@@ -2,10 +2,12 @@
 the nodes after them, and rmw's rules for node names and namespaces (launch_ros.utilities).
 
 The state lives in the launch configurations under ROS 2's keys: ``ros_namespace`` (str),
-``global_params`` (a tuple of ``(name, value)`` and params-file paths) and ``ros_remaps`` (a
-tuple of ``(from, to)``). Deliberate fix: these are immutable tuples that each action replaces,
-never lists extended in place, so a SetParameter or SetRemap inside a scoped GroupAction no
-longer leaks out of it (launch_ros's ``list.extend`` on a shallow-copied scope does leak).
+``global_params`` (``(name, value)`` pairs and params-file paths) and ``ros_remaps`` (a tuple of
+``(from, to)``). Global parameters are a list extended in place, as in launch_ros, so a
+SetParameter or SetParametersFromFile inside a scoped GroupAction also applies after the group
+when the list already existed outside it (launch's shallow-copied scope): mlaunch warns where
+that happens. ``--scoped-parameters`` (or a comment ``mlaunch: scoped-parameters`` in the file)
+keeps them inside the group: an immutable tuple that each action replaces.
 
 Nothing here imports rclpy: names and namespaces are validated with rmw's rules, re-stated.
 """
@@ -19,6 +21,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.run.resolve import Resolver
 
 
 # --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
@@ -91,11 +94,36 @@ def global_params(context: LaunchContext) -> tuple[Any, ...]:
     return tuple(context.launch_configurations.get("global_params") or ())
 
 
+def add_global_params(resolver: Resolver, action: Any, entries: tuple[Any, ...]) -> None:
+    """Extend the global parameters as launch_ros does, or within the scope on request (the
+    option, the file's comment, or ``keep_in_scope`` on the action: ROS 1 files' params)."""
+    from mlaunch.run.binding import SCOPED_PARAMETERS, file_has
+
+    configs = resolver.context.launch_configurations
+    current = configs.get("global_params")
+    origin = action.origin or ""
+    scoped = getattr(action, "keep_in_scope", False) or resolver.options.scoped_parameters
+    if scoped or file_has(origin, SCOPED_PARAMETERS):
+        configs["global_params"] = (*(current or ()), *entries)
+    elif isinstance(current, list):
+        if resolver.context.shared_with_outer_scope(current):
+            resolver.warn(
+                f"{origin}: this global parameter also applies to the nodes after the enclosing"
+                " group, as in ros2 launch (its list is shared with the outer scope);"
+                " --scoped-parameters, or a comment 'mlaunch: scoped-parameters' in the file,"
+                " keeps it inside the group"
+            )
+        current.extend(entries)
+    else:
+        configs["global_params"] = [*(current or ()), *entries]
+
+
 def ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
     return tuple(context.launch_configurations.get("ros_remaps") or ())
 
 
 __all__ = [
+    "add_global_params",
     "global_params",
     "make_namespace_absolute",
     "namespace_problem",

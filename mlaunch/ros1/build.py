@@ -105,7 +105,9 @@ def _action(item: Item) -> Any:
     if isinstance(item, SetArg):
         return ConstantArgument(item.name, subs(item.value))
     if isinstance(item, SetParam):
-        return ros.SetParameter(name=subs(item.name), value=parameter_value(item.value))
+        action = ros.SetParameter(name=subs(item.name), value=parameter_value(item.value))
+        action.keep_in_scope = True  # ROS 1 global parameters belong to their group
+        return action
     if isinstance(item, SetRemap):
         return ros.SetRemap(src=subs(item.src), dst=subs(item.dst))
     if isinstance(item, SetEnv):

@@ -36,6 +36,7 @@ from mlaunch.ros1.model import (
     Warn,
 )
 from mlaunch.ros1.writing import (
+    SCOPED_NOTE,
     WIDTH,
     ConversionError,
     Source,
@@ -184,7 +185,7 @@ class PythonWriter:
         header = file_header(self.source, '"""', '"""')
         imports = _imports(self.used)
         text = (
-            f"{header}\n\n{imports}\n\n\n"
+            f"{header}\n\n{SCOPED_NOTE.format(c='#')}\n{imports}\n\n\n"
             "def generate_launch_description() -> LaunchDescription:\n"
             f"    return {body}\n"
         )

@@ -25,6 +25,7 @@ from mlaunch.ros1.model import (
     Warn,
 )
 from mlaunch.ros1.writing import (
+    SCOPED_NOTE,
     WIDTH,
     Source,
     Templates,
@@ -45,7 +46,12 @@ class XmlWriter:
 
     def write(self, items: list[Item]) -> str:
         header = file_header(self.source, "", "", "     ")
-        lines = ['<?xml version="1.0"?>', f"<!-- {header.strip()} -->", "<launch>"]
+        note = [
+            f"<!-- {line.removeprefix('@ ')} -->"
+            for line in SCOPED_NOTE.format(c="@").split("\n")
+            if line
+        ]
+        lines = ['<?xml version="1.0"?>', f"<!-- {header.strip()} -->", *note, "<launch>"]
         lines += self.items(items, 1)
         lines.append("</launch>")
         return "\n".join(lines) + "\n"

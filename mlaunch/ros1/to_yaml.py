@@ -19,6 +19,7 @@ from mlaunch.ros1.model import (
 )
 from mlaunch.ros1.to_xml import XmlWriter
 from mlaunch.ros1.writing import (
+    SCOPED_NOTE,
     WIDTH,
     Source,
     Templates,
@@ -40,7 +41,7 @@ class YamlWriter:
 
     def write(self, items: list[Item]) -> str:
         header = file_header(self.source, "", "", "# ")
-        lines = [header, "", "launch:"]
+        lines = [header, "", SCOPED_NOTE.format(c="#").rstrip("\n"), "launch:"]
         lines += self.items(items, 0)
         return "\n".join(lines) + "\n"
 

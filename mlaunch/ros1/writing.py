@@ -273,6 +273,15 @@ def eval_pieces(part: EvalRef) -> Value:
     return merge(out)
 
 
+# ROS 1 global parameters belong to their group; ROS 2's SetParameter in a scoped group also
+# reaches the nodes after it. The comment keeps ROS 1's meaning under mlaunch (mlaunch.run.binding).
+SCOPED_NOTE = (
+    "{c} ROS 1 group parameters stay in their group under mlaunch (the comment below);\n"
+    "{c} under ros2 launch a SetParameter in a group also reaches the nodes after it.\n"
+    "{c} mlaunch: scoped-parameters\n"
+)
+
+
 def file_header(source: Source, opening: str, closing: str, prefix: str = "") -> str:
     name = os.path.basename(source.path)
     lines = [

@@ -18,8 +18,7 @@ from __future__ import annotations
 import re
 
 PRAGMA = "mlaunch: capture-at-definition"
-# A comment line of its own: '# ...' (Python, YAML) or '<!-- ... -->' (XML).
-_PRAGMA_LINE = re.compile(r"^[ \t]*(#|<!--)[ \t]*" + re.escape(PRAGMA), re.MULTILINE)
+SCOPED_PARAMETERS = "mlaunch: scoped-parameters"
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -27,7 +26,8 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
 
-_PRAGMAS: dict[str, bool] = {}
+_FILES: dict[str, str] = {}
+_PRAGMAS: dict[tuple[str, str], bool] = {}
 # The launch configurations launch_ros keeps the pushed namespace, parameters and remaps in.
 _ROS_STATE = {
     "ros_namespace": "the ROS namespace",
@@ -38,14 +38,26 @@ _ROS_STATE = {
 
 def file_captures(origin: str) -> bool:
     """Whether the launch file of ``origin`` (``path:line``) asks for capture-at-definition."""
+    return file_has(origin, PRAGMA)
+
+
+def file_has(origin: str, pragma: str) -> bool:
+    """Whether the launch file of ``origin`` (``path:line``) has ``pragma`` as a comment line:
+    ``# ...`` (Python, YAML) or ``<!-- ... -->`` (XML), so the file runs unchanged in ros2."""
+    if not origin:
+        return False
     path = origin.rsplit(":", 1)[0] if origin[-1:].isdigit() else origin
-    if path not in _PRAGMAS:
+    if path not in _FILES:
         try:
             with open(path, encoding="utf-8", errors="replace") as f:
-                _PRAGMAS[path] = _PRAGMA_LINE.search(f.read()) is not None
+                _FILES[path] = f.read()
         except OSError:
-            _PRAGMAS[path] = False
-    return _PRAGMAS[path]
+            _FILES[path] = ""
+    key = (path, pragma)
+    if key not in _PRAGMAS:
+        line = re.compile(r"^[ \t]*(#|<!--)[ \t]*" + re.escape(pragma), re.MULTILINE)
+        _PRAGMAS[key] = line.search(_FILES[path]) is not None
+    return _PRAGMAS[key]
 
 
 class _Uses:

@@ -106,6 +106,7 @@ def resolve_for_run(
         packages=package_search(opts, path),
         temp_dir=temp_dir,
         capture=opts.capture,
+        scoped_parameters=opts.scoped_parameters,
     )
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions import with_use_sim_time

@@ -44,7 +44,7 @@ class ResolveOptions(Record):
     None for the default search); ``temp_dir`` is where params files are written.
     """
 
-    _fields = ("standins", "packages", "temp_dir", "capture")
+    _fields = ("standins", "packages", "temp_dir", "capture", "scoped_parameters")
     __slots__ = _fields
 
     def __init__(
@@ -53,12 +53,15 @@ class ResolveOptions(Record):
         packages: PackageSearch | None = None,
         temp_dir: str | None = None,
         capture: bool = False,
+        scoped_parameters: bool = False,
     ) -> None:
         self.standins = standins
         self.packages = packages
         self.temp_dir = temp_dir
         # Timers and handlers take the values where they were written (mlaunch.run.binding).
         self.capture = capture
+        # SetParameter(s)FromFile stay inside scoped groups (mlaunch.launch_ros.actions).
+        self.scoped_parameters = scoped_parameters
 
 
 class Resolver:

@@ -20,9 +20,6 @@ import pytest
 
 KNOWN_DIFFERENCES: dict[str, str] = {
     "exit_status_required.launch.py": "on purpose: a failed required process exits 1 (README: exit status)",
-    "ros_scoping.launch.py": "scoped SetParameter leaks out of its group in launch (conformance.md: scopes)",
-    "ros_scoping.launch.xml": "scoped SetParameter leaks out of its group in launch (conformance.md: scopes)",
-    "ros_scoping.launch.yaml": "scoped SetParameter leaks out of its group in launch (conformance.md: scopes)",
 }
 
 REFERENCE = harness.reference_environ()
