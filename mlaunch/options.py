@@ -34,6 +34,7 @@ class Options:
         quiet: bool = False,
         color: bool | None = None,
         log_max_bytes: int | None = None,
+        log_keep: int | None = None,
     ) -> None:
         self.target = target
         self.second = second
@@ -53,6 +54,7 @@ class Options:
         self.quiet = quiet
         self.color = color
         self.log_max_bytes = log_max_bytes
+        self.log_keep = log_keep
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -192,6 +194,12 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="rotate each log file at N bytes, 0 never (default: 67108864, 64 MiB)",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    parser.add_argument(
+        "--log-keep",
+        default=None,
+        metavar="N|all",
+        help="rotated parts kept per log file (default 3; all: never drop a line)",
+    )
     return parser
 
 
@@ -203,7 +211,14 @@ def _version() -> str:
 
 # Options that take a value: the token after them is theirs even if it contains ":=".
 VALUE_OPTIONS = frozenset(
-    {"--package-path", "--launch-prefix", "--launch-prefix-filter", "--color", "--log-max-bytes"}
+    {
+        "--package-path",
+        "--launch-prefix",
+        "--launch-prefix-filter",
+        "--color",
+        "--log-max-bytes",
+        "--log-keep",
+    }
 )
 
 
@@ -247,6 +262,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         quiet=ns.quiet,
         color={"auto": None, "always": True, "never": False}[ns.color],
         log_max_bytes=ns.log_max_bytes,
+        log_keep=_log_keep(ns.log_keep),
     )
     opts.capture = ns.capture_at_definition
     opts.scoped_parameters = ns.scoped_parameters
@@ -270,3 +286,18 @@ def parse_options(argv: Sequence[str]) -> Options:
     if ns.show_all_subprocesses_output:
         os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
     return opts
+
+
+def _log_keep(value: str | None) -> int | None:
+    """--log-keep: a count of rotated parts, or ``all`` (logfiles.ALL)."""
+    if value is None:
+        return None
+    if value == "all":
+        return -1
+    if value.isdigit():
+        return int(value)
+    from mlaunch.errors import UsageError
+
+    raise UsageError(
+        f"--log-keep is {value!r}; valid: a number of rotated files (0 or more), or all"
+    )

@@ -174,7 +174,7 @@ def supervise(
 ) -> int:
     """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts."""
     from mlaunch.errors import UsageError
-    from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
+    from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
     from mlaunch.run.output import Printer, stdout_is_color_terminal
     from mlaunch.run.process import Process
     from mlaunch.run.supervisor import Supervisor
@@ -186,7 +186,13 @@ def supervise(
     guard, run_id = life.guard, life.run_id
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
-    printer = Printer(color=color, log_dir=log_dir, quiet=opts.quiet, rotate_bytes=rotate)
+    printer = Printer(
+        color=color,
+        log_dir=log_dir,
+        quiet=opts.quiet,
+        rotate_bytes=rotate,
+        rotate_keep=DEFAULT_ROTATE_KEEP if opts.log_keep is None else opts.log_keep,
+    )
     printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
     spawner = _remote_spawner(labels, run_id)
     supervisor = Supervisor(
