@@ -18,9 +18,9 @@ from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
 
 from mlaunch.errors import LaunchFileError
 from mlaunch.launch.actions import DeclareLaunchArgument, GroupAction, LaunchDescription
-from mlaunch.ros.lifecycle import (
+from mlaunch.ros.handoff import LoopCall
+from mlaunch.ros.lifecycle_sequence import (
     LifecycleSequence,
-    LoopCall,
     SequenceStep,
     sequence_from_arguments,
 )

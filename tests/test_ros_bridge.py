@@ -22,10 +22,10 @@ import pytest
 from conftest import REPO, requires_rclpy
 from procutil import wait_until
 
-from mlaunch.ros.bridge import (
+from mlaunch.ros.bridge import RosGraph
+from mlaunch.ros.graph_types import (
     INSTALL_HINT,
     GraphNotRunning,
-    RosGraph,
     RosInputError,
     RosTimeout,
     RosUnavailable,

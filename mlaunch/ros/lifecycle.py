@@ -28,18 +28,20 @@ supervisor's loop thread through ``LoopCall`` (a queue and a wakeup pipe in its 
 from __future__ import annotations
 
 import os
-import queue
-import re
-import selectors
 import threading
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import EXIT_FAILURE, LaunchFileError
-from mlaunch.launch.actions import Action
-from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
+from mlaunch.errors import EXIT_FAILURE
+from mlaunch.ros.handoff import LoopCall, SharedGraph
+from mlaunch.ros.lifecycle_sequence import (
+    DEFAULT_TIMEOUT,
+    LifecycleSequence,
+    SequenceStep,
+    sequence_from_arguments,
+)
 from mlaunch.run.events import (
     Event,
     Exited,
@@ -49,16 +51,13 @@ from mlaunch.run.events import (
     Started,
     Transition,
 )
-from mlaunch.run.plan import SEQUENCE_ARGUMENT, Note, ProcessSpec
+from mlaunch.run.plan import ProcessSpec
 
 if TYPE_CHECKING:
     from mlaunch.ros.bridge import RosGraph, TransitionResult
     from mlaunch.run.process import Process
-    from mlaunch.run.resolve import Resolver
     from mlaunch.run.supervisor import Supervisor
 
-# How long a node's lifecycle services may take to appear, and each transition to answer.
-DEFAULT_TIMEOUT = 20.0
 # get_state is asked again this often while waiting for a node (a lost request is not fatal).
 STATE_ATTEMPT = 2.0
 # At shutdown each active node gets this long to deactivate before its stop ladder starts.
@@ -80,205 +79,6 @@ TRANSITION_LABELS: dict[int, str] = {
     6: "shutdown",
     7: "shutdown",
 }
-_NODE_PART = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
-
-
-# --- handing work back to the supervisor's loop ---------------------------------------------------
-
-
-class LoopCall:
-    """``call_soon(fn)`` from any thread: fn runs in the supervisor's loop thread, in order.
-
-    A queue plus a pipe registered with the supervisor's selector, so a result arriving from a
-    ROS thread wakes the loop at once instead of waiting for its next timer.
-    """
-
-    def __init__(self, selector: selectors.BaseSelector) -> None:
-        self._selector = selector
-        self._queue: queue.SimpleQueue[Callable[[], None]] = queue.SimpleQueue()
-        self._read, self._write = os.pipe()
-        os.set_blocking(self._read, False)
-        os.set_blocking(self._write, False)
-        selector.register(self._read, selectors.EVENT_READ, self._run)
-        self._closed = False
-
-    def call_soon(self, fn: Callable[[], None]) -> None:
-        if self._closed:
-            return
-        self._queue.put(fn)
-        try:
-            os.write(self._write, b"x")
-        except (BlockingIOError, OSError):
-            pass  # a full pipe already wakes the loop; a closed one means the run is over
-
-    def _run(self, fd: int) -> None:
-        try:
-            while os.read(fd, 4096):
-                pass
-        except BlockingIOError:
-            pass
-        while True:
-            try:
-                fn = self._queue.get_nowait()
-            except queue.Empty:
-                return
-            fn()
-
-    def close(self) -> None:
-        if self._closed:
-            return
-        self._closed = True
-        try:
-            self._selector.unregister(self._read)
-        except (KeyError, ValueError, RuntimeError, AttributeError):
-            pass  # the supervisor closed its selector already
-        for fd in (self._read, self._write):
-            try:
-                os.close(fd)
-            except OSError:
-                pass
-
-
-class SharedGraph:
-    """One private RosGraph, started on first use from whichever thread needs it first."""
-
-    def __init__(self, environ: Mapping[str, str], node_name: str) -> None:
-        self.environ = dict(environ)
-        self.node_name = node_name
-        self._lock = threading.Lock()
-        self._graph: RosGraph | None = None
-        self._closed = False
-
-    def get(self) -> RosGraph:
-        from mlaunch.ros.bridge import GraphNotRunning, RosGraph
-
-        with self._lock:
-            if self._closed:
-                raise GraphNotRunning("the launch is over: the ROS graph bridge is closed")
-            if self._graph is None:
-                graph = RosGraph(node_name=self.node_name, environ=self.environ)
-                graph.start()
-                self._graph = graph
-            return self._graph
-
-    @property
-    def started(self) -> bool:
-        return self._graph is not None
-
-    def close(self) -> None:
-        with self._lock:
-            self._closed = True
-            graph, self._graph = self._graph, None
-        if graph is not None:
-            graph.close()
-
-
-# --- the launch-file side -----------------------------------------------------------------------
-
-
-@dataclass
-class SequenceStep(Note):
-    """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order (a Note: the
-    lifecycle manager reads it from the plan)."""
-
-    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
-
-    origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
-    nodes: tuple[str, ...] = ()
-    shutdown_on_failure: bool = True
-    timeout: float = DEFAULT_TIMEOUT
-
-
-class LifecycleSequence(Action):
-    """Configure and activate lifecycle nodes in order, each once the previous one is active.
-
-    ``nodes`` are node names: absolute (``/robot1/map_server``) or relative to the ROS namespace
-    where the action stands. ``timeout`` bounds each node's wait for its services and each of its
-    transitions. With ``shutdown_on_failure`` a failed transition ends the launch (status 1).
-    """
-
-    needs = frozenset({"lifecycle"})  # seen in deferred bodies too (Plan.needs)
-
-    def __init__(
-        self,
-        *,
-        nodes: Iterable[SomeSubstitutionsType],
-        shutdown_on_failure: bool = True,
-        timeout: float | SomeSubstitutionsType = DEFAULT_TIMEOUT,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        if isinstance(nodes, str):
-            raise LaunchFileError(
-                f"LifecycleSequence nodes={nodes!r} is a string; give a list of node names",
-                where=self.origin,
-            )
-        self.nodes = [normalize(n) for n in nodes]
-        self.shutdown_on_failure = shutdown_on_failure
-        self.timeout = timeout
-
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        namespace = str(ctx.launch_configurations.get("ros_namespace") or "/")
-        names = [qualify(perform_substitutions(ctx, n), namespace, self.origin) for n in self.nodes]
-        check_sequence(names, self.origin)
-        timeout = resolver.float_value(self.timeout, "LifecycleSequence timeout", self.origin)
-        if timeout <= 0:
-            raise LaunchFileError(
-                f"LifecycleSequence timeout is {timeout:g}; it must be > 0 seconds",
-                where=self.origin,
-            )
-        resolver.add(
-            SequenceStep(
-                origin=self.origin,
-                nodes=tuple(names),
-                shutdown_on_failure=bool(self.shutdown_on_failure),
-                timeout=timeout,
-            )
-        )
-
-    def describe_short(self) -> str:
-        return f"LifecycleSequence({len(self.nodes)} nodes)"
-
-
-def qualify(name: str, namespace: str, where: str) -> str:
-    """The full name of a node named relative to ``namespace`` (or absolutely)."""
-    name = name.strip()
-    full = name if name.startswith("/") else f"{namespace.rstrip('/')}/{name}"
-    parts = full[1:].split("/")
-    if not name or not all(_NODE_PART.match(p) for p in parts):
-        raise LaunchFileError(
-            f"lifecycle node name {name!r} is not a ROS node name like 'map_server' or"
-            " '/robot1/map_server' (letters, digits, '_'; not starting with a digit)",
-            where=where,
-        )
-    return full
-
-
-def check_sequence(names: list[str], where: str) -> None:
-    if not names:
-        raise LaunchFileError("LifecycleSequence needs at least one node", where=where)
-    seen: set[str] = set()
-    for name in names:
-        if name in seen:
-            raise LaunchFileError(f"LifecycleSequence lists {name!r} twice", where=where)
-        seen.add(name)
-
-
-def sequence_from_arguments(
-    plan_arguments: Mapping[str, Any], given: Mapping[str, str]
-) -> SequenceStep | None:
-    """The YAML/XML form: the ``mlaunch_lifecycle_sequence`` launch argument, if declared."""
-    info = plan_arguments.get(SEQUENCE_ARGUMENT)
-    if info is None and SEQUENCE_ARGUMENT not in given:
-        return None
-    text = given.get(SEQUENCE_ARGUMENT, getattr(info, "default", None) or "")
-    where = getattr(info, "origin", "") or "the command line"
-    names = [qualify(n, "/", where) for n in re.split(r"[\s,]+", text) if n]
-    if not names:
-        return None
-    check_sequence(names, where)
-    return SequenceStep(origin=where, nodes=tuple(names))
 
 
 # --- the running side ---------------------------------------------------------------------------

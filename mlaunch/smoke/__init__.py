@@ -65,7 +65,8 @@ from mlaunch.run.events import Event, Exited, Output, Started
 from mlaunch.run.plan import Note
 
 if TYPE_CHECKING:
-    from mlaunch.ros.lifecycle import LifecycleManager, Outcome, SharedGraph
+    from mlaunch.ros.handoff import SharedGraph
+    from mlaunch.ros.lifecycle import LifecycleManager, Outcome
     from mlaunch.run.lifeline import Lifeline
     from mlaunch.run.plan import Plan, ProcessSpec
     from mlaunch.run.process import Process
@@ -646,7 +647,7 @@ class SmokeRun:
         *,
         lifecycle: LifecycleManager | None = None,
     ) -> None:
-        from mlaunch.ros.lifecycle import LoopCall, SharedGraph
+        from mlaunch.ros.handoff import LoopCall, SharedGraph
 
         self.supervisor = supervisor
         self.expectations = expectations
@@ -834,7 +835,7 @@ class SmokeRun:
     # --- checker thread ---------------------------------------------------------------------------
 
     def _check_graph(self) -> None:
-        from mlaunch.ros.bridge import GraphNotRunning, RosBridgeError
+        from mlaunch.ros.graph_types import GraphNotRunning, RosBridgeError
 
         try:
             graph = self.graph.get()
@@ -946,7 +947,7 @@ class GraphProbe:
         return False, f"not in the graph (nodes seen: {shown or 'none'})"
 
     def _lifecycle(self, e: Expectation, *, nodes: set[str], **_: Any) -> tuple[bool, str]:
-        from mlaunch.ros.bridge import RosTimeout
+        from mlaunch.ros.graph_types import RosTimeout
 
         if e.target not in nodes:
             return False, "the node is not in the graph"
