@@ -20,17 +20,9 @@ from mlaunch.launch.actions import (
     SetLaunchConfiguration,
 )
 from mlaunch.run.resolve import resolve
-from mlaunch.smoke import (
-    Expect,
-    Settings,
-    _CollectConfigurations,
-    build_expectations,
-    junit,
-    parse_settings,
-    parse_spec,
-    parse_target,
-    split_arguments,
-)
+from mlaunch.smoke import build_expectations, junit
+from mlaunch.smoke.expectations import Expect, _CollectConfigurations, parse_spec, parse_target
+from mlaunch.smoke.settings import Settings, parse_settings, split_arguments
 
 LAUNCHES = Path(__file__).resolve().parent / "launches"
 SYSTEM = str(LAUNCHES / "smoke_system.launch.py")

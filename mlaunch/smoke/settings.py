@@ -1,0 +1,216 @@
+"""``mlaunch test FILE [name:=value ...] [options]``: its options (this text is its --help).
+
+It starts the launch exactly as ``mlaunch FILE`` would, waits until the system is *ready*,
+holds it (``--hold S``, 3 s by default) watching for crashes, shuts it down and exits 0; anything
+else exits 1 with a table of what was expected and what was seen, and the last lines of output
+of the processes involved (``--junit FILE`` writes the same as JUnit XML).
+
+Ready means, by default:
+  - every process of the launch started and is still running;
+  - every Node with a name is in the ROS graph under its fully qualified name;
+  - every lifecycle node is ``active``;
+  - with use_sim_time (``--use-sim-time``, ``use_sim_time:=true``, a SetParameter or a node's
+    own parameter), ``/clock`` is advancing;
+and at the end, every process stopped within its stop ladder (none needed SIGKILL). A process
+that exits with a failure (non-zero status, or a signal) before the end fails the test; one that
+exits 0 is a one-shot (a spawner, a loader) and fine, unless it was started with respawn: a
+respawning process that exits fails even with status 0, and ``--allow-exit LABEL`` lets it
+(label or base name) finish with status 0. At the end, a process that started less than
+STARTUP_GRACE seconds ago is given the rest of that time before the stop signals, so it is not
+interrupted half-way through its imports. Processes started later by
+timers or event handlers are watched from when they start.
+
+More expectations, from the command line (each has the overall ``--timeout`` as deadline unless
+``--within S`` follows it):
+  --expect-topic /scan[:RATE_HZ]     messages arrive (at >= 90% of RATE_HZ, when given)
+  --expect-service /map_server/load_map
+  --expect-node /robot1/amcl
+  --expect-lifecycle /robot1/amcl[:STATE]   (default active; replaces the default check)
+  --expect-output 'LABEL:REGEX' | 'REGEX'   a line of output (LABEL: a process label like
+                                     talker-1 or its base name talker) matches REGEX
+  --expect-clock /clock              simulated time advances (also without use_sim_time)
+  --expect 'KIND TARGET [within S]'  the same in one string (KIND: topic, service, node,
+                                     lifecycle, output, clock)
+or from the launch file:
+  - any launch configuration whose name starts with ``mlaunch_expect`` holds one expectation
+    as 'KIND TARGET [within S]', e.g. in YAML
+    ``- let: {name: mlaunch_expect_scan, value: "topic /scan:10 within 15"}``, in XML
+    ``<let name="mlaunch_expect_scan" value="topic /scan:10"/>`` (it must be set where the
+    top level of the launch sees it: at the top level, or in an included file, not in a group);
+  - in Python, ``mlaunch.smoke.Expect(topic="/scan", rate=10.0, within=15)`` (or
+    ``service=``, ``node=``, ``lifecycle=`` with ``state=``, ``output=`` with ``process=``).
+A normal ``mlaunch FILE`` run ignores both.
+
+Exit status: 0 ready (and held, and stopped cleanly); 1 an expectation failed; 2 bad command
+line or launch file; 128+N interrupted by signal N.
+"""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from mlaunch.errors import UsageError
+from mlaunch.smoke.expectations import KINDS, Expectation, parse_spec, parse_target
+
+_HELP = __doc__ or ""
+DEFAULT_TIMEOUT = 30.0
+# Held after ready so a node that crashes a few seconds in is caught (--hold 0 skips it).
+DEFAULT_HOLD = 3.0
+HELP = {
+    "topic": "/scan[:RATE_HZ]: messages arrive (at >= 90%% of RATE_HZ)",
+    "service": "/name: the service is offered",
+    "node": "/ns/name: the node is in the ROS graph",
+    "lifecycle": "/ns/name[:STATE]: the managed node is in STATE (active)",
+    "output": "'LABEL:REGEX' or 'REGEX': a line of output matches",
+    "clock": "/clock: simulated time advances (implied by use_sim_time)",
+}
+
+# --- the command line -----------------------------------------------------------------------------
+
+
+@dataclass
+class Settings:
+    """What ``mlaunch test`` adds to ``mlaunch FILE``'s options."""
+
+    expectations: list[Expectation] = field(default_factory=list)
+    timeout: float = DEFAULT_TIMEOUT
+    hold: float = DEFAULT_HOLD
+    junit: str | None = None
+    allow_exit: list[str] = field(default_factory=list)
+
+
+VALUE_FLAGS = (
+    "--expect",
+    "--expect-topic",
+    "--expect-service",
+    "--expect-node",
+    "--expect-lifecycle",
+    "--expect-output",
+    "--within",
+    "--timeout",
+    "--hold",
+    "--junit",
+    "--allow-exit",
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="mlaunch test",
+        usage="mlaunch test FILE [name:=value ...] [options of mlaunch FILE] [test options]",
+        description="Start a launch, wait until it is ready, hold it, stop it: exit 0 when"
+        " every expectation held, 1 otherwise (with a table of expected vs seen).",
+        # The docstring's reStructuredText quoting means nothing on a terminal.
+        epilog=_HELP[_HELP.index("Ready means") :].replace("``", "")
+        + "\nEvery option of 'mlaunch FILE' is accepted too (see mlaunch --help).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    group = parser.add_argument_group("expectations")
+    for kind in KINDS:
+        group.add_argument(
+            f"--expect-{kind}",
+            metavar=kind.upper(),
+            action=_ExpectAction,
+            const=kind,
+            help=HELP[kind],
+        )
+    group.add_argument(
+        "--expect",
+        metavar="'KIND TARGET [within S]'",
+        action=_ExpectAction,
+        help="any of the above in one string",
+    )
+    group.add_argument(
+        "--within",
+        metavar="S",
+        type=float,
+        action=_WithinAction,
+        help="the deadline (seconds from the start) of the expectation just before",
+    )
+    parser.add_argument(
+        "--timeout",
+        type=float,
+        default=DEFAULT_TIMEOUT,
+        metavar="S",
+        help=f"deadline for everything to be ready (default {DEFAULT_TIMEOUT:g} s)",
+    )
+    parser.add_argument(
+        "--hold",
+        type=float,
+        default=DEFAULT_HOLD,
+        metavar="S",
+        help=f"stay up S seconds after ready, watching for crashes (default {DEFAULT_HOLD:g};"
+        " 0 skips it)",
+    )
+    parser.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
+    parser.add_argument(
+        "--allow-exit",
+        action="append",
+        default=[],
+        metavar="LABEL",
+        help="a respawning process (label or base name) that may still finish with status 0"
+        " (repeatable; a process without respawn that exits 0 is a one-shot, fine anyway)",
+    )
+    return parser
+
+
+class _ExpectAction(argparse.Action):
+    def __call__(self, parser: Any, ns: Any, value: Any, option: str | None = None) -> None:
+        items = getattr(ns, "expectations", None) or []
+        if self.const is None:
+            items.append(parse_spec(value, f"{option} {value!r}"))
+        else:
+            items.append(parse_target(self.const, value, f"{option} {value!r}"))
+        ns.expectations = items
+
+
+class _WithinAction(argparse.Action):
+    def __call__(self, parser: Any, ns: Any, value: Any, option: str | None = None) -> None:
+        items = getattr(ns, "expectations", None) or []
+        if not items:
+            raise UsageError("--within S follows an --expect-... option and sets its deadline")
+        if not value > 0:
+            raise UsageError(f"--within {value!r}: the deadline must be > 0 seconds")
+        items[-1].within = value
+
+
+def split_arguments(args: Sequence[str]) -> tuple[list[str], list[str]]:
+    """(test options, everything else for mlaunch FILE's own parser)."""
+    mine: list[str] = []
+    rest: list[str] = []
+    i = 0
+    while i < len(args):
+        arg = args[i]
+        name = arg.split("=", 1)[0]
+        if name in VALUE_FLAGS:
+            mine.append(arg)
+            if "=" not in arg:
+                if i + 1 >= len(args):
+                    raise UsageError(f"{arg} needs a value")
+                mine.append(args[i + 1])
+                i += 1
+        elif arg in ("-h", "--help"):
+            mine.append(arg)
+        else:
+            rest.append(arg)
+        i += 1
+    return mine, rest
+
+
+def parse_settings(args: Sequence[str]) -> Settings:
+    ns = build_parser().parse_args(list(args))
+    for what, value in (("--timeout", ns.timeout), ("--hold", ns.hold)):
+        if not value >= 0 or value == float("inf"):
+            raise UsageError(f"{what} {value!r}: expected a number of seconds >= 0")
+    if ns.timeout == 0:
+        raise UsageError("--timeout 0: the deadline must be > 0 seconds")
+    return Settings(
+        expectations=list(getattr(ns, "expectations", None) or []),
+        timeout=ns.timeout,
+        hold=ns.hold,
+        junit=ns.junit,
+        allow_exit=list(ns.allow_exit),
+    )

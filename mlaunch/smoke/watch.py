@@ -1,0 +1,407 @@
+"""Watching a smoke run: ready or failed, from the supervisor's events and the ROS graph."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import threading
+from collections import deque
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.run.events import Event, Exited, Output, Started
+from mlaunch.smoke.expectations import Expectation
+from mlaunch.smoke.settings import Settings
+
+if TYPE_CHECKING:
+    from mlaunch.ros.handoff import SharedGraph
+    from mlaunch.ros.lifecycle import LifecycleManager, Outcome
+    from mlaunch.run.plan import Plan, ProcessSpec
+    from mlaunch.run.process import Process
+    from mlaunch.run.supervisor import Supervisor
+
+# At the end, the youngest process is given up to this long since its start before the stop
+# signals: SIGINT during a Python node's imports leaves a traceback in a passing run.
+STARTUP_GRACE = 2.0
+RING_LINES = 20
+# A topic given with a rate passes at this fraction of it (publishers jitter, CI machines lag).
+RATE_TOLERANCE = 0.9
+# The graph is looked at this often; deadlines are checked this often.
+GRAPH_PERIOD = 0.2
+TICK = 0.1
+# Waiting for a lifecycle node's get_state answer while checking (it is asked again later).
+STATE_QUERY_TIMEOUT = 1.0
+GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock"})
+_ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
+
+# --- watching the run -----------------------------------------------------------------------------
+
+
+class SmokeRun:
+    """Attached to the supervisor: decides ready / failed, then shuts the launch down.
+
+    Process and output checks run in the supervisor's loop thread (its event stream);
+    ROS graph checks run in one checker thread that hands its findings to the loop.
+    """
+
+    def __init__(
+        self,
+        supervisor: Supervisor,
+        expectations: list[Expectation],
+        settings: Settings,
+        *,
+        lifecycle: LifecycleManager | None = None,
+    ) -> None:
+        from mlaunch.ros.handoff import LoopCall, SharedGraph
+
+        self.supervisor = supervisor
+        self.expectations = expectations
+        self.settings = settings
+        self.phase = "waiting"  # waiting -> holding -> done
+        self.failed_reason = ""
+        self.rings: dict[str, deque[str]] = {}
+        self.loop = LoopCall(supervisor.selector)
+        self.started_at = supervisor.clock()
+        self._stop = threading.Event()
+        graph_env = _graph_environ(supervisor.plan)
+        self.graph: SharedGraph = (
+            lifecycle.graph
+            if lifecycle is not None
+            else SharedGraph(graph_env, f"_mlaunch_test_{os.getpid()}")
+        )
+        self._own_graph = lifecycle is None
+        self._checker: threading.Thread | None = None
+        supervisor.events.subscribe(self._on_event)
+        supervisor.schedule(TICK, self._tick, keeps_alive=False)
+        if any(e.kind in GRAPH_KINDS for e in expectations):
+            self._checker = threading.Thread(
+                target=self._check_graph, name="mlaunch-test-graph", daemon=True
+            )
+            self._checker.start()
+
+    def elapsed(self) -> float:
+        return self.supervisor.clock() - self.started_at
+
+    # --- loop thread ---------------------------------------------------------------------------
+
+    def _on_event(self, event: Event) -> None:
+        """The subscription: output, starts and exits, and the lifecycle manager's results."""
+        from mlaunch.ros.lifecycle import Outcome
+
+        if isinstance(event, Output):
+            self._on_output(event.process.label, event.data)
+        elif isinstance(event, Started):
+            self._on_process(False, event.process)
+        elif isinstance(event, Exited):
+            self._on_process(True, event.process)
+        elif isinstance(event, Outcome):
+            self._on_transition(event)
+
+    def _on_output(self, label: str, data: bytes) -> None:
+        lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
+        ring = self.rings.get(label)
+        if ring is None:
+            ring = self.rings[label] = deque(maxlen=RING_LINES)
+        ring.extend(lines)
+        if self.phase == "done":
+            return
+        for e in self.expectations:
+            if e.kind != "output" or e.status != "pending" or e.regex is None:
+                continue
+            if e.process and e.process not in (label, label.rsplit("-", 1)[0]):
+                continue
+            for line in lines:
+                if e.regex.search(line):
+                    self._met(e, f"{label}: {line.strip()[:160]}")
+                    break
+        self._maybe_ready()
+
+    def _on_process(self, exited: bool, process: Process) -> None:
+        label = process.label
+        e = next((x for x in self.expectations if x.key() == ("process", label)), None)
+        if e is None:
+            e = Expectation("process", label, origin="started later", labels=[label])
+            self.expectations.insert(len(self.expectations) - 1, e)
+        if not exited:
+            if e.status == "pending":
+                self._met(e, f"running (pid {process.pid})")
+            return
+        self._exited(e, process)
+
+    def _exited(self, e: Expectation, process: Process) -> None:
+        from mlaunch.run.process import describe_status
+
+        code = process.returncode if process.returncode is not None else 0
+        uptime = max(0.0, process.ended_at - process.started_at)
+        what = f"{describe_status(code)} after {uptime:.1f} s (pid {process.pid})"
+        if self.phase == "done" or process.stopping or self.supervisor.shutting_down:
+            return
+        if code == 0 and process.spec.respawn.mode == "never":
+            e.seen = f"{what}: a one-shot, finished"
+            return
+        if code == 0 and _allowed(process.spec, self.settings.allow_exit):
+            e.seen = f"{what}: allowed by --allow-exit"
+            return
+        self._fail(e, f"{what}, before the test ended")
+
+    def _on_transition(self, outcome: Outcome) -> None:
+        """The lifecycle manager's results: a failed bring-up fails its node's check at once."""
+        result = outcome.result
+        if result.ok or outcome.reason not in ("autostart", "sequence", "respawn"):
+            return
+        for e in self.expectations:
+            if e.kind == "lifecycle" and e.target == result.node and e.status != "failed":
+                self._fail(e, result.detail)
+
+    def _tick(self) -> None:
+        if self.phase == "done":
+            return
+        now = self.elapsed()
+        expired = []
+        for e in self.expectations:
+            deadline = e.within if e.within is not None else self.settings.timeout
+            if e.status == "pending" and e.kind != "shutdown" and now >= deadline:
+                expired.append((e, f"{e.seen} (deadline {deadline:g} s passed)"))
+        if expired and self.phase == "waiting":
+            # Every check past its deadline is reported, not just the first one.
+            for e, seen in expired:
+                self._mark(e, "failed", seen)
+            self._finish(f"mlaunch test failed: {expired[0][0].describe()}: {expired[0][1]}")
+        self._maybe_ready()
+        if self.phase != "done":
+            self.supervisor.schedule(TICK, self._tick, keeps_alive=False)
+
+    def _apply(self, findings: list[tuple[Expectation, bool, str]]) -> None:
+        for e, met, seen in findings:
+            if e.status != "pending" or self.phase == "done":
+                continue
+            if met:
+                self._met(e, seen)
+            else:
+                e.seen = seen
+        self._maybe_ready()
+
+    def _mark(self, e: Expectation, status: str, seen: str) -> None:
+        e.status, e.seen, e.at = status, seen, self.elapsed()
+
+    def _met(self, e: Expectation, seen: str) -> None:
+        self._mark(e, "met", seen)
+
+    def _fail(self, e: Expectation, seen: str) -> None:
+        if self.phase == "done":
+            return
+        self._mark(e, "failed", seen)
+        self._finish(f"mlaunch test failed: {e.describe()}: {seen}")
+
+    def _fail_all(self, expectations: list[Expectation], seen: str) -> None:
+        if self.phase == "done" or not expectations:
+            return
+        for e in expectations:
+            self._mark(e, "failed", seen)
+        self._finish(f"mlaunch test failed: {seen}")
+
+    def _maybe_ready(self) -> None:
+        if self.phase != "waiting":
+            return
+        if any(e.status == "pending" and e.kind != "shutdown" for e in self.expectations):
+            return
+        self.phase = "holding"
+        printer = self.supervisor.printer
+        count = sum(1 for e in self.expectations if e.status == "met")
+        printer.message("INFO", "test", f"ready after {self.elapsed():.1f} s ({count} checks met)")
+        if self.settings.hold > 0:
+            printer.message("INFO", "test", f"holding for {self.settings.hold:g} s")
+            self.supervisor.schedule(self.settings.hold, self._held, keeps_alive=False)
+        else:
+            self._held()
+
+    def _held(self) -> None:
+        self._finish("mlaunch test: ready" + (", held" if self.settings.hold else ""))
+
+    def _finish(self, reason: str) -> None:
+        if self.phase == "done":
+            return
+        wait = self._starting_for()
+        if wait > 0:
+            # Let the youngest process finish starting (see STARTUP_GRACE); checks still run.
+            self.supervisor.schedule(wait, lambda: self._finish(reason), keeps_alive=False)
+            return
+        self.phase = "done"
+        self.failed_reason = reason if "failed" in reason else ""
+        self._stop.set()
+        self.supervisor.begin_shutdown(reason)
+
+    def _starting_for(self) -> float:
+        """How much longer the youngest running process needs to reach STARTUP_GRACE of age."""
+        now = self.supervisor.clock()
+        ages = [now - p.started_at for p in self.supervisor.processes if p.running]
+        return max(0.0, STARTUP_GRACE - min(ages)) if ages else 0.0
+
+    # --- checker thread ---------------------------------------------------------------------------
+
+    def _check_graph(self) -> None:
+        from mlaunch.ros.graph_types import GraphNotRunning, RosBridgeError
+
+        try:
+            graph = self.graph.get()
+        except GraphNotRunning:
+            return
+        except RosBridgeError as exc:
+            # No graph (rclpy missing, a bad ROS_DOMAIN_ID): nothing will change by waiting.
+            message = f"cannot look at the ROS graph: {exc}"
+            failing = self._graph_expectations()
+            self.loop.call_soon(lambda: self._fail_all(failing, message))
+            return
+        probe = GraphProbe(graph)
+        while not self._stop.is_set():
+            try:
+                findings = probe.check(self._graph_expectations())
+            except GraphNotRunning:
+                return
+            except RosBridgeError as exc:
+                findings = [
+                    (e, False, f"ROS graph error: {exc}") for e in self._graph_expectations()
+                ]
+            self.loop.call_soon(lambda f=findings: self._apply(f))  # type: ignore[misc]
+            if not self._graph_expectations():
+                return
+            self._stop.wait(GRAPH_PERIOD)
+
+    def _graph_expectations(self) -> list[Expectation]:
+        return [e for e in self.expectations if e.kind in GRAPH_KINDS and e.status == "pending"]
+
+    # --- the end ----------------------------------------------------------------------------------
+
+    def conclude(self) -> None:
+        """After the run: pending checks did not happen; the stop ladder check."""
+        reason = self.supervisor.shutdown_reason or "it ended"
+        stopped_early = any(e.status == "failed" for e in self.expectations)
+        for e in self.expectations:
+            if e.kind == "shutdown":
+                self._conclude_shutdown(e)
+            elif e.status == "pending" and stopped_early:
+                # Undecided, not failed: the test stopped at the first failure.
+                seen = f"undecided, the test stopped at a failure (last seen: {e.seen})"
+                self._mark(e, "skipped", seen)
+            elif e.status == "pending":
+                self._mark(e, "failed", f"{e.seen}; the launch shut down first ({reason})")
+
+    def _conclude_shutdown(self, e: Expectation) -> None:
+        records = getattr(self.supervisor, "records", None) or {}
+        killed = [r.label for r in records.values() if signal.SIGKILL in r.signals]
+        e.labels = killed
+        if killed:
+            seen = f"needed SIGKILL: {', '.join(killed)} (ignored SIGINT and SIGTERM)"
+            self._mark(e, "failed", seen)
+        elif any(p.running for p in self.supervisor.processes):
+            self._mark(e, "failed", "processes still running when mlaunch ended")
+        else:
+            self._mark(e, "met", "every process ended after SIGINT or SIGTERM")
+
+    def close(self) -> None:
+        self._stop.set()
+        self.loop.close()
+        if self._checker is not None:
+            self._checker.join(timeout=2.0)
+        if self._own_graph:
+            self.graph.close()
+
+
+def _messages(count: int) -> str:
+    return "1 message" if count == 1 else f"{count} messages"
+
+
+def _allowed(spec: ProcessSpec, allowed: Iterable[str]) -> bool:
+    return any(name in (spec.label, spec.base_name) for name in allowed)
+
+
+def _graph_environ(plan: Plan) -> dict[str, str]:
+    """The environment of the launch's first ROS node (its ROS_DOMAIN_ID), else mlaunch's."""
+    for spec in plan.processes():
+        if spec.node is not None:
+            return dict(spec.env)
+    return dict(os.environ)
+
+
+class GraphProbe:
+    """Evaluates graph expectations against one RosGraph (runs in the checker thread)."""
+
+    def __init__(self, graph: Any) -> None:
+        self.graph = graph
+        self.watches: dict[str, Any] = {}
+        self.clock_first: float | None = None
+
+    def check(self, expectations: list[Expectation]) -> list[tuple[Expectation, bool, str]]:
+        nodes = self.graph.node_names()
+        topics = self.graph.topic_types()
+        services = (
+            self.graph.service_names() if any(e.kind == "service" for e in expectations) else set()
+        )
+        out: list[tuple[Expectation, bool, str]] = []
+        for e in expectations:
+            check: Callable[..., tuple[bool, str]] = getattr(self, f"_{e.kind}")
+            met, seen = check(e, nodes=nodes, topics=topics, services=services)
+            out.append((e, met, seen))
+        return out
+
+    def _node(self, e: Expectation, *, nodes: set[str], **_: Any) -> tuple[bool, str]:
+        if e.target in nodes:
+            return True, "in the graph"
+        visible = sorted(n for n in nodes if not n.rsplit("/", 1)[-1].startswith("_"))
+        shown = ", ".join(visible[:8]) + (" ..." if len(visible) > 8 else "")
+        return False, f"not in the graph (nodes seen: {shown or 'none'})"
+
+    def _lifecycle(self, e: Expectation, *, nodes: set[str], **_: Any) -> tuple[bool, str]:
+        from mlaunch.ros.graph_types import RosTimeout
+
+        if e.target not in nodes:
+            return False, "the node is not in the graph"
+        try:
+            state = self.graph.lifecycle_state(e.target, STATE_QUERY_TIMEOUT)
+        except RosTimeout as exc:
+            return False, f"no state: {exc}"
+        return state == e.state, f"state {state!r}"
+
+    def _service(self, e: Expectation, *, services: set[str], **_: Any) -> tuple[bool, str]:
+        if e.target in services:
+            return True, "offered"
+        return False, f"not offered ({len(services)} services in the graph)"
+
+    def _topic(self, e: Expectation, *, topics: dict[str, list[str]], **_: Any) -> tuple[bool, str]:
+        watch = self.watches.get(e.target)
+        if watch is None:
+            watch = self.watches[e.target] = self.graph.watch_topic(e.target)
+        if watch.error:
+            return False, watch.error
+        if watch.count == 0:
+            if e.target not in topics:
+                return False, "not in the graph (no publisher or subscriber)"
+            types = ", ".join(topics[e.target])
+            return False, f"in the graph ({types}) but no message received"
+        if e.rate is None:
+            return True, f"{_messages(watch.count)} received"
+        window = max(2.0, 5.0 / e.rate)
+        measured = watch.rate(window)
+        wanted = e.rate * RATE_TOLERANCE
+        seen = f"{measured:.1f} Hz over the last {window:g} s ({_messages(watch.count)})"
+        # A rate from a handful of arrivals is mostly jitter: it passes only from a few more.
+        if watch.count < max(3, min(10, int(e.rate))):
+            return False, f"still measuring: {seen}, wanted >= {wanted:.1f} Hz"
+        if measured >= wanted:
+            return True, seen
+        return False, f"too slow: {seen}, wanted >= {wanted:.1f} Hz"
+
+    def _clock(self, e: Expectation, **_: Any) -> tuple[bool, str]:
+        watch = self.watches.get("/clock")
+        if watch is None:
+            watch = self.watches["/clock"] = self.graph.clock()
+        message = watch.last_message()
+        if message is None:
+            return False, watch.error or "no /clock message received"
+        now = message.clock.sec + message.clock.nanosec * 1e-9
+        if self.clock_first is None:
+            self.clock_first = now
+        if now > self.clock_first:
+            return True, f"advanced from {self.clock_first:.2f} s to {now:.2f} s"
+        return False, f"stuck at {now:.2f} s ({_messages(watch.count)})"
