@@ -20,7 +20,8 @@ The children's pipes and the terminal share the loop's selector (mlaunch.run.pip
 terminal holds the children's pipes unread instead of losing lines. The per-label ProcessRecord
 (mlaunch.run.records) is what the status view and the exit summary read. Signals are recorded
 by mlaunch.run.signals, timers are mlaunch.run.timers, the respawn policy is
-mlaunch.run.respawn, and the launch file's event handlers are mlaunch.run.handlers.
+mlaunch.run.respawn, the launch file's event handlers are mlaunch.run.handlers, and the
+shutdown and signal handling is the Stopping base (mlaunch.run.stopping).
 """
 
 from __future__ import annotations
@@ -28,11 +29,10 @@ from __future__ import annotations
 import itertools
 import os
 import selectors
-import signal
 import time
 from collections.abc import Callable
 
-from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, exit_for_signal
+from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
 from mlaunch.run import guard as guards
 from mlaunch.run.events import (
     Completed,
@@ -41,13 +41,11 @@ from mlaunch.run.events import (
     Exited,
     FailedToStart,
     GaveUp,
-    Interrupted,
     LaunchEvent,
     NotStarted,
     Output,
     RespawnScheduled,
     Said,
-    ShutdownBegun,
     Started,
     StartsSkipped,
     StoppingAll,
@@ -71,11 +69,12 @@ from mlaunch.run.plan import (
     StartTimer,
     Step,
 )
-from mlaunch.run.process import Process, describe_status, signal_name
+from mlaunch.run.process import Process, describe_status
 from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, ProcessRecord
 from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve_deferred
 from mlaunch.run.respawn import GIVE_UP, NO_RESTART, next_restart
 from mlaunch.run.signals import SignalWatch
+from mlaunch.run.stopping import Stopping
 from mlaunch.run.strays import STRAY_GRACE, Strays
 from mlaunch.run.timers import Timer, Timers
 
@@ -89,7 +88,7 @@ if TYPE_CHECKING:
 POLL = 0.05
 
 
-class Supervisor:
+class Supervisor(Stopping):
     """Runs a Plan. Seams (printer, clock, guard, run id) are constructor arguments.
 
     The printer is subscribed to ``events`` first (after the supervisor's own reactions), then
@@ -458,100 +457,3 @@ class Supervisor:
         if not old.streams and old not in self.lingering and old in self.processes:
             self.processes.remove(old)  # a crash loop must not grow the list forever
         self.start(old.spec, restarts=attempt)
-
-    # --- stopping ----------------------------------------------------------------------------
-
-    def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None:
-        """Shut the launch down, in two phases on the stream.
-
-        ShutdownBegun: the printer says why, OnShutdown handlers run (and may ``hold_stop``
-        a process); then StoppingAll: every process not held gets its stop ladder.
-        """
-        if self.shutting_down:
-            return
-        self.shutting_down = True
-        self.shutdown_reason = reason
-        self.timers.shutting_down()  # pending respawns and TimerActions included
-        for record in self.records.values():
-            if record.state == RESTARTING:
-                record.not_restarting()
-        self.events.emit(ShutdownBegun(reason, due_to_signal))
-        self.events.emit(StoppingAll())
-
-    def _stop_all(self) -> None:
-        for process in self.processes:
-            if process.running and process not in self._held:
-                self.stop(process)
-        for process in self.lingering:
-            if process.check_group() and not process.stopping:
-                self.stop(process)
-
-    def hold_stop(self, process: Process) -> None:
-        """Keep ``process`` out of the stop ladder until ``release_stop`` (or a second Ctrl-C).
-
-        For work that must happen while a process still runs at shutdown, such as deactivating
-        a lifecycle node before it is signalled. Call it on ShutdownBegun: the ladder starts
-        for every process not held at the StoppingAll that follows it.
-        """
-        self._held.add(process)
-
-    def release_stop(self, process: Process) -> None:
-        """Hand a held process to the stop ladder (now, if the launch is shutting down)."""
-        self._held.discard(process)
-        if self.shutting_down and process.running:
-            self.stop(process)
-
-    def stop(self, process: Process) -> None:
-        """The stop ladder for one process group (mlaunch.run.ladder)."""
-        self.ladder.stop(process)
-
-    def kill_everything(self) -> None:
-        """A second Ctrl-C: SIGKILL every group and every stray at once."""
-        self._kill_now = True
-        self.ladder.kill(self.processes + self.lingering)
-        self.events.emit(StoppingAll(kill=True))
-        self.begin_shutdown("killed")
-
-    def _emergency_stop(self) -> None:
-        """The loop itself failed: kill everything we know of before the error propagates."""
-        try:
-            for process in self.processes + self.lingering:
-                if process.running or process.check_group():
-                    process.signal_group(signal.SIGKILL)
-            self.strays.kill_all(self.by_pid, self.guard.pid if self.guard is not None else None)
-            self._reap()
-        except Exception:
-            pass  # the original error is the one worth reporting
-
-    # --- signals -----------------------------------------------------------------------------
-
-    def _handle_signals(self) -> None:
-        pending = self.signals.pending
-        while pending:
-            sig = pending.pop(0)
-            if sig == signal.SIGCHLD:
-                self._reap()
-                continue
-            self._stop_pressed(sig)
-        self._reap()
-
-    def _handle_stop_signals(self) -> None:
-        """Act on the stop signals recorded so far; leave exits (SIGCHLD) for the loop."""
-        pending = self.signals.pending
-        i = 0
-        while i < len(pending):  # in place: the handler may append meanwhile
-            sig = pending[i]
-            if sig == signal.SIGCHLD:
-                i += 1
-                continue
-            del pending[i]
-            self._stop_pressed(sig)
-
-    def _stop_pressed(self, sig: int) -> None:
-        self._stop_presses += 1
-        if self._stop_presses == 1:
-            self.exit_code = max(self.exit_code, exit_for_signal(sig))
-            self.events.emit(Interrupted(sig))
-            self.begin_shutdown(f"{signal_name(sig)} received", due_to_signal=sig)
-        else:
-            self.kill_everything()
