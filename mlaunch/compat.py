@@ -44,7 +44,6 @@ SYNONYMS: dict[str, str] = {
     "launch.frontend": "mlaunch.launch",
     "launch_xml.launch_description_sources": "mlaunch.launch.launch_description_sources",
     "launch_yaml.launch_description_sources": "mlaunch.launch.launch_description_sources",
-    "launch_ros.descriptions": "mlaunch.launch_ros.parameter_descriptions",
     "launch_ros.event_handlers": "mlaunch.launch_ros.events",
     "launch_ros.events.lifecycle": "mlaunch.launch_ros.events",
     "launch_ros.utilities": "mlaunch.launch_ros",

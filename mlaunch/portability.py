@@ -84,6 +84,7 @@ def _check_one(path: str) -> tuple[list[Finding], list[str]]:
             )
         ], []
     if module == "mlaunch.frontends.python":
+        # portability_python builds on this module's Finding; it loads only for Python files.
         from mlaunch.portability_python import check_python
 
         return check_python(path)

@@ -298,6 +298,8 @@ class ExecuteProcess(Action):
         if callable(on_exit) and not hasattr(on_exit, "visit"):
             return resolver.defer([], self.origin, callback=on_exit), required
         entities = list(on_exit) if isinstance(on_exit, (list, tuple)) else [on_exit]
+        # launch.actions imports this module (ExecuteProcess is one of its names), so Shutdown
+        # is looked up when an on_exit needs it rather than at import.
         from mlaunch.launch.actions import Shutdown
 
         if any(isinstance(e, Shutdown) for e in entities):

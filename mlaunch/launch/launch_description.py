@@ -74,6 +74,8 @@ class LaunchDescription(LaunchDescriptionEntity):
 
     def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
         """The DeclareLaunchArgument actions in this description, includes not followed."""
+        # launch.actions builds on this module's classes, so its classes are looked up when a
+        # caller asks for the arguments, not at import.
         from mlaunch.launch import actions
 
         found: list[Any] = []

@@ -62,7 +62,7 @@ class YAMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
 
 def source_for(value: Any) -> LaunchDescriptionSource:
     """IncludeLaunchDescription also takes a bare path or a LaunchDescription."""
-    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch.launch_description import LaunchDescription
 
     if isinstance(value, LaunchDescription):
         return LaunchDescriptionSource(launch_description=value)

@@ -31,7 +31,7 @@ _SUBMODULES = {
     "actions": "mlaunch.launch_ros.actions",
     "substitutions": "mlaunch.launch_ros.substitutions",
     "parameter_descriptions": "mlaunch.launch_ros.parameter_descriptions",
-    "descriptions": "mlaunch.launch_ros.parameter_descriptions",
+    "descriptions": "mlaunch.launch_ros.descriptions",
     "events": "mlaunch.launch_ros.events",
     "event_handlers": "mlaunch.launch_ros.events",
     "utilities": "mlaunch.launch_ros",

@@ -358,17 +358,7 @@ def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -
     return write_temp("launch_params_", performed, temp_dir)
 
 
-def __getattr__(name: str) -> Any:
-    # ComposableNode lives with the composition code; loaded only when a file names it.
-    if name == "ComposableNode":
-        from mlaunch.launch_ros.composable import ComposableNode
-
-        return ComposableNode
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 __all__ = [
-    "ComposableNode",  # noqa: F822 (module __getattr__)
     "Parameter",
     "ParameterFile",
     "ParameterValue",

@@ -11,8 +11,8 @@ launch configuration, so a scoped GroupAction keeps it inside.
 from __future__ import annotations
 
 from mlaunch.errors import LaunchFileError
-from mlaunch.launch.actions import Action
 from mlaunch.launch.execute_process import PUSHED_MACHINE as PUSHED
+from mlaunch.launch.launch_description import Action
 from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
 from mlaunch.machines.spec import DEFAULT_TIMEOUT, MachineSpec, check_name, declared
 
