@@ -122,7 +122,9 @@ def wait_until(
     return bool(predicate())
 
 
-def wait_for(predicate: Callable[[], T], timeout: float, what: str, interval: float = 0.05) -> T:
+def wait_for(
+    predicate: Callable[[], T | None], timeout: float, what: str, interval: float = 0.05
+) -> T:
     """Poll until ``predicate()`` is truthy and return it; an AssertionError naming ``what`` when
     the deadline passes."""
     deadline = time.monotonic() + timeout

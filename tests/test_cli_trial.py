@@ -15,6 +15,7 @@ from mlaunch import __version__
 from mlaunch.run import describe, status
 from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
 from mlaunch.run.output import Printer
+from mlaunch.run.plan import ArgumentInfo
 
 PY = sys.executable
 
@@ -60,21 +61,15 @@ def test_status_falls_back_to_80x24_on_a_0x0_terminal(monkeypatch: pytest.Monkey
     assert status.terminal_size() == (132, 50)
 
 
-class _Info:
-    def __init__(self, name: str, default: str | None, description: str) -> None:
-        self.name = name
-        self.default = default
-        self.description = description
-        self.conditional = False
-
-
 def test_show_args_wraps_long_defaults(monkeypatch: pytest.MonkeyPatch) -> None:
     long_default = "/opt/ros/jazzy/share/some_robot_description/urdf/robot_with_sensors.urdf"
     for columns in (80, 300, 0):
         monkeypatch.setattr(
             describe.os, "get_terminal_size", lambda fd, c=columns: os.terminal_size((c, 24))
         )
-        text = describe.format_arguments([_Info("model", long_default, "the robot model")])
+        text = describe.format_arguments(
+            [ArgumentInfo("model", long_default, "the robot model", None, "test")]
+        )
         assert "..." not in text
         # The default column (after "  model  ", 36 wide) holds every character, in order.
         rows = text.splitlines()[4:]

@@ -8,9 +8,9 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from procutil import REPO, clean_env, run_mlaunch
 
 from mlaunch.export.systemd import environment_file, quote_exec
-from tests.procutil import REPO, clean_env, run_mlaunch
 
 PREFIX = REPO / "launches" / "examples" / "prefix"
 LAUNCH = """

@@ -14,6 +14,7 @@ import sys
 import time
 import urllib.request
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import requires_rclpy
@@ -34,7 +35,7 @@ def descendants_of(pid: int) -> list[int]:
         return []
 
 
-def run_probe(env: dict[str, str], nodes: list[str]) -> dict[str, object]:
+def run_probe(env: dict[str, str], nodes: list[str]) -> dict[str, Any]:
     done = subprocess.run(
         [sys.executable, str(Path(__file__).parent / "e2e_probe.py"), ",".join(nodes), "40"],
         capture_output=True,
@@ -77,7 +78,7 @@ def test_jtbot_sim_end_to_end(ros_env: dict[str, str], tmp_path: Path) -> None:
         children = descendants_of(run.proc.pid)
         assert len(children) >= 3, run.text
         result = run_probe(env, EXPECTED_NODES)
-        assert set(EXPECTED_NODES) <= set(result["nodes"]), result  # type: ignore[arg-type]
+        assert set(EXPECTED_NODES) <= set(result["nodes"]), result
         assert result["use_sim_time"] == {n: True for n in EXPECTED_NODES}, result
         assert result["clock_advanced"], result
         assert result["odom_moved"] > 0.2, result  # type: ignore[operator]

@@ -133,7 +133,11 @@ def test_loop_call_runs_callbacks_from_threads_in_the_loop_thread_in_order() -> 
 
         def post() -> None:
             for i in range(200):
-                loop.call_soon(lambda i=i: seen.append((i, threading.current_thread().name)))
+
+                def record(i: int = i) -> None:
+                    seen.append((i, threading.current_thread().name))
+
+                loop.call_soon(record)
 
         worker = threading.Thread(target=post)
         worker.start()

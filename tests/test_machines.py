@@ -14,10 +14,9 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-
-from tests import sshd as sshd_server
-from tests.procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
-from tests.sshd import HOST_ALIAS, Server
+import sshd as sshd_server
+from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
+from sshd import HOST_ALIAS, Server
 
 HEADER = """
 from launch import LaunchDescription

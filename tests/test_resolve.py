@@ -252,7 +252,8 @@ def test_opaque_function_reads_context_and_returns_actions() -> None:
 
 def test_opaque_function_exception_is_located() -> None:
     def broken(context):  # type: ignore[no-untyped-def]
-        return {}["nope"]
+        nothing: dict[str, str] = {}
+        return nothing["nope"]
 
     with pytest.raises(MlaunchError, match="KeyError") as err:
         run(LaunchDescription([OpaqueFunction(function=broken)]))

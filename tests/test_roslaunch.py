@@ -412,8 +412,8 @@ def test_global_params_reach_every_node_of_their_scope_whatever_the_order(tmp_pa
 
 
 def test_robot_description_goes_to_robot_state_publisher_only(tmp_path: Path) -> None:
-    model = package(tmp_path, "bot")
-    (model / "bot.urdf").write_text('<robot name="bot"><link name="base"/></robot>\n')
+    bot = package(tmp_path, "bot")
+    (bot / "bot.urdf").write_text('<robot name="bot"><link name="base"/></robot>\n')
     path = write(
         tmp_path,
         "launch/rd.launch",

@@ -52,9 +52,11 @@ def main() -> int:
 
     node.create_subscription(TFMessage, "/tf_static", keep("/tf_static"), latched)
     node.create_subscription(TFMessage, "/tf", keep("/tf"), 100)
-    node.create_subscription(
-        String, "robot_description", lambda m: links.extend(parse_urdf(m.data).links), latched
-    )
+
+    def on_description(msg: String) -> None:
+        links.extend(parse_urdf(msg.data).links)
+
+    node.create_subscription(String, "robot_description", on_description, latched)
     deadline = time.monotonic() + deadline_s
     while not (links and all(reachable(root, parents, link) for link in links)):
         if time.monotonic() > deadline:

@@ -73,9 +73,11 @@ class _ParamsLoader(yaml.SafeLoader):
     """Reads launch_ros's params files, which write Python tuples with their YAML tag."""
 
 
-_ParamsLoader.add_constructor(
-    "tag:yaml.org,2002:python/tuple", lambda loader, node: loader.construct_sequence(node)
-)
+def _tuple_as_list(loader: yaml.SafeLoader, node: yaml.SequenceNode) -> list[object]:
+    return loader.construct_sequence(node)
+
+
+_ParamsLoader.add_constructor("tag:yaml.org,2002:python/tuple", _tuple_as_list)
 
 
 def case_names() -> list[str]:

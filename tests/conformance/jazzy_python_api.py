@@ -13,7 +13,6 @@ import importlib
 import inspect
 import json
 import pkgutil
-import sys
 import warnings
 
 PACKAGES = ("launch", "launch_ros", "launch_xml", "launch_yaml")
@@ -94,4 +93,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -27,7 +27,7 @@ import time
 
 def _own_options(argv):
     """The recorder's options: everything before --ros-args, leaving the ROS part alone."""
-    opts = {"say": [], "err": [], "linger": 0.0, "exit": 0, "wait_for": None}
+    opts: dict = {"say": [], "err": [], "linger": 0.0, "exit": 0, "wait_for": None}
     args = argv[1:]
     if "--ros-args" in args:
         args = args[: args.index("--ros-args")]
