@@ -74,4 +74,6 @@ def load(path: str, hint: str | None = None) -> LaunchDescription:
             f"reading {path!r} needs the Python package {e.name!r}, which is not installed"
             " (reinstall mlaunch with its dependencies: pip install mlaunch)"
         ) from e
-    return module.load(path)
+    # Every frontend module's load() returns a LaunchDescription; import_module cannot say so.
+    description: LaunchDescription = module.load(path)
+    return description

@@ -218,7 +218,7 @@ class Entity:
             )
 
     def number(
-        self, name: str, kind: type = float, *, minimum: float | None = None
+        self, name: str, kind: type[float] | type[int] = float, *, minimum: float | None = None
     ) -> float | int | Parts | None:
         """A number attribute (``kind`` int or float), or substitutions."""
         attr = self._take(name, False)

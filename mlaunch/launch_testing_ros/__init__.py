@@ -35,12 +35,13 @@ class WaitForTopics:
         messages_received_buffer_length: int = 10,
     ) -> None:
         import rclpy
+        from rclpy.context import Context
         from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
         self.topic_tuples = list(topic_tuples)
         self.timeout = timeout
         self._length = messages_received_buffer_length
-        self._context = rclpy.Context()
+        self._context = Context()
         rclpy.init(context=self._context)
         self._executor = SingleThreadedExecutor(context=self._context)
         self._node = rclpy.create_node(

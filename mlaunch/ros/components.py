@@ -175,9 +175,9 @@ class ComponentDriver:
         self.supervisor = supervisor
         self.loop = LoopCall(supervisor.selector)
         environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
-        import rclpy
+        from rclpy.context import Context
 
-        context = rclpy.Context()
+        context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
         self.loader = ComponentLoader(context, self._log)
         self.steps = steps

@@ -170,7 +170,8 @@ def yaml_float(value: float) -> str:
 def reads_back(value: str) -> bool:
     """Whether ROS 2's untyped param guess reads this text as the same string."""
     try:
-        return yaml.safe_load(value) == value
+        read_back: object = yaml.safe_load(value)
+        return read_back == value
     except yaml.YAMLError:
         return True
 

@@ -361,8 +361,9 @@ class StatusView:
             )
         import io
 
+        out = io.StringIO()
         console = Console(
-            file=io.StringIO(),
+            file=out,
             width=max(40, columns - 1),
             force_terminal=True,
             color_system="standard" if self.color else None,
@@ -371,7 +372,7 @@ class StatusView:
             legacy_windows=False,
         )
         console.print(table)
-        return console.file.getvalue().rstrip("\n")  # type: ignore[attr-defined]
+        return out.getvalue().rstrip("\n")
 
 
 def _printable(raw: bytes) -> str:

@@ -54,13 +54,13 @@ def init_ros(args: list[str], node_name: str) -> StopFlag | None:
 
 def spin(node: Any, stop: StopFlag) -> None:
     """Run the node's callbacks until the stop flag is set or ROS shuts down."""
-    import rclpy
     from rclpy.executors import SingleThreadedExecutor
+    from rclpy.utilities import ok
 
     executor = SingleThreadedExecutor(context=node.context)
     executor.add_node(node)
     try:
-        while not stop.requested and rclpy.ok(context=node.context):
+        while not stop.requested and ok(context=node.context):
             executor.spin_once(timeout_sec=0.1)
     finally:
         executor.remove_node(node)
@@ -77,8 +77,8 @@ def spin_until_shutdown(
     ``input_errors`` maps the program's own exception types for a bad URDF or parameter to the
     prefix of their line: their message is the whole story, so no traceback.
     """
-    import rclpy
     from rclpy.executors import ExternalShutdownException
+    from rclpy.utilities import try_shutdown
 
     try:
         start()
@@ -91,5 +91,5 @@ def spin_until_shutdown(
         pass
     finally:
         node.destroy_node()
-        rclpy.try_shutdown()
+        try_shutdown()
     return EXIT_OK

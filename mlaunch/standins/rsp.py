@@ -170,7 +170,7 @@ class StatePublisher:
         oldest = min(oldest, now)
         interval_ns = int(1000.0 / self.options["publish_frequency"]) * 1_000_000
         stamp_ns = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
-        return self.options["ignore_timestamp"] or stamp_ns >= oldest + interval_ns
+        return bool(self.options["ignore_timestamp"]) or stamp_ns >= oldest + interval_ns
 
     def on_joint_states(self, msg: JointState) -> None:
         """Keep the latest joint positions, publish the moving joints on /tf when due."""

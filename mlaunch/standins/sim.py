@@ -25,15 +25,12 @@ import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from mlaunch.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag
-from mlaunch.standins.diffdrive import (
-    ModelError,
-    Pose2D,
-    describe_model,
-)
+from mlaunch.standins.diffdrive import Pose2D, describe_model
+from mlaunch.standins.plugins import ModelError
 from mlaunch.standins.sim_topics import (
     PROG,
     Output,
@@ -121,7 +118,7 @@ def _gz_parser() -> argparse.ArgumentParser:
 class _Parser(argparse.ArgumentParser):
     """argparse that raises instead of printing usage and exiting."""
 
-    def error(self, message: str) -> Any:  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         raise SimUsageError(message)
 
 
@@ -264,6 +261,7 @@ def _serve(argv: list[str], options: SimOptions, world: World, stop: StopFlag) -
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
+    from rclpy.utilities import try_shutdown
 
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
@@ -296,7 +294,7 @@ def _serve(argv: list[str], options: SimOptions, world: World, stop: StopFlag) -
     finally:
         if node is not None:
             node.destroy_node()
-        rclpy.try_shutdown()
+        try_shutdown()
 
 
 def _default_sim_time(node: Any) -> None:

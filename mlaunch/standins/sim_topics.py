@@ -15,7 +15,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from mlaunch.standins.camera import CameraParams, DepthRenderer, camera_info
-from mlaunch.standins.diffdrive import DiffDrive, ImuParams, LidarParams, ModelSpec, Pose2D
+from mlaunch.standins.diffdrive import DiffDrive, ModelSpec, Pose2D
+from mlaunch.standins.sensors import ImuParams, LidarParams
 from mlaunch.standins.simulation import Schedule, SimRobot, Simulation
 
 PROG = "mlaunch sim"

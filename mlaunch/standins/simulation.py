@@ -11,8 +11,8 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from mlaunch.standins.diffdrive import DiffDrive, ImuParams, LidarParams, ModelSpec, Pose2D
-from mlaunch.standins.sensors import Mount
+from mlaunch.standins.diffdrive import DiffDrive, ModelSpec, Pose2D
+from mlaunch.standins.sensors import ImuParams, LidarParams, Mount
 from mlaunch.standins.world import (
     Disc,
     NoiseSampler,

@@ -21,7 +21,7 @@ import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from mlaunch.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag
@@ -64,7 +64,7 @@ class SpawnOptions:
 class _Parser(argparse.ArgumentParser):
     """argparse that raises SpawnError instead of printing usage and exiting."""
 
-    def error(self, message: str) -> Any:  # type: ignore[override]
+    def error(self, message: str) -> NoReturn:
         raise SpawnError(f"{self.prog}: {message}", exit_code=2)
 
 
@@ -148,14 +148,14 @@ def _looks_like_option(token: str) -> bool:
 def _options_from(ns: argparse.Namespace, flavor: str, program: str) -> SpawnOptions:
     source = next(s for s in SOURCES if getattr(ns, f"source_{s}", None) not in (None, False))
     value = getattr(ns, f"source_{source}")
-    pose = tuple(getattr(ns, f"pose_{k}") for k in ("x", "y", "z", "R", "P", "Y"))
+    pose = (ns.pose_x, ns.pose_y, ns.pose_z, ns.pose_R, ns.pose_P, ns.pose_Y)
     options = SpawnOptions(
         flavor=flavor,
         program=program,
         name=ns.entity,
         source=source,
         value="" if value is True else str(value),
-        pose=pose,  # type: ignore[arg-type]
+        pose=pose,
         timeout=ns.timeout,
         sim_timeout=getattr(ns, "spawn_service_timeout", None),
         robot_namespace=getattr(ns, "robot_namespace", None),
@@ -304,6 +304,7 @@ def _spawn(argv: list[str], options: SpawnOptions, xml: str | None, stop: StopFl
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
+    from rclpy.utilities import try_shutdown
 
     try:
         rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
@@ -324,7 +325,7 @@ def _spawn(argv: list[str], options: SpawnOptions, xml: str | None, stop: StopFl
     finally:
         if node is not None:
             node.destroy_node()
-        rclpy.try_shutdown()
+        try_shutdown()
 
 
 @dataclass

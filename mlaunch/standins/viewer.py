@@ -421,7 +421,8 @@ def subscribe_tf_and_depth(node: Node, state: ViewerState, latched: Any, sensor:
         node.create_subscription(TFMessage, "/tf", on_tf, 100)
         node.create_subscription(TFMessage, "/tf_static", on_tf, latched)
     if state.config.depth_topic:
-        from rclpy.clock import Clock, ClockType
+        from rclpy.clock import Clock
+        from rclpy.clock_type import ClockType
 
         feed = DepthFeed(node, state)
         # Steady time: under use_sim_time a paused /clock must not keep a closed page's feed.
@@ -462,10 +463,9 @@ class DepthFeed:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the viewer until shutdown; 1 with a one-line error when its input is unusable."""
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
-    import rclpy
     from rclpy.executors import ExternalShutdownException
     from rclpy.node import Node
-    from rclpy.utilities import remove_ros_args
+    from rclpy.utilities import remove_ros_args, try_shutdown
 
     try:
         options = parse_args(remove_ros_args(args)[1:])
@@ -503,7 +503,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             server.shutdown()
             server.server_close()
         node.destroy_node()
-        rclpy.try_shutdown()
+        try_shutdown()
     return EXIT_OK
 
 
