@@ -78,6 +78,9 @@ class MlaunchError(Exception):
     """
 
     exit_code = EXIT_USAGE
+    # The launch argument a bad value came from, when it came straight from one: the resolver
+    # then names the argument's declaration too, where the user's command line can be fixed.
+    argument: str | None = None
 
     def __init__(self, message: str, *, where: str | None = None, what: str | None = None):
         super().__init__(message)

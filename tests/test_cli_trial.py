@@ -105,3 +105,58 @@ def test_help_has_no_restructuredtext_quoting(sub: list[str], env: dict[str, str
     done = run_mlaunch(*sub, "--help", env=env)
     assert done.returncode == 0, done.stderr
     assert "``" not in done.stdout
+
+
+def _demo_package(tmp_path: Path) -> str:
+    """An ament prefix with package ``demo`` and its executable ``talker``; the prefix path."""
+    prefix = tmp_path / "install"
+    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
+    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
+    (prefix / "share/demo").mkdir()
+    (prefix / "lib/demo").mkdir(parents=True)
+    talker = prefix / "lib/demo/talker"
+    talker.write_text(f"#!{PY}\nprint('talking')\n")
+    talker.chmod(0o755)
+    return str(prefix)
+
+
+SIM_TIME_LAUNCH = """\
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node, SetParameter
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument('use_sim_time', default_value='false'),
+        DeclareLaunchArgument('sim', default_value='true'),
+        SetParameter('use_sim_time', LaunchConfiguration('use_sim_time')),
+        Node(package='demo', executable='talker',
+             parameters=[{'use_sim_time': LaunchConfiguration('sim')}]),
+    ])
+"""
+
+
+def test_use_sim_time_that_is_not_a_boolean_names_its_declaration(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    """ros2 launch passes use_sim_time:=maybe on and every node dies of a type error; mlaunch
+    says so once, at the line that sets it, with the argument's declaration."""
+    path = tmp_path / "sim.launch.py"
+    path.write_text(SIM_TIME_LAUNCH)
+    env = {**env, "AMENT_PREFIX_PATH": _demo_package(tmp_path)}
+    ok = run_mlaunch(str(path), "--print", "use_sim_time:=true", "sim:=False", env=env)
+    assert ok.returncode == 0, ok.stderr
+    done = run_mlaunch(str(path), "--print", "use_sim_time:=maybe", env=env)
+    assert done.returncode == 2
+    assert done.stderr.splitlines() == [
+        f"mlaunch: error: {path}:10: SetParameter('use_sim_time'): parameter 'use_sim_time' is"
+        " 'maybe', which every ROS node rejects at start-up (it must be a boolean); valid: true"
+        f" or false (launch argument 'use_sim_time', declared at {path}:8)"
+    ]
+    # A node's own parameter, from another argument: 1 is an integer to ROS, not a boolean.
+    done = run_mlaunch(str(path), "--print", "sim:=1", env=env)
+    assert done.returncode == 2
+    assert done.stderr.startswith(f"mlaunch: error: {path}:11: "), done.stderr
+    assert "parameter 'use_sim_time' is 1," in done.stderr
+    assert f"(launch argument 'sim', declared at {path}:9)" in done.stderr

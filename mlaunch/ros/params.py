@@ -29,6 +29,7 @@ from pathlib import Path
 
 from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.launch.substitutions import (
+    LaunchConfiguration,
     Substitution,
     TextSubstitution,
     describe,
@@ -194,7 +195,31 @@ def evaluate_dict(context: LaunchContext, params: NormalizedDict) -> dict[str, A
                 e.message = f"parameter {name!r}: {e.message}"
                 e.args = (e.message,)
             raise
+        if name == USE_SIM_TIME and not isinstance(out[name], bool):
+            raise _not_a_clock_switch(context, value, out[name])
     return out
+
+
+USE_SIM_TIME = "use_sim_time"
+
+
+def _not_a_clock_switch(
+    context: LaunchContext, value: NormalizedValue, got: Any
+) -> SubstitutionFailure:
+    """The error for a use_sim_time that is not a boolean.
+
+    Every ROS node declares use_sim_time as a boolean and refuses to start with anything else
+    (ros2 launch passes it on and each node dies with a type error); here it is one line that
+    names the launch argument it came from, if any, so the resolver can add its declaration.
+    """
+    error = SubstitutionFailure(
+        f"parameter {USE_SIM_TIME!r} is {got!r}, which every ROS node rejects at start-up"
+        " (it must be a boolean); valid: true or false"
+    )
+    subs = value.subs if isinstance(value, Text) else ()
+    if len(subs) == 1 and isinstance(subs[0], LaunchConfiguration):
+        error.argument = perform_substitutions(context, subs[0].variable_name)
+    return error
 
 
 def evaluate_value(context: LaunchContext, value: NormalizedValue, name: str) -> Any:

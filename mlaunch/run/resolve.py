@@ -110,9 +110,19 @@ class Resolver:
                 e.where = origin
             if e.what is None and not isinstance(e, LaunchFileError):
                 e.what = _short(entity)
+            self._name_declaration(e)
             raise
         if more:
             self.visit_all(more)
+
+    def _name_declaration(self, error: MlaunchError) -> None:
+        """Add where the launch argument a bad value came from is declared (once)."""
+        info = self.plan.arguments.get(error.argument or "")
+        if info is None or not info.origin:
+            return
+        error.message += f" (launch argument {error.argument!r}, declared at {info.origin})"
+        error.args = (error.message,)
+        error.argument = None
 
     def visit_all(self, entities: Iterable[Any]) -> None:
         for entity in entities:
