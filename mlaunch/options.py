@@ -14,6 +14,10 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+# The viewer stand-in's port variable (mlaunch.standins.viewer_config.PORT_ENV; not imported
+# from there: that module loads dataclasses and typing, which a launch's start-up does without).
+VIEWER_PORT_ENV = "MLAUNCH_VIEWER_PORT"
+
 
 class Options:
     """What the command line asked for (a plain class: dataclasses cost ~8 ms to import)."""
@@ -193,6 +197,12 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         metavar="N",
         help="rotate each log file at N bytes, 0 never (default: 67108864, 64 MiB)",
     )
+    parser.add_argument(
+        "--viewer-port",
+        metavar="PORT",
+        help="port of the viewer stand-in's page on 127.0.0.1 (default: any free port;"
+        f" also ${VIEWER_PORT_ENV})",
+    )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     parser.add_argument(
         "--log-keep",
@@ -218,6 +228,7 @@ VALUE_OPTIONS = frozenset(
         "--color",
         "--log-max-bytes",
         "--log-keep",
+        "--viewer-port",
     }
 )
 
@@ -285,7 +296,38 @@ def parse_options(argv: Sequence[str]) -> Options:
         opts.arguments["launch-prefix-filter"] = ns.launch_prefix_filter
     if ns.show_all_subprocesses_output:
         os.environ["OVERRIDE_LAUNCH_PROCESS_OUTPUT"] = "both"
+    if ns.viewer_port is not None:
+        # The viewer stand-in reads it from its environment, as when the variable is set.
+        os.environ[VIEWER_PORT_ENV] = str(_viewer_port(ns.viewer_port))
     return opts
+
+
+def _viewer_port(value: str) -> int:
+    """--viewer-port: 0 (any free port) or a port of 127.0.0.1 that nothing listens on now."""
+    from mlaunch.errors import UsageError
+
+    text = value.strip()
+    port = int(text) if text.isdigit() else -1
+    if not 0 <= port <= 65535:
+        raise UsageError(
+            f"--viewer-port is {value!r}; valid: a port number 1..65535, or 0 for any free port"
+        )
+    if port:
+        import socket
+
+        probe = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        try:
+            # As the viewer's server binds it: a port in TIME_WAIT is free, a listener is not.
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            probe.bind(("127.0.0.1", port))
+        except OSError as e:
+            raise UsageError(
+                f"--viewer-port {port}: 127.0.0.1:{port} cannot be used ({e.strerror});"
+                " valid: a free port, or 0 for any free port"
+            ) from None
+        finally:
+            probe.close()
+    return port
 
 
 def _log_keep(value: str | None) -> int | None:

@@ -2,20 +2,29 @@
 
 from __future__ import annotations
 
+import json
 import os
 import re
+import signal
+import socket
 import sys
 import textwrap
+import urllib.request
 from pathlib import Path
 
 import pytest
-from procutil import clean_env, run_mlaunch
+from conftest import requires_rclpy
+from procutil import Running, clean_env, mlaunch, run_mlaunch
 
 from mlaunch import __version__
+from mlaunch.options import VIEWER_PORT_ENV
 from mlaunch.run import describe, status
+from mlaunch.run.events import Output, Started
 from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
 from mlaunch.run.output import Printer
-from mlaunch.run.plan import ArgumentInfo
+from mlaunch.run.plan import ArgumentInfo, ProcessSpec
+from mlaunch.run.process import Process
+from mlaunch.standins.viewer_config import PORT_ENV
 
 PY = sys.executable
 
@@ -160,3 +169,100 @@ def test_use_sim_time_that_is_not_a_boolean_names_its_declaration(
     assert done.stderr.startswith(f"mlaunch: error: {path}:11: "), done.stderr
     assert "parameter 'use_sim_time' is 1," in done.stderr
     assert f"(launch argument 'sim', declared at {path}:9)" in done.stderr
+
+
+def _viewer_process(output: str) -> Process:
+    argv = (PY, "-m", "mlaunch.standins.viewer", "-d", "x.rviz")
+    spec = ProcessSpec("rviz2-1", argv, {}, {}, output=output, standin="rviz2/rviz2")
+    process = Process(spec, 0)
+    process.pid = 4242
+    return process
+
+
+@pytest.mark.parametrize(("output", "quiet"), [("log", False), ("log", True), ("screen", False)])
+def test_the_viewers_address_is_said_once_in_every_mode(
+    tmp_path: Path, output: str, quiet: bool
+) -> None:
+    seen: list[bytes] = []
+    printer = Printer(out=seen.append, quiet=quiet, log_dir=str(tmp_path))
+    viewer = _viewer_process(output)
+    printer(Started(viewer))
+    address = b"viewer: open http://127.0.0.1:41234/\n"
+    printer(Output(viewer, "stdout", b"before\n" + address + b"after\n"))
+    printer.close()
+    shown = b"".join(seen).decode()
+    assert shown.count("viewer: open") == 1
+    assert "[INFO] [rviz2-1]: viewer: open http://127.0.0.1:41234/\n" in shown
+    # The viewer's other stdout lines follow its output mode (and -q) as before.
+    assert ("[rviz2-1] before" in shown) == (output == "screen" and not quiet)
+    own = (tmp_path / "rviz2-1.log").read_text()
+    assert own == "before\n" + address.decode() + "after\n"
+    assert (tmp_path / "launch.log").read_text().count("viewer: open http://127.0.0.1:41234/") == 1
+
+
+def test_other_processes_lines_like_the_address_are_theirs() -> None:
+    seen: list[bytes] = []
+    printer = Printer(out=seen.append, quiet=True)
+    process = _viewer_process("screen")
+    process.spec.argv = (PY, "-c", "print('viewer: open http://example/')")
+    process.spec.standin = None
+    printer(Started(process))
+    printer(Output(process, "stdout", b"viewer: open http://example/\n"))
+    assert b"".join(seen) == b""  # a plain child's stdout under -q: not said
+
+
+def test_viewer_port_option_is_checked(env: dict[str, str]) -> None:
+    for bad in ("http", "70000", "-1"):
+        done = run_mlaunch("x.launch.py", "--viewer-port", bad, env=env)
+        assert done.returncode == 2
+        assert done.stderr == (
+            f"mlaunch: error: --viewer-port is {bad!r}; valid: a port number 1..65535, or 0 for"
+            " any free port\n"
+        )
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        done = run_mlaunch("x.launch.py", "--viewer-port", str(port), env=env)
+    assert done.returncode == 2
+    assert done.stderr == (
+        f"mlaunch: error: --viewer-port {port}: 127.0.0.1:{port} cannot be used (Address already"
+        " in use); valid: a free port, or 0 for any free port\n"
+    )
+    assert VIEWER_PORT_ENV == PORT_ENV  # the name the viewer reads
+
+
+VIEWER_LAUNCH = """\
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+def generate_launch_description():
+    return LaunchDescription([Node(package='rviz2', executable='rviz2', output='log')])
+"""
+
+
+@requires_rclpy
+@pytest.mark.timeout(90)
+def test_quiet_launch_shows_the_viewer_address_on_the_chosen_port(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    path = tmp_path / "view.launch.py"
+    path.write_text(VIEWER_LAUNCH)
+    with socket.socket() as free:
+        free.bind(("127.0.0.1", 0))
+        port = free.getsockname()[1]
+    env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    env["ROS_LOG_DIR"] = str(tmp_path / "logs")
+    run = Running(mlaunch(str(path), "-q", "--viewer-port", str(port)), env=env, cwd=str(tmp_path))
+    try:
+        found = run.wait_for(r"\[INFO\] \[rviz2-1\]: viewer: open (http://\S+)\n", timeout=60)
+        url = found.group(1)
+        assert url == f"http://127.0.0.1:{port}/"
+        with urllib.request.urlopen(url + "state.json", timeout=5) as reply:
+            assert json.loads(reply.read())["fixed_frame"] == "odom"
+        run.signal(signal.SIGINT)
+        assert run.finish(timeout=15) == 130
+    finally:
+        run.kill()
+    assert run.text.count("viewer: open") == 1, run.text
+    assert "process started" not in run.text  # still quiet

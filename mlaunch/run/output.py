@@ -60,6 +60,11 @@ LABEL_COLORS = [b"\x1b[32m", b"\x1b[36m", b"\x1b[35m", b"\x1b[34m", b"\x1b[33m",
                 b"\x1b[96m", b"\x1b[95m", b"\x1b[94m", b"\x1b[93m"]  # fmt: skip
 RESET = b"\x1b[0m"
 
+# The viewer stand-in (mlaunch.standins.viewer) prints its page's address as a line starting
+# with this on stdout; mlaunch says the line itself, in every output mode and under -q.
+VIEWER_MODULE = "mlaunch.standins.viewer"
+VIEWER_ADDRESS = b"viewer: open "
+
 
 def clean(data: bytes) -> bytes:
     """Valid UTF-8, with U+FFFD for whatever was not."""
@@ -122,6 +127,7 @@ class Printer:
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
+        self._viewers: set[str] = set()  # labels of viewer stand-ins, whose address is said
         if self.log_dir:
             self._launch_log = self._open("launch.log", lazy=False, rotate=False)
 
@@ -182,10 +188,10 @@ class Printer:
 
     # --- launch's own messages ----------------------------------------------------------------
 
-    def message(self, level: str, source: str, text: str) -> None:
-        """``[LEVEL] [source]: text`` on screen and in launch.log."""
+    def message(self, level: str, source: str, text: str, *, always: bool = False) -> None:
+        """``[LEVEL] [source]: text`` on screen and in launch.log (``always``: under -q too)."""
         line = f"[{level}] [{source}]: {text}\n".encode("utf-8", "replace")
-        if not self.quiet or level in ("WARNING", "ERROR"):
+        if always or not self.quiet or level in ("WARNING", "ERROR"):
             write = getattr(self._write, "urgent", self._write)
             if self.color and LEVEL_COLORS.get(level):
                 write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
@@ -288,7 +294,38 @@ class Printer:
 
     def _output(self, event: Output) -> None:
         process = event.process
-        self.output(process.label, event.stream, process.spec.output, event.data)
+        if (
+            self._viewers
+            and process.label in self._viewers
+            and event.stream == "stdout"
+            and VIEWER_ADDRESS in event.data
+        ):
+            self._viewer_output(process, event.data)
+        else:
+            self.output(process.label, event.stream, process.spec.output, event.data)
+
+    def _viewer_output(self, process: Process, data: bytes) -> None:
+        """A viewer stand-in's stdout with its address line, which mlaunch says itself.
+
+        The address must be seen whatever the viewer's output mode (``log`` hides its stdout)
+        and under -q, and only once: the child's copy goes to its own log file only.
+        """
+        label, mode = process.label, process.spec.output
+        rest = b""
+        for line in data.splitlines(keepends=True):
+            if not line.startswith(VIEWER_ADDRESS):
+                rest += line
+                continue
+            if rest:
+                self.output(label, "stdout", mode, rest)
+                rest = b""
+            self.message("INFO", label, clean(line).decode().rstrip(), always=True)
+            own = self._own.get(label)
+            if own is not None:
+                own.write(line)
+                self._dirty.add(own)
+        if rest:
+            self.output(label, "stdout", mode, rest)
 
     def _started(self, event: Started) -> None:
         process = event.process
@@ -298,6 +335,8 @@ class Printer:
             self.message(
                 "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
             )
+            if VIEWER_MODULE in spec.argv:
+                self._viewers.add(spec.label)
         self.message("INFO", spec.label, f"process started with pid [{process.pid}]")
 
     def _failed_to_start(self, event: FailedToStart) -> None:

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 from mlaunch.standins.common import init_ros, spin
 from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
 from mlaunch.standins.viewer_config import (
+    PORT_ENV,
     DisplayConfig,
     ViewerError,
     parse_args,
@@ -350,7 +351,10 @@ def serve(state: ViewerState, port: int, clock: Any) -> PageServer:
     try:
         server = PageServer(("127.0.0.1", port), make_handler(state, page, clock))
     except OSError as exc:
-        raise ViewerError(f"cannot listen on 127.0.0.1:{port}: {exc.strerror}") from None
+        raise ViewerError(
+            f"cannot listen on 127.0.0.1:{port}: {exc.strerror}; valid: a free port, or 0 for"
+            f" any free port (mlaunch --viewer-port, or {PORT_ENV})"
+        ) from None
     threading.Thread(target=server.serve_forever, name="viewer-http", daemon=True).start()
     return server
 
