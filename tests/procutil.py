@@ -18,6 +18,20 @@ T = TypeVar("T")
 REPO = Path(__file__).resolve().parent.parent
 
 
+def demo_package(root: Path) -> str:
+    """An ament prefix under ``root`` with package ``demo`` and its executable ``talker`` (a
+    Python script printing 'talking'); returns the prefix, for AMENT_PREFIX_PATH."""
+    prefix = root / "install"
+    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
+    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
+    (prefix / "share/demo").mkdir()
+    (prefix / "lib/demo").mkdir(parents=True)
+    talker = prefix / "lib/demo/talker"
+    talker.write_text(f"#!{sys.executable}\nprint('talking')\n")
+    talker.chmod(0o755)
+    return str(prefix)
+
+
 def clean_env(**extra: str) -> dict[str, str]:
     env = dict(os.environ)
     env.pop("PYTHONDONTWRITEBYTECODE", None)

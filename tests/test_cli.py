@@ -10,7 +10,15 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from procutil import Running, clean_env, mlaunch, pid_alive, run_mlaunch, wait_until
+from procutil import (
+    Running,
+    clean_env,
+    demo_package,
+    mlaunch,
+    pid_alive,
+    run_mlaunch,
+    wait_until,
+)
 
 PY = sys.executable
 
@@ -354,14 +362,7 @@ def test_node_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> Non
     """A launch of installed ROS nodes keeps the ExecuteProcess budget: the package lookup, names,
     namespaces, remaps, arguments and global parameters load nothing heavy before the first child.
     """
-    prefix = tmp_path / "install"
-    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
-    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
-    (prefix / "share/demo").mkdir()
-    (prefix / "lib/demo").mkdir(parents=True)
-    talker = prefix / "lib/demo/talker"
-    talker.write_text(f"#!{PY}\nprint('talking')\n")
-    talker.chmod(0o755)
+    prefix = demo_package(tmp_path)
     path = tmp_path / "nodes.launch.py"
     path.write_text(
         textwrap.dedent(
@@ -383,7 +384,7 @@ def test_node_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> Non
             """
         )
     )
-    env = {**env, "AMENT_PREFIX_PATH": str(prefix)}
+    env = {**env, "AMENT_PREFIX_PATH": prefix}
     assert loaded_at_first_child(str(path), env) == []
 
 

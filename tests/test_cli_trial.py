@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from conftest import requires_rclpy
-from procutil import Running, clean_env, mlaunch, run_mlaunch
+from procutil import Running, clean_env, demo_package, mlaunch, run_mlaunch
 
 from mlaunch import __version__
 from mlaunch.options import VIEWER_PORT_ENV
@@ -116,19 +116,6 @@ def test_help_has_no_restructuredtext_quoting(sub: list[str], env: dict[str, str
     assert "``" not in done.stdout
 
 
-def _demo_package(tmp_path: Path) -> str:
-    """An ament prefix with package ``demo`` and its executable ``talker``; the prefix path."""
-    prefix = tmp_path / "install"
-    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
-    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
-    (prefix / "share/demo").mkdir()
-    (prefix / "lib/demo").mkdir(parents=True)
-    talker = prefix / "lib/demo/talker"
-    talker.write_text(f"#!{PY}\nprint('talking')\n")
-    talker.chmod(0o755)
-    return str(prefix)
-
-
 SIM_TIME_LAUNCH = """\
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
@@ -153,7 +140,7 @@ def test_use_sim_time_that_is_not_a_boolean_names_its_declaration(
     says so once, at the line that sets it, with the argument's declaration."""
     path = tmp_path / "sim.launch.py"
     path.write_text(SIM_TIME_LAUNCH)
-    env = {**env, "AMENT_PREFIX_PATH": _demo_package(tmp_path)}
+    env = {**env, "AMENT_PREFIX_PATH": demo_package(tmp_path)}
     ok = run_mlaunch(str(path), "--print", "use_sim_time:=true", "sim:=False", env=env)
     assert ok.returncode == 0, ok.stderr
     done = run_mlaunch(str(path), "--print", "use_sim_time:=maybe", env=env)
