@@ -177,7 +177,13 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
     parser.add_argument(
         "--launch-prefix-filter", help="regex on executable names the prefix applies to"
     )
-    parser.add_argument("--status", action="store_true", help="live status view of the processes")
+    parser.add_argument(
+        "--status",
+        action="store_true",
+        help="a live table of the processes below their output; in a terminal, keys: up/down"
+        " or j/k select a process, l (or Enter) shows its last lines, Esc or q goes back to the"
+        " table; Ctrl-C stops everything",
+    )
     parser.add_argument(
         "-q",
         "--quiet",

@@ -9,7 +9,9 @@ EOF without the goodbye, mlaunch is dead: the guard sends SIGTERM (and SIGCONT, 
 processes) to every group it was told about and to every process whose environment carries the
 run's marker (``MLAUNCH_RUN_ID=<id>``, set in every child's environment and inherited by
 grandchildren, so even one that started its own session is found), waits the groups' grace,
-SIGKILLs what is left, removes mlaunch's private temp dir and says what it did on stderr.
+SIGKILLs what is left, removes mlaunch's private temp dir and says what it did on stderr. When
+``--status`` keys have the terminal in cbreak mode, mlaunch also sends the settings to put back
+(``t ...``, mlaunch.run.keyboard), and the guard puts them back first: the shell gets its echo.
 
 Why a forked process and not PR_SET_PDEATHSIG: that needs a preexec_fn in every spawn (slow,
 and unsafe with threads) and never reaches grandchildren. A fork costs about a millisecond and
@@ -284,6 +286,13 @@ class Guard:
         if not self.broken:
             self._pending.append(b"-%d\n" % pgid)
 
+    def terminal(self, line: bytes) -> None:
+        """The settings to put back on the terminal (fd 0) should mlaunch die (``--status``
+        keys change its mode; mlaunch.run.keyboard makes the line), sent at once."""
+        if not self.broken:
+            self._pending.append(line)
+            self.flush()
+
     @property
     def pending(self) -> bool:
         """Lines are queued for the next ``flush``."""
@@ -385,6 +394,7 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
     groups: dict[int, float] = {}
     clean = False
     pending = b""
+    terminal = b""  # the terminal settings mlaunch changed and would put back (a "t ..." line)
     while True:
         data = os.read(fd, 4096)
         if not data:
@@ -398,8 +408,12 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
                 groups[int(pgid)] = float(grace or DEFAULT_GRACE)
             elif line.startswith(b"-"):
                 groups.pop(int(line[1:]), None)
+            elif line.startswith(b"t"):
+                terminal = line
     if clean:
         return
+    if terminal:
+        _restore_terminal(terminal)  # first: a person is looking at that terminal
     ended = end_run(groups, run_id, cgroup, exclude={parent})
     removed = _remove_temp_dir(temp_dir)
     if ended or removed:
@@ -420,10 +434,29 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
             pass
 
 
+def _restore_terminal(line: bytes) -> None:
+    """Put back the terminal settings mlaunch changed (its keys under ``--status``)."""
+    import termios
+
+    from mlaunch.run.keyboard import parse_guard_line
+
+    attrs = parse_guard_line(line)
+    if attrs is None:
+        return
+    try:
+        termios.tcsetattr(0, termios.TCSANOW, attrs)  # SIGTTOU is ignored here
+    except (termios.error, OSError):
+        pass
+
+
 def _keep_only_fds(fd: int) -> None:
-    """Hold nothing of mlaunch's open: no pipe of a child, no log file, not its stdout."""
+    """Hold nothing of mlaunch's open: no pipe of a child, no log file, not its stdout.
+
+    A terminal on stdin stays: the guard puts its settings back if mlaunch dies in cbreak mode.
+    """
     devnull = os.open(os.devnull, os.O_RDWR)
-    os.dup2(devnull, 0)
+    if not os.isatty(0):
+        os.dup2(devnull, 0)
     os.dup2(devnull, 1)
     os.close(devnull)
     os.closerange(3, fd)

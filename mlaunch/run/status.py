@@ -30,6 +30,11 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from rich.console import Console
+
+    from mlaunch.run.keyboard import Keyboard
+    from mlaunch.run.status_keys import StatusKeys
+
 REFRESH = 0.5
 # The table takes at most this share of the terminal's height; output scrolls above it.
 MAX_SHARE = 0.5
@@ -172,6 +177,9 @@ class StatusView:
         self._urgent = False
         self._closed = False
         self._psutil: dict[int, Any] = {}
+        # Keys (mlaunch.run.status_keys), when the terminal can type them: ``enable_keys``.
+        self.keys: StatusKeys | None = None
+        self.keyboard: Keyboard | None = None
         self.screen = self.printer.set_screen(self)
         supervisor.events.subscribe(self._saw_output)
         supervisor.schedule(0.0, self._tick, keeps_alive=False, cancel_on_shutdown=False)
@@ -220,6 +228,8 @@ class StatusView:
         if self._closed:
             return
         self._closed = True
+        if self.keyboard is not None:
+            self.keyboard.close()  # the terminal's own mode back before anything else
         self._footer = b""
         self._redraw = True
         self.flush()
@@ -228,10 +238,41 @@ class StatusView:
 
     # --- what it shows --------------------------------------------------------------------------
 
+    def enable_keys(self) -> StatusKeys:
+        """Select a process with the keys and show its last lines (``press`` them on
+        ``keys``); the table gets a marked row and a help line."""
+        from mlaunch.run.status_keys import StatusKeys
+
+        self.keys = StatusKeys(lambda: list(self.supervisor.records), self.redraw)
+        return self.keys
+
+    def read_keys(self, fd: int) -> Keyboard:
+        """Take keys from the terminal ``fd``: cbreak mode until ``close`` (run/keyboard.py)."""
+        from mlaunch.run.keyboard import Keyboard
+
+        keys = self.keys or self.enable_keys()
+        guard = getattr(self.supervisor, "guard", None)
+        self.keyboard = Keyboard(
+            self.supervisor.selector,
+            keys.press,
+            fd=fd,
+            tell_guard=guard.terminal if guard is not None else None,
+        )
+        self.keyboard.start()
+        return self.keyboard
+
+    def redraw(self) -> None:
+        """Draw the view again now, with the usage last sampled (a key was pressed)."""
+        if not self._closed:
+            self._footer = self.render().encode("utf-8", "replace")
+            self._redraw = True
+
     def _saw_output(self, event: Event) -> None:
         if not isinstance(event, Output):
             return
         data = event.data
+        if self.keys is not None:
+            self.keys.saw_output(event.process.label, data)
         end = len(data) - 1  # data is complete lines: it ends with a newline
         start = data.rfind(b"\n", 0, end) + 1
         self.last_line[event.process.label] = data[start : min(end, start + LAST_LINE)]
@@ -239,6 +280,8 @@ class StatusView:
     def _tick(self) -> None:
         if self._closed:
             return
+        if self.keyboard is not None:
+            self.keyboard.check()  # job control: back in the foreground after Ctrl-Z, fg
         self.usage = self._sample()
         self._footer = self.render().encode("utf-8", "replace")
         self._redraw = True
@@ -313,18 +356,48 @@ class StatusView:
         return out
 
     def render(self) -> str:
-        """The table as terminal text (ANSI styles when ``color``), no trailing newline."""
-        from rich import box
+        """The view as terminal text (ANSI styles when ``color``), no trailing newline: the
+        table (or the pane of a process's last lines), then the keys' help line if any."""
+        import io
+
         from rich.console import Console
-        from rich.table import Table
         from rich.text import Text
 
         columns, lines = self.size()
+        out = io.StringIO()
+        console = Console(
+            file=out,
+            width=max(40, columns - 1),
+            force_terminal=True,
+            color_system="standard" if self.color else None,
+            no_color=not self.color,
+            highlight=False,
+            legacy_windows=False,
+        )
+        keys = self.keys
+        if keys is not None and keys.pane is not None:
+            self._print_pane(console, keys.pane, lines)
+        else:
+            self._print_table(console, lines)
+        if keys is not None:
+            console.print(Text(keys.help_line(), style="dim", no_wrap=True, overflow="ellipsis"))
+        return out.getvalue().rstrip("\n")
+
+    def _print_table(self, console: Console, lines: int) -> None:
+        from rich import box
+        from rich.table import Table
+        from rich.text import Text
+
         rows = self.rows()
-        room = max(1, int(lines * MAX_SHARE) - 4)
+        selected = self.keys.current() if self.keys is not None else None
+        room = max(1, int(lines * MAX_SHARE) - (5 if self.keys is not None else 4))
         hidden = 0
         if len(rows) > room:
-            keep = sorted(range(len(rows)), key=lambda i: (STATE_ORDER.get(rows[i][1], 4), i))
+            # Trouble first, and the selected row always.
+            keep = sorted(
+                range(len(rows)),
+                key=lambda i: (rows[i][0].label != selected, STATE_ORDER.get(rows[i][1], 4), i),
+            )
             kept = set(keep[:room])
             hidden = len(rows) - room
             rows = [row for i, row in enumerate(rows) if i in kept]
@@ -349,8 +422,12 @@ class StatusView:
         table.add_column("last output", no_wrap=True, overflow="ellipsis", ratio=1)
         for record, state, pid, uptime, cpu, rss, last in rows:
             style = STATE_STYLE.get(state, "dim")
+            label = record.label
+            if self.keys is not None:
+                # A marker as well as the highlight: without colours it is all there is.
+                label = ("> " if label == selected else "  ") + label
             table.add_row(
-                Text(record.label),
+                Text(label),
                 Text(state, style=style),
                 Text(pid),
                 Text(uptime),
@@ -358,38 +435,47 @@ class StatusView:
                 Text(cpu),
                 Text(rss),
                 Text(last, style="dim"),
+                style="reverse" if record.label == selected else None,
             )
-        import io
-
-        out = io.StringIO()
-        console = Console(
-            file=out,
-            width=max(40, columns - 1),
-            force_terminal=True,
-            color_system="standard" if self.color else None,
-            no_color=not self.color,
-            highlight=False,
-            legacy_windows=False,
-        )
         console.print(table)
-        return out.getvalue().rstrip("\n")
+
+    def _print_pane(self, console: Console, label: str, lines: int) -> None:
+        """The last lines ``label`` printed, as many as the table's share of the screen."""
+        from rich.text import Text
+
+        assert self.keys is not None
+        record = self.supervisor.records.get(label)
+        state = record.state if record is not None else "-"
+        shown = self.keys.recent.lines(label, max(1, int(lines * MAX_SHARE) - 2))
+        what = f"its last {len(shown)} lines" if shown else "no output yet"
+        console.print(Text(f"{label}: {state}, {what}", style="bold", no_wrap=True))
+        for raw in shown:
+            text = _printable(raw, strip=False)
+            console.print(Text(text, no_wrap=True, overflow="ellipsis"))
 
 
-def _printable(raw: bytes) -> str:
-    """A child's last line without its colours and control characters (they would break rows)."""
+def _printable(raw: bytes, *, strip: bool = True) -> str:
+    """A child's line without its colours and control characters (they would break rows)."""
     text = raw.decode("utf-8", "replace")
     if "\x1b" in text:
         from rich.text import Text
 
         text = Text.from_ansi(text).plain
-    return "".join(ch if ch.isprintable() else " " for ch in text).strip()
+    text = "".join(ch if ch.isprintable() else " " for ch in text)
+    return text.strip() if strip else text.rstrip()
 
 
 def attach_status_view(supervisor: Any) -> StatusView | None:
-    """The view on a terminal; on anything else a warning (redrawing would fill a log file)."""
+    """The view on a terminal; on anything else a warning (redrawing would fill a log file).
+
+    With a terminal on stdin too, its keys select a process and act on it (``read_keys``).
+    """
     if not os.isatty(1):
         supervisor.printer.message(
             "WARNING", "launch", "--status needs a terminal on stdout; no status view"
         )
         return None
-    return StatusView(supervisor, color=bool(getattr(supervisor.printer, "color", True)))
+    view = StatusView(supervisor, color=bool(getattr(supervisor.printer, "color", True)))
+    if os.isatty(0):
+        view.read_keys(0)
+    return view
