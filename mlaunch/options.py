@@ -156,8 +156,9 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
     parser.add_argument(
         "--scoped-parameters",
         action="store_true",
-        help="keep SetParameter and SetParametersFromFile inside their scoped group (ros2 launch"
-        " applies them after the group too); per file: a comment 'mlaunch: scoped-parameters'",
+        help="keep SetParameter, SetParametersFromFile and SetRemap inside their scoped group"
+        " (ros2 launch applies them after the group too); per file: a comment"
+        " 'mlaunch: scoped-parameters'",
     )
     parser.add_argument(
         "--package-path",

@@ -518,18 +518,19 @@ INSIDE += ["-p", "inner:=2", "-r", "a:=b", "-r", "c:=d"]
 def test_a_scoped_groups_global_parameter_applies_after_it_as_in_launch(
     prefix: Path, temp_dir: str
 ) -> None:
-    """Observed in Jazzy (conformance case ros_scoping): the parameter leaks, the remap and the
-    namespace do not; mlaunch says where it happens."""
+    """Observed in Jazzy (conformance cases ros_scoping, remap_scope): the parameter and the
+    remap leak, the namespace does not; mlaunch says where it happens."""
     plan = run(_scope_entities(), prefix, temp_dir)
     inside, outside = plan.processes()
     assert ros_part(inside) == INSIDE
     assert ros_part(outside) == [
         *["--ros-args", "-r", "__node:=out", "-r", "__ns:=/base"],
-        *["-p", "outer:=1", "-p", "inner:=2", "-r", "a:=b"],
+        *["-p", "outer:=1", "-p", "inner:=2", "-r", "a:=b", "-r", "c:=d"],
     ]
-    (warning,) = plan.warnings
-    assert "also applies to the nodes after the enclosing group" in warning
-    assert "--scoped-parameters" in warning
+    parameter, remap = plan.warnings
+    assert "this global parameter also applies to the nodes after the enclosing group" in parameter
+    assert "this global remap also applies to the nodes after the enclosing group" in remap
+    assert "--scoped-parameters" in remap
 
 
 def test_scoped_parameters_keep_them_inside_the_group(prefix: Path, temp_dir: str) -> None:

@@ -22,11 +22,11 @@ from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
 from mlaunch.launch_ros.scope import (
     add_global_params,
+    add_global_remap,
     make_namespace_absolute,
     namespace_problem,
     node_name_problem,
     prefix_namespace,
-    ros_remaps,
 )
 from mlaunch.ros import params
 from mlaunch.ros import xacro as _xacro
@@ -128,10 +128,13 @@ class SetRemap(Action):
         self.src = normalize(src)
         self.dst = normalize(dst)
 
+    # mlaunch's: True keeps it inside a scoped group even without --scoped-parameters.
+    keep_in_scope = False
+
     def execute(self, resolver: Resolver) -> None:
         ctx = resolver.context
         rule = (perform_substitutions(ctx, self.src), perform_substitutions(ctx, self.dst))
-        ctx.launch_configurations["ros_remaps"] = (*ros_remaps(ctx), rule)
+        add_global_remap(resolver, self, rule)
 
     def describe_short(self) -> str:
         return f"SetRemap({describe(self.src)} -> {describe(self.dst)})"

@@ -2,9 +2,9 @@
 the nodes after them, and rmw's rules for node names and namespaces (launch_ros.utilities).
 
 The state lives in the launch configurations under ROS 2's keys: ``ros_namespace`` (str),
-``global_params`` (``(name, value)`` pairs and params-file paths) and ``ros_remaps`` (a tuple of
-``(from, to)``). Global parameters are a list extended in place, as in launch_ros, so a
-SetParameter or SetParametersFromFile inside a scoped GroupAction also applies after the group
+``global_params`` (``(name, value)`` pairs and params-file paths) and ``ros_remaps`` (``(from,
+to)`` pairs). Both are lists extended in place, as in launch_ros, so a SetParameter,
+SetParametersFromFile or SetRemap inside a scoped GroupAction also applies after the group
 when the list already existed outside it (launch's shallow-copied scope): mlaunch warns where
 that happens. ``--scoped-parameters`` (or a comment ``mlaunch: scoped-parameters`` in the file)
 keeps them inside the group: an immutable tuple that each action replaces.
@@ -97,25 +97,37 @@ def global_params(context: LaunchContext) -> tuple[Any, ...]:
 def add_global_params(resolver: Resolver, action: Any, entries: tuple[Any, ...]) -> None:
     """Extend the global parameters as launch_ros does, or within the scope on request (the
     option, the file's comment, or ``keep_in_scope`` on the action: ROS 1 files' params)."""
+    _extend_shared(resolver, action, "global_params", entries, "global parameter")
+
+
+def add_global_remap(resolver: Resolver, action: Any, rule: tuple[str, str]) -> None:
+    """Add a global remap rule as launch_ros's SetRemap does: its list is extended in place too,
+    so inside a scoped group it reaches the nodes after the group (the same opt-in keeps it in)."""
+    _extend_shared(resolver, action, "ros_remaps", (rule,), "global remap")
+
+
+def _extend_shared(
+    resolver: Resolver, action: Any, key: str, entries: tuple[Any, ...], what: str
+) -> None:
     from mlaunch.run.binding import SCOPED_PARAMETERS, file_has
 
     configs = resolver.context.launch_configurations
-    current = configs.get("global_params")
+    current = configs.get(key)
     origin = action.origin or ""
     scoped = getattr(action, "keep_in_scope", False) or resolver.options.scoped_parameters
     if scoped or file_has(origin, SCOPED_PARAMETERS):
-        configs["global_params"] = (*(current or ()), *entries)
+        configs[key] = (*(current or ()), *entries)
     elif isinstance(current, list):
         if resolver.context.shared_with_outer_scope(current):
             resolver.warn(
-                f"{origin}: this global parameter also applies to the nodes after the enclosing"
+                f"{origin}: this {what} also applies to the nodes after the enclosing"
                 " group, as in ros2 launch (its list is shared with the outer scope);"
                 " --scoped-parameters, or a comment 'mlaunch: scoped-parameters' in the file,"
                 " keeps it inside the group"
             )
         current.extend(entries)
     else:
-        configs["global_params"] = [*(current or ()), *entries]
+        configs[key] = [*(current or ()), *entries]
 
 
 def ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
@@ -124,6 +136,7 @@ def ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
 
 __all__ = [
     "add_global_params",
+    "add_global_remap",
     "global_params",
     "make_namespace_absolute",
     "namespace_problem",

@@ -109,7 +109,9 @@ def _action(item: Item) -> Any:
         action.keep_in_scope = True  # ROS 1 global parameters belong to their group
         return action
     if isinstance(item, SetRemap):
-        return ros.SetRemap(src=subs(item.src), dst=subs(item.dst))
+        remap = ros.SetRemap(src=subs(item.src), dst=subs(item.dst))
+        remap.keep_in_scope = True  # ROS 1 remaps belong to their group
+        return remap
     if isinstance(item, SetEnv):
         return core.SetEnvironmentVariable(subs(item.name), subs(item.value))
     if isinstance(item, Group):
