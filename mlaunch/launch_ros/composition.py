@@ -34,19 +34,31 @@ if TYPE_CHECKING:
 class LoadComponents(Note):
     """Load ``requests`` into the container ``target`` (a full node name), in order.
 
+    ``written`` is the container's name as the launch file gave it (launch_ros's log lines show
+    that, ``'box'`` rather than ``'/box'``); empty means the same as ``target``.
     A Note: the supervisor carries nothing out for it; the LoadNode driver (attached to the run
     when the plan has such steps) sends the requests."""
 
-    __slots__ = ("requests", "target")
-    _fields = (*Note._fields, "target", "requests")
+    __slots__ = ("requests", "target", "written")
+    _fields = (*Note._fields, "target", "requests", "written")
     needs = frozenset({"components"})  # the run attaches the LoadNode driver (Plan.needs)
 
     def __init__(
-        self, origin: str = "", target: str = "", requests: tuple[LoadRequest, ...] = ()
+        self,
+        origin: str = "",
+        target: str = "",
+        requests: tuple[LoadRequest, ...] = (),
+        written: str = "",
     ) -> None:
         self.origin = origin
         self.target = target
         self.requests = requests
+        self.written = written
+
+    @property
+    def container_name(self) -> str:
+        """The container as launch_ros names it in its log lines: as written in the file."""
+        return self.written or self.target
 
     @property
     def service(self) -> str:
@@ -134,7 +146,7 @@ class LoadComposableNodes(Action):
         if requests:
             # A relative name is resolved by launch_ros's own node, whose namespace is '/'.
             full = make_namespace_absolute(target) if target else target
-            resolver.add(LoadComponents(self.origin, full, tuple(requests)))
+            resolver.add(LoadComponents(self.origin, full, tuple(requests), target))
 
     def _target_name(self) -> str | None:
         """The container action's full name (None when the target is given as a name)."""

@@ -24,6 +24,8 @@ if TYPE_CHECKING:
 
 # (level, message): where the driver's lines go (the run's printer, a test's list).
 Log = Callable[[str, str], None]
+# The logger launch_ros's LoadComposableNodes logs under (its module's name).
+LOGGER = "launch_ros.actions.load_composable_nodes"
 
 
 class LoadResult(Record):
@@ -138,13 +140,14 @@ class ComponentLoader:
         name = response.full_node_name or request.node_name
         if response.success:
             self.log(
-                "INFO", f"Loaded node '{response.full_node_name}' in container '{step.target}'"
+                "INFO",
+                f"Loaded node '{response.full_node_name}' in container '{step.container_name}'",
             )
         else:
             self.log(
                 "ERROR",
                 f"Failed to load node '{name}' of type '{request.plugin_name}' in container"
-                f" '{step.target}': {response.error_message}",
+                f" '{step.container_name}': {response.error_message}",
             )
         return LoadResult(
             request,
@@ -189,7 +192,7 @@ class ComponentDriver:
 
     def _log(self, level: str, message: str) -> None:
         printer = self.supervisor.printer
-        self.loop.call_soon(lambda: printer.message(level, "launch_ros", message))
+        self.loop.call_soon(lambda: printer.message(level, LOGGER, message))
 
     def close(self) -> None:
         self.loader.stop.set()
