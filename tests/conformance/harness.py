@@ -109,7 +109,7 @@ def reference_environ() -> dict[str, str] | None:
     return env if shutil.which("ros2", path=env.get("PATH")) else None
 
 
-def make_prefix(root: Path) -> Path:
+def make_prefix(root: Path, cases: Path = CASES) -> Path:
     """An ament prefix holding ``conf_pkg``: the recorder and every case under share/.../launch."""
     prefix = root / "prefix"
     index = prefix / "share" / "ament_index" / "resource_index" / "packages"
@@ -122,7 +122,7 @@ def make_prefix(root: Path) -> Path:
         "<version>0.0.0</version><description>conformance recorder</description>"
         "<maintainer email='a@b.c'>m</maintainer><license>Apache-2.0</license></package>\n"
     )
-    shutil.copytree(CASES, share / "launch")
+    shutil.copytree(cases, share / "launch")
     lib = prefix / "lib" / PACKAGE
     lib.mkdir(parents=True)
     recorder = lib / "recorder"
