@@ -149,6 +149,23 @@ class StrayEnded(Event):
         self.signal = signal
 
 
+class Controlled(Event):
+    """The user asked for ``action`` on the process ``label`` (mlaunch.run.control).
+
+    ``action``: "stop", "start", "restart", "mute" or "unmute". Emitted before the action is
+    carried out, so the printer says the request before what follows from it (the stop
+    ladder's steps, the exit, the new start). ``by`` says through what: "ctl" (the control
+    socket), "keys" (the --status view) or whatever an embedder passes.
+    """
+
+    __slots__ = ("action", "by", "label")
+
+    def __init__(self, label: str, action: str, by: str = "") -> None:
+        self.label = label
+        self.action = action
+        self.by = by
+
+
 # --- the launch as a whole ------------------------------------------------------------------------
 
 

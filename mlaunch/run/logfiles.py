@@ -125,6 +125,41 @@ class LogFile:
             self._file.close()
 
 
+def tail_lines(path: str, count: int, *, block: int = 64 * 1024) -> list[bytes]:
+    """The last ``count`` lines of a log file and its rotated parts (``path.1`` ...), oldest first.
+
+    Read backwards a block at a time, so a 64 MiB log costs a block or two, not the whole file.
+    Lines keep no newline; a missing file has none.
+    """
+    found: list[bytes] = []
+    part = 0
+    while len(found) < count:
+        name = path if part == 0 else f"{path}.{part}"
+        try:
+            with open(name, "rb") as f:
+                found[:0] = _file_tail(f, count - len(found), block)
+        except FileNotFoundError:
+            break
+        part += 1
+    return found
+
+
+def _file_tail(f: IO[bytes], count: int, block: int) -> list[bytes]:
+    pos = f.seek(0, os.SEEK_END)
+    buf = b""
+    while pos > 0 and buf.count(b"\n") <= count:
+        start = max(0, pos - block)
+        f.seek(start)
+        buf = f.read(pos - start) + buf
+        pos = start
+    if buf.endswith(b"\n"):
+        buf = buf[:-1]
+    lines = buf.split(b"\n") if buf else []
+    if pos > 0:
+        lines = lines[1:]  # cut by the block boundary: its start is further back
+    return lines[-count:] if count > 0 else []
+
+
 def log_base_dir(environ: Mapping[str, str]) -> str:
     """``$ROS_LOG_DIR``, else ``$ROS_HOME/log``, else ``~/.ros/log`` (as ROS 2)."""
     if environ.get("ROS_LOG_DIR"):

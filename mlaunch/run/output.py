@@ -17,6 +17,7 @@ import time
 from collections.abc import Callable, Mapping
 
 from mlaunch.run.events import (
+    Controlled,
     Escalated,
     Event,
     Exited,
@@ -34,7 +35,7 @@ from mlaunch.run.events import (
     StrayEnded,
     Unclaimed,
 )
-from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile
+from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile, tail_lines
 from mlaunch.run.process import describe_status, signal_name
 from mlaunch.run.screen import Screen
 
@@ -124,6 +125,8 @@ class Printer:
         self._launch_log_full = False
         self._own: dict[str, LogFile] = {}
         self._prefix: dict[str, bytes] = {}
+        # Labels whose output the user muted (mlaunch.run.control): kept off the screen only.
+        self.muted: set[str] = set()
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
@@ -230,7 +233,11 @@ class Printer:
         """Complete lines from a process (bytes ending in newline)."""
         data = clean(data)
         # -q quiets mlaunch's own messages and children's stdout; their stderr stays visible.
-        if stream in SCREEN_STREAMS.get(mode, ()) and (not self.quiet or stream == "stderr"):
+        if (
+            stream in SCREEN_STREAMS.get(mode, ())
+            and (not self.quiet or stream == "stderr")
+            and label not in self.muted
+        ):
             if self._write is self._screen:
                 # Counted per process, for per-process flow control (Screen.holding).
                 self._screen.write(prefix_lines(self._prefix[label], data), source=label)
@@ -263,6 +270,16 @@ class Printer:
             )
             log.write(b"%.7f " % self.clock() + note.encode())
         self._dirty.add(log)
+
+    def log_tail(self, label: str, count: int) -> list[bytes] | None:
+        """The last ``count`` lines ``label`` wrote (from its log file); None without log files."""
+        own = self._own.get(label)
+        if own is None:
+            if not self.log_dir:
+                return None
+            return tail_lines(os.path.join(self.log_dir, f"{label}.log"), count)
+        own.flush()
+        return tail_lines(own.path, count)
 
     def flush(self) -> None:
         """Push buffered lines to disk and screen (called when the supervisor is about to wait)."""
@@ -363,6 +380,11 @@ class Printer:
         label, pid = process.label, process.pid
         if not pid:
             return  # never started: "failed to start" said it all
+        if process.user_stop:
+            how = signal_name(-code) if code < 0 else f"exit code {code}"
+            why = " for a restart" if process.user_stop == "restart" else ""
+            self.message("INFO", label, f"process stopped by the user{why} [pid {pid}, {how}]")
+            return
         if code == 0:
             self.message("INFO", label, f"process has finished cleanly [pid {pid}]")
             return
@@ -462,6 +484,17 @@ class Printer:
             name = type(event.launch_event.event).__name__
             self.message("WARNING", "launch", f"event {name} has no handler in mlaunch; ignored")
 
+    def _controlled(self, event: Controlled) -> None:
+        via = _VIA.get(event.by, "")
+        label, action = event.label, event.action
+        if action == "mute":
+            text = f"output muted by the user{via}; still written to {label}.log"
+        elif action == "unmute":
+            text = f"output unmuted by the user{via}"
+        else:
+            text = f"{action} asked by the user{via}"
+        self.message("INFO", label, text)
+
     def _said(self, event: Said) -> None:
         self.message(event.level, event.source, event.text)
 
@@ -478,6 +511,9 @@ def _seconds(value: float) -> str:
     """``4.0``, ``0.5``, ``0.05``: one decimal unless that would round a short delay away."""
     return f"{value:.2f}" if 0 < value < 0.1 else f"{value:.1f}"
 
+
+# How the user's requests came (Controlled.by), in words.
+_VIA = {"ctl": " (mlaunch ctl)", "keys": " (--status keys)"}
 
 # Which words each record of the event stream becomes (records not listed are not said).
 _SAYS: dict[type, Callable[[Printer, Any], None]] = {
@@ -496,4 +532,5 @@ _SAYS: dict[type, Callable[[Printer, Any], None]] = {
     ShutdownBegun: Printer._shutdown,
     Unclaimed: Printer._unclaimed,
     Said: Printer._said,
+    Controlled: Printer._controlled,
 }

@@ -193,6 +193,7 @@ class Process:
         "started_at",
         "stopping",
         "streams",
+        "user_stop",
     )
 
     def __init__(self, spec: ProcessSpec, index: int, restarts: int = 0) -> None:
@@ -206,6 +207,8 @@ class Process:
         self.streams: dict[int, Stream] = {}
         self.popen: subprocess.Popen[bytes] | None = None
         self.stopping = False
+        # "stop" or "restart" when the user asked for its stop (mlaunch.run.control), else "".
+        self.user_stop = ""
         self.signals_sent: list[int] = []
         self.group_alive = True
         self.core_dumped = False

@@ -16,6 +16,8 @@ RESTARTING = "restarting"
 FINISHED = "finished"
 FAILED = "failed"
 GAVE_UP = "gave up"
+STOPPED = "stopped"  # by the user (mlaunch.run.control): it stays down until started again
+USER_STOPPED = "stopped by the user"
 
 
 class ProcessRecord:
@@ -40,6 +42,7 @@ class ProcessRecord:
         "started_at",
         "state",
         "streak",
+        "user_starts",
     )
 
     def __init__(
@@ -59,6 +62,7 @@ class ProcessRecord:
         cpu_time: float = 0.0,
         restart_at: float | None = None,
         signals: list[int] | None = None,
+        user_starts: int = 0,
     ) -> None:
         self.label = label
         self.spec = spec
@@ -76,6 +80,8 @@ class ProcessRecord:
         self.cpu_time = cpu_time
         self.restart_at = restart_at
         self.signals: list[int] = [] if signals is None else signals
+        # Of ``restarts``, those the user asked for: they do not use up respawn's max_retries.
+        self.user_starts = user_starts
 
     def __repr__(self) -> str:
         return (
@@ -96,6 +102,10 @@ class ProcessRecord:
         self.cpu_time += process.cpu_time
         self.signals.extend(process.signals_sent)
         self.failed = False
+        if process.user_stop:
+            self.outcome = USER_STOPPED
+            self.state = RESTARTING if process.user_stop == "restart" else STOPPED
+            return
         if process.stopping:
             self.outcome = _stopped_outcome(process, code)
         elif code == 0:
@@ -107,6 +117,9 @@ class ProcessRecord:
 
     def not_restarting(self) -> None:
         """A pending restart was cancelled (the launch shuts down): it ended as it last did."""
+        if self.outcome == USER_STOPPED:
+            self.state, self.restart_at = STOPPED, None
+            return
         self.state, self.restart_at = (FAILED if self.failed else FINISHED), None
 
 

@@ -35,12 +35,13 @@ def respawn_delay(policy: RespawnPolicy, streak: int) -> float:
 def next_restart(policy: RespawnPolicy, record: ProcessRecord, code: int, uptime: float) -> float:
     """The delay before restarting a process that exited with ``code`` after ``uptime`` seconds.
 
-    NO_RESTART when the policy does not restart it, GIVE_UP when its retries are spent. Updates
-    the record's crash-loop streak (the exponent of the backoff).
+    NO_RESTART when the policy does not restart it, GIVE_UP when its retries are spent (restarts
+    the user asked for do not count). Updates the record's crash-loop streak (the exponent of
+    the backoff).
     """
     if policy.mode == "never" or (policy.mode == "on-failure" and code == 0):
         return NO_RESTART
-    if 0 <= policy.max_retries <= record.restarts:
+    if 0 <= policy.max_retries <= record.restarts - record.user_starts:
         return GIVE_UP
     if uptime >= STABLE_UPTIME:
         record.streak = 0  # it ran well for a while: not a crash loop

@@ -24,7 +24,15 @@ import time
 from collections.abc import Callable, Iterable
 
 from mlaunch.run.events import Event, Output
-from mlaunch.run.records import FAILED, GAVE_UP, RESTARTING, RUNNING, STOPPING, ProcessRecord
+from mlaunch.run.records import (
+    FAILED,
+    GAVE_UP,
+    RESTARTING,
+    RUNNING,
+    STOPPED,
+    STOPPING,
+    ProcessRecord,
+)
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -46,9 +54,10 @@ STATE_STYLE = {
     RESTARTING: "yellow",
     FAILED: "bold red",
     GAVE_UP: "bold red",
+    STOPPED: "blue",  # by the user: neither a failure nor the end
 }
 # Which rows to keep when there are more processes than room: trouble first.
-STATE_ORDER = {FAILED: 0, GAVE_UP: 0, RESTARTING: 1, STOPPING: 2, RUNNING: 3}
+STATE_ORDER = {FAILED: 0, GAVE_UP: 0, RESTARTING: 1, STOPPING: 2, STOPPED: 2, RUNNING: 3}
 
 
 def format_duration(seconds: float) -> str:

@@ -70,7 +70,7 @@ from mlaunch.run.plan import (
     Step,
 )
 from mlaunch.run.process import Process, describe_status
-from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, ProcessRecord
+from mlaunch.run.records import GAVE_UP, RESTARTING, RUNNING, STOPPED, ProcessRecord
 from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve_deferred
 from mlaunch.run.respawn import GIVE_UP, NO_RESTART, next_restart
 from mlaunch.run.signals import SignalWatch
@@ -83,6 +83,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.run.cgroup import RunCgroup
+    from mlaunch.run.control import Control
 
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
 POLL = 0.05
@@ -132,6 +133,9 @@ class Supervisor(Stopping):
         self.lingering: list[Process] = []
         self.records: dict[str, ProcessRecord] = {}
         self.timers = Timers(clock)
+        # Pending respawns by label: a user's stop or start cancels the one waiting.
+        self.respawn_timers: dict[str, Timer] = {}
+        self._control: Control | None = None
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
             self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
@@ -159,6 +163,18 @@ class Supervisor(Stopping):
         self._marker_env = {guards.MARKER: self.run_id}
         # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
         self._awaited: set[int] = set()
+
+    @property
+    def control(self) -> Control:
+        """Runtime control of this run (mlaunch.run.control), made on first use; loop thread only.
+
+        Stop, start, restart, mute, unmute a process by label, list them, read their last lines.
+        """
+        if self._control is None:
+            from mlaunch.run.control import Control
+
+            self._control = Control(self)
+        return self._control
 
     @property
     def handlers(self) -> list[AddHandler]:
@@ -212,6 +228,8 @@ class Supervisor(Stopping):
         if not self.shutting_down:
             if self.timers.keep_alive():
                 return False
+            if any(r.state == STOPPED for r in self.records.values()):
+                return False  # stopped by the user, who may start it again: not idle
             # Idle: nothing runs and nothing is pending, as ROS 2's idle shutdown.
             self.begin_shutdown("idle")
         if self._lingering_pending():
@@ -434,6 +452,12 @@ class Supervisor(Stopping):
             self.events.emit(Completed(spec.action))
 
     def _maybe_respawn(self, process: Process, code: int) -> None:
+        if process.user_stop == "restart":
+            if self.shutting_down:
+                self.records[process.label].not_restarting()
+            else:
+                self.start_again(process)  # at once: no backoff, the user asked for it
+            return
         if self.shutting_down or process.stopping:
             return
         record = self.records[process.label]
@@ -450,10 +474,32 @@ class Supervisor(Stopping):
         attempt = record.restarts + 1
         self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
         record.state, record.restart_at = RESTARTING, self.clock() + delay
-        self.schedule(delay, lambda: self._respawn(process, attempt))
+        self.respawn_timers[process.label] = self.schedule(
+            delay, lambda: self._respawn(process, attempt)
+        )
 
     def _respawn(self, old: Process, attempt: int) -> None:
         """Start the same spec again (same argv, label, temp files); forget the old instance."""
+        self.respawn_timers.pop(old.label, None)
+        self._forget(old)
+        self.start(old.spec, restarts=attempt)
+
+    def start_again(self, old: Process) -> Process | None:
+        """Start ``old``'s spec again now, as the user asked (mlaunch.run.control).
+
+        It counts as a restart, but not against respawn's ``max_retries``, and respawn's
+        crash-loop backoff starts over: the user ended the last run, not a crash. A respawn
+        still waiting for its delay is cancelled.
+        """
+        timer = self.respawn_timers.pop(old.label, None)
+        if timer is not None:
+            timer.cancelled = True
+        record = self.records[old.label]
+        record.user_starts += 1
+        record.streak = 0
+        self._forget(old)
+        return self.start(old.spec, restarts=record.restarts + 1)
+
+    def _forget(self, old: Process) -> None:
         if not old.streams and old not in self.lingering and old in self.processes:
             self.processes.remove(old)  # a crash loop must not grow the list forever
-        self.start(old.spec, restarts=attempt)
