@@ -26,6 +26,7 @@ SUBCOMMANDS = {
     "test": "mlaunch.smoke",
     "convert": "mlaunch.ros1.convert",
     "export": "mlaunch.export",
+    "ctl": "mlaunch.ctl",
 }
 
 

@@ -307,6 +307,10 @@ HEAVY_AT_START = (
     "inspect",
     "psutil",
     "tempfile",
+    # mlaunch ctl's socket opens on the loop's first turn, after the first children.
+    "socket",
+    "mlaunch.run.control",
+    "mlaunch.run.control_socket",
 )
 
 

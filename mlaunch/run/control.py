@@ -79,6 +79,17 @@ class UnknownLabel(ControlError):
         super().__init__(f"no process {label!r} in this run{hint} (processes: {', '.join(labels)})")
 
 
+class AmbiguousLabel(ControlError):
+    """A name that several labels share (``talker`` for ``talker-1`` and ``talker-3``)."""
+
+    exit_code = EXIT_USAGE
+
+    def __init__(self, name: str, labels: list[str]) -> None:
+        self.label = name
+        self.labels = labels
+        super().__init__(f"{name!r} names several processes: {', '.join(labels)}; give one label")
+
+
 class ProcessInfo:
     """One label as the user sees it: what ``list`` shows and ``done`` callbacks receive.
 
@@ -137,15 +148,29 @@ class Control:
         """Every process label of the run so far, in the order they first started."""
         return list(self.supervisor.records)
 
+    def resolve(self, name: str) -> str:
+        """The label ``name`` means: a label, else the one label of that name (``talker`` for
+        ``talker-1``: the name without launch's counter, or the node's name or full name).
+
+        UnknownLabel (with the valid labels and the close ones) or AmbiguousLabel otherwise.
+        """
+        records = self.supervisor.records
+        if name in records:
+            return name
+        named = [label for label, record in records.items() if name in _names(record)]
+        if len(named) == 1:
+            return named[0]
+        if named:
+            raise AmbiguousLabel(name, named)
+        raise UnknownLabel(name, self.labels())
+
     def record(self, label: str) -> ProcessRecord:
-        """The label's record; UnknownLabel (with the valid labels) if the run has none."""
-        record = self.supervisor.records.get(label)
-        if record is None:
-            raise UnknownLabel(label, self.labels())
-        return record
+        """The record of the label ``label`` means (``resolve``)."""
+        return self.supervisor.records[self.resolve(label)]
 
     def info(self, label: str) -> ProcessInfo:
         record = self.record(label)
+        label = record.label
         running = record.state in (RUNNING, STOPPING)
         uptime = max(0.0, self.supervisor.clock() - record.started_at) if running else None
         return ProcessInfo(
@@ -167,7 +192,7 @@ class Control:
 
     def logs(self, label: str, lines: int = DEFAULT_LINES) -> list[str]:
         """The last ``lines`` lines of the label's output, oldest first, from its log file."""
-        self.record(label)
+        label = self.resolve(label)
         if lines < 0:
             raise ControlError(f"lines is {lines}; valid: 0 or more", what="logs")
         tail = self.supervisor.printer.log_tail(label, lines)
@@ -179,7 +204,7 @@ class Control:
 
     def stop(self, label: str, *, by: str = "", done: Done | None = None) -> None:
         """Stop the label's process with its stop ladder; it stays down (respawn included)."""
-        record, current = self._acting_on(label, "stop")
+        label, record, current = self._acting_on(label, "stop")
         supervisor = self.supervisor
         if current is not None and current.running:
             if current.user_stop:
@@ -205,7 +230,7 @@ class Control:
 
     def start(self, label: str, *, by: str = "", done: Done | None = None) -> None:
         """Start a label that is not running again, at once (same label, argv, parameters)."""
-        _, current = self._acting_on(label, "start")
+        label, _, current = self._acting_on(label, "start")
         if current is not None and current.running:
             raise ControlError(f"{label} is already running [pid {current.pid}]")
         self._start(label, "start", by, current, done)
@@ -215,7 +240,7 @@ class Control:
 
         A label that is not running is started at once.
         """
-        _, current = self._acting_on(label, "restart")
+        label, _, current = self._acting_on(label, "restart")
         supervisor = self.supervisor
         if current is None or not current.running:
             self._start(label, "restart", by, current, done)
@@ -230,7 +255,7 @@ class Control:
 
     def mute(self, label: str, *, by: str = "") -> ProcessInfo:
         """Keep the label's output off the screen (its log file still gets every line)."""
-        self.record(label)
+        label = self.resolve(label)
         if not self.is_muted(label):
             self.supervisor.printer.muted.add(label)
             self.supervisor.events.emit(Controlled(label, "mute", by))
@@ -238,7 +263,7 @@ class Control:
 
     def unmute(self, label: str, *, by: str = "") -> ProcessInfo:
         """Show the label's output on the screen again."""
-        self.record(label)
+        label = self.resolve(label)
         if self.is_muted(label):
             self.supervisor.printer.muted.discard(label)
             self.supervisor.events.emit(Controlled(label, "unmute", by))
@@ -246,12 +271,13 @@ class Control:
 
     # --- the parts -------------------------------------------------------------------------
 
-    def _acting_on(self, label: str, action: str) -> tuple[ProcessRecord, Process | None]:
-        """The label's record and latest instance, once the launch may still act on it."""
-        record = self.record(label)
+    def _acting_on(self, name: str, action: str) -> tuple[str, ProcessRecord, Process | None]:
+        """The label, its record and latest instance, once the launch may still act on it."""
+        record = self.record(name)
+        label = record.label
         if self.supervisor.shutting_down:
             raise ControlError(f"cannot {action} {label}: the launch is shutting down")
-        return record, self._current(label)
+        return label, record, self._current(label)
 
     def _current(self, label: str) -> Process | None:
         for process in reversed(self.supervisor.processes):
@@ -301,3 +327,14 @@ class Control:
             if what == "restart" and waited.label == label and not waited.running:
                 self._waits.remove(wait)
                 done(self.info(label))
+
+
+def _names(record: ProcessRecord) -> set[str]:
+    """What a label also goes by: without launch's ``-N`` counter, and its node's names."""
+    base, _, number = record.label.rpartition("-")
+    names = {base} if base and number.isdigit() else set()
+    node = record.spec.node
+    if node is not None and node.name:
+        names.add(node.name)
+        names.add(node.fully_qualified_name or node.name)
+    return names

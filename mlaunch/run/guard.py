@@ -9,9 +9,11 @@ EOF without the goodbye, mlaunch is dead: the guard sends SIGTERM (and SIGCONT, 
 processes) to every group it was told about and to every process whose environment carries the
 run's marker (``MLAUNCH_RUN_ID=<id>``, set in every child's environment and inherited by
 grandchildren, so even one that started its own session is found), waits the groups' grace,
-SIGKILLs what is left, removes mlaunch's private temp dir and says what it did on stderr. When
-``--status`` keys have the terminal in cbreak mode, mlaunch also sends the settings to put back
-(``t ...``, mlaunch.run.keyboard), and the guard puts them back first: the shell gets its echo.
+SIGKILLs what is left, removes mlaunch's private temp dir and the run's control socket
+(``u<path>``, so ``mlaunch ctl`` finds no socket rather than a stale one) and says what it did
+on stderr. When ``--status`` keys have the terminal in cbreak mode, mlaunch also sends the
+settings to put back (``t ...``, mlaunch.run.keyboard), and the guard puts them back first: the
+shell gets its echo.
 
 Why a forked process and not PR_SET_PDEATHSIG: that needs a preexec_fn in every spawn (slow,
 and unsafe with threads) and never reaches grandchildren. A fork costs about a millisecond and
@@ -293,6 +295,12 @@ class Guard:
             self._pending.append(line)
             self.flush()
 
+    def remove_on_death(self, path: str) -> None:
+        """A file (the control socket) the guard removes, with its folder if that is then empty,
+        should mlaunch die without saying goodbye."""
+        if not self.broken and "\n" not in path:
+            self._pending.append(b"u" + os.fsencode(path) + b"\n")
+
     @property
     def pending(self) -> bool:
         """Lines are queued for the next ``flush``."""
@@ -392,6 +400,7 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     _keep_only_fds(fd)
     groups: dict[int, float] = {}
+    leftovers: list[bytes] = []  # files to remove if mlaunch dies (its control socket)
     clean = False
     pending = b""
     terminal = b""  # the terminal settings mlaunch changed and would put back (a "t ..." line)
@@ -410,10 +419,14 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
                 groups.pop(int(line[1:]), None)
             elif line.startswith(b"t"):
                 terminal = line
+            elif line.startswith(b"u"):
+                leftovers.append(line[1:])
     if clean:
         return
     if terminal:
         _restore_terminal(terminal)  # first: a person is looking at that terminal
+    for path in leftovers:
+        _remove_file(path)
     ended = end_run(groups, run_id, cgroup, exclude={parent})
     removed = _remove_temp_dir(temp_dir)
     if ended or removed:
@@ -549,6 +562,15 @@ def retitle(title: str) -> None:
 def _send(pid: int, sig: int) -> None:
     try:
         os.kill(pid, sig)
+    except OSError:
+        pass
+
+
+def _remove_file(path: bytes) -> None:
+    """Remove ``path`` and its folder if that is left empty."""
+    try:
+        os.unlink(path)
+        os.rmdir(os.path.dirname(path))
     except OSError:
         pass
 

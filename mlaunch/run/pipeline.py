@@ -250,12 +250,12 @@ def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
 
 
 def standard_parts(opts: Options) -> list[Attach]:
-    """Lifecycle driving, composable node loading, the ``--status`` view if asked for, then the
-    exit summary.
+    """Lifecycle driving, composable node loading, the control socket, the ``--status`` view if
+    asked for, then the exit summary.
 
     Closed in this order at the end: the status view leaves the screen before the summary.
     """
-    parts: list[Attach] = [lifecycle, components]
+    parts: list[Attach] = [lifecycle, components, control_socket]
     if opts.status:
         parts.append(status_view)
     parts.append(exit_summary)
@@ -324,6 +324,41 @@ def components(run: Run) -> object:
     from mlaunch.ros.components import attach
 
     return attach(run.opts, run.supervisor)
+
+
+def control_socket(run: Run) -> object:
+    """``mlaunch ctl``'s socket in the run's log folder (mlaunch.run.control_socket)."""
+    log_dir = run.supervisor.printer.log_dir
+    return _ControlSocketPart(run.supervisor, log_dir) if log_dir else None
+
+
+class _ControlSocketPart:
+    """Opens the control socket on the loop's first turn, and removes it at close.
+
+    After the first children have started: ``socket`` and ``json`` cost milliseconds, which
+    opening it at attach time would spend before the first child.
+    """
+
+    def __init__(self, supervisor: Supervisor, log_dir: str) -> None:
+        self.supervisor = supervisor
+        self.log_dir = log_dir
+        self.server: Any = None
+        supervisor.schedule(0.0, self._open, keeps_alive=False)
+
+    def _open(self) -> None:
+        from mlaunch.run.control_socket import ControlSocket
+        from mlaunch.run.events import Said
+
+        server = ControlSocket(self.supervisor, self.log_dir)
+        if server.open():
+            self.server = server
+        else:
+            text = f"{server.error}; mlaunch ctl cannot reach this run"
+            self.supervisor.events.emit(Said("WARNING", "launch", text))
+
+    def close(self) -> None:
+        if self.server is not None:
+            self.server.close()
 
 
 def status_view(run: Run) -> object:
