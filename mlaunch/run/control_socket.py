@@ -170,18 +170,14 @@ class _Client:
         if self.out:
             self._send()
             return
-        if self.asked:
-            self._read_eof()
+        data = self._recv()
+        if data is None:
             return
-        try:
-            data = self.conn.recv(4096)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError:
-            data = b""
         if not data:
-            self.server.forget(self)
+            self.server.forget(self)  # the client left (while its stop was under way, too)
             return
+        if self.asked:
+            return  # past the request: its answer comes when it is done
         self.received += data
         if b"\n" in self.received:
             self.asked = True
@@ -190,16 +186,14 @@ class _Client:
             self.asked = True
             self.fail("the request is too long", EXIT_USAGE)
 
-    def _read_eof(self) -> None:
-        """The client left while its stop was under way: its answer has nowhere to go."""
+    def _recv(self) -> bytes | None:
+        """What the client sent (b"" when it left), None if nothing yet."""
         try:
-            data = self.conn.recv(4096)
+            return self.conn.recv(4096)
         except (BlockingIOError, InterruptedError):
-            return
+            return None
         except OSError:
-            data = b""
-        if not data:
-            self.server.forget(self)
+            return b""
 
     # --- the request -----------------------------------------------------------------------
 
