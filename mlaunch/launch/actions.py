@@ -91,7 +91,7 @@ class DeclareLaunchArgument(Action):
 
     def execute(self, resolver: Resolver) -> None:
         ctx = resolver.context
-        resolver.plan.arguments.setdefault(self.name, self.argument_info(conditional=False))
+        info = resolver.plan.arguments.setdefault(self.name, self.argument_info(conditional=False))
         if self.name not in ctx.launch_configurations:
             if self.default_value is None:
                 raise LaunchArgumentError(
@@ -108,6 +108,8 @@ class DeclareLaunchArgument(Action):
                 f" {', '.join(self.choices)}",
                 where=self.origin,
             )
+        if info.value is None:  # the first declaration's value, as --print --format json shows
+            info.value = str(value)
 
     def describe_short(self) -> str:
         return f"DeclareLaunchArgument({self.name!r})"

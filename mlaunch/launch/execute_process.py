@@ -170,6 +170,7 @@ class ExecuteProcess(Action):
         spec = ProcessSpec(
             label=resolver.new_label(base),
             argv=tuple(prefix + argv),
+            launch_prefix=tuple(prefix),
             env=env,
             env_changes=_env_changes(ctx.initial_environment, env),
             cwd=None if self.cwd is None else perform_substitutions(ctx, self.cwd),

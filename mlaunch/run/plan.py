@@ -132,6 +132,7 @@ class ProcessSpec(Record):
         "standin",
         "temp_files",
         "machine",
+        "launch_prefix",
     )
     __slots__ = _fields
 
@@ -156,6 +157,7 @@ class ProcessSpec(Record):
         standin: str | None = None,
         temp_files: tuple[str, ...] = (),
         machine: MachineSpec | None = None,
+        launch_prefix: tuple[str, ...] = (),
     ) -> None:
         self.label = label
         self.argv = argv
@@ -177,6 +179,8 @@ class ProcessSpec(Record):
         self.temp_files = temp_files
         # Where it runs: None for this computer, else a declared machine (mlaunch.machines).
         self.machine = machine
+        # The launch prefix's words at the head of argv (--launch-prefix, prefix=), for --print.
+        self.launch_prefix = launch_prefix
 
     @property
     def base_name(self) -> str:
@@ -357,7 +361,7 @@ def step_needs(step: Step) -> frozenset[str]:
 class ArgumentInfo(Record):
     """A declared launch argument, for --show-args and CLI checks."""
 
-    _fields = ("name", "default", "description", "choices", "origin", "conditional")
+    _fields = ("name", "default", "description", "choices", "origin", "conditional", "value")
     __slots__ = _fields
 
     def __init__(
@@ -368,6 +372,7 @@ class ArgumentInfo(Record):
         choices: tuple[str, ...] | None,
         origin: str,
         conditional: bool = False,
+        value: str | None = None,
     ) -> None:
         self.name = name
         self.default = default
@@ -375,6 +380,9 @@ class ArgumentInfo(Record):
         self.choices = choices
         self.origin = origin
         self.conditional = conditional
+        # The value the run gave it where it was first declared (resolve sets it; --show-args
+        # does not resolve, so None there).
+        self.value = value
 
 
 class Plan(Record):
