@@ -59,6 +59,7 @@ class Options:
         self.color = color
         self.log_max_bytes = log_max_bytes
         self.log_keep = log_keep
+        self.format = "text"  # --format: how --print writes the plan (text or json)
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -130,6 +131,13 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         action="store_true",
         help="report what ros2 launch (Jazzy) would reject or read differently in the file"
         " and the files it includes by path; exit 1 if anything",
+    )
+    parser.add_argument(
+        "--format",
+        choices=("text", "json"),
+        default="text",
+        help="how --print writes the plan: text to read (default), or json for tools"
+        " (the schema: docs/plan-json.md)",
     )
     parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
     parser.add_argument(
@@ -235,6 +243,7 @@ VALUE_OPTIONS = frozenset(
         "--launch-prefix",
         "--launch-prefix-filter",
         "--color",
+        "--format",
         "--log-max-bytes",
         "--log-keep",
         "--viewer-port",
@@ -285,6 +294,9 @@ def parse_options(argv: Sequence[str]) -> Options:
         log_keep=_log_keep(ns.log_keep),
     )
     opts.capture = ns.capture_at_definition
+    opts.format = ns.format
+    if opts.format != "text" and not opts.print_plan:
+        raise UsageError(f"--format {opts.format} is for --print (-p): the plan as {opts.format}")
     opts.scoped_parameters = ns.scoped_parameters
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):

@@ -21,15 +21,8 @@ REPO = Path(__file__).resolve().parent.parent
 def demo_package(root: Path) -> str:
     """An ament prefix under ``root`` with package ``demo`` and its executable ``talker`` (a
     Python script printing 'talking'); returns the prefix, for AMENT_PREFIX_PATH."""
-    prefix = root / "install"
-    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True)
-    (prefix / "share/ament_index/resource_index/packages/demo").write_text("")
-    (prefix / "share/demo").mkdir()
-    (prefix / "lib/demo").mkdir(parents=True)
-    talker = prefix / "lib/demo/talker"
-    talker.write_text(f"#!{sys.executable}\nprint('talking')\n")
-    talker.chmod(0o755)
-    return str(prefix)
+    talker = f"#!{sys.executable}\nprint('talking')\n"
+    return str(install_package(root / "install", "demo", {"talker": talker}))
 
 
 def clean_env(**extra: str) -> dict[str, str]:
@@ -102,6 +95,20 @@ class Running:
         except ProcessLookupError:
             pass
         self.proc.wait(timeout=5)
+
+
+def install_package(prefix: Path, package: str, programs: dict[str, str]) -> Path:
+    """An install prefix holding ``package`` (its ament index marker, share and lib folders)
+    with executable ``programs`` (name -> file text) in lib/<package>; returns ``prefix``."""
+    (prefix / "share/ament_index/resource_index/packages").mkdir(parents=True, exist_ok=True)
+    (prefix / "share/ament_index/resource_index/packages" / package).write_text("")
+    (prefix / "share" / package).mkdir(exist_ok=True)
+    (prefix / "lib" / package).mkdir(parents=True, exist_ok=True)
+    for name, text in programs.items():
+        program = prefix / "lib" / package / name
+        program.write_text(text)
+        program.chmod(0o755)
+    return prefix
 
 
 def mlaunch(*args: str) -> list[str]:

@@ -311,6 +311,7 @@ HEAVY_AT_START = (
     "socket",
     "mlaunch.run.control",
     "mlaunch.run.control_socket",
+    "json",  # only --print --format json (mlaunch.run.plan_json) and the ROS bridge need it
 )
 
 

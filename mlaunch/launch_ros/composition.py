@@ -79,6 +79,16 @@ class LoadComponents(Note):
             lines.extend(describe_request(request, self.target, self.origin))
         return lines
 
+    def describe_data(self) -> dict[str, Any]:
+        """--print --format json: the container and each component to load, in order."""
+        from mlaunch.launch_ros.load_request import request_data
+
+        return {
+            "kind": "load_components",
+            "container": self.target,
+            "nodes": [request_data(r) for r in self.requests],
+        }
+
 
 class ComposableNodeContainer(Node):
     """A container process (a Node) and the composable nodes to load into it once it is up."""

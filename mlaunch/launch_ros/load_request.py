@@ -269,6 +269,30 @@ def describe_request(request: LoadRequest, container: str, origin: str) -> list[
     return lines
 
 
+def request_data(request: LoadRequest) -> dict[str, Any]:
+    """--print --format json: one component load as data (mlaunch.run.plan_json)."""
+    from mlaunch.run.plan_json import json_safe
+
+    def typed(p: TypedParameter) -> dict[str, Any]:
+        return {"name": p.name, "value": json_safe(p.value), "type": TYPE_NAMES[p.type]}
+
+    named = bool(request.node_name)
+    return {
+        "package": request.package_name,
+        "plugin": request.plugin_name,
+        "name": request.node_name if named else None,
+        "namespace": request.node_namespace or None,
+        "full_name": request.full_name if named else None,
+        "log_level": request.log_level,
+        "remaps": [
+            {"from": rule.partition(":=")[0], "to": rule.partition(":=")[2]}
+            for rule in request.remap_rules
+        ],
+        "parameters": [typed(p) for p in request.parameters],
+        "extra_arguments": [typed(p) for p in request.extra_arguments],
+    }
+
+
 def _listed(value: Any) -> Any:
     return list(value) if isinstance(value, tuple) else value
 

@@ -39,6 +39,15 @@ class SequenceStep(Note):
     shutdown_on_failure: bool = True
     timeout: float = DEFAULT_TIMEOUT
 
+    def describe_data(self) -> dict[str, Any]:
+        """--print --format json: the nodes in bring-up order and the sequence's settings."""
+        return {
+            "kind": "lifecycle_sequence",
+            "nodes": list(self.nodes),
+            "shutdown_on_failure": self.shutdown_on_failure,
+            "timeout": self.timeout,
+        }
+
 
 class LifecycleSequence(Action):
     """Configure and activate lifecycle nodes in order, each once the previous one is active.

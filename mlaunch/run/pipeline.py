@@ -156,11 +156,20 @@ def launch(opts: Options, attach: Sequence[Attach]) -> int:
             opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir
         )
         if opts.print_plan:
-            from mlaunch.run.describe import describe_plan
-
-            write_stdout(describe_plan(plan, path))
+            write_stdout(describe(opts, plan, path))
             return 0
         return supervise(opts, plan, options, labels, log_dir, life, attach)
+
+
+def describe(opts: Options, plan: Plan, path: str) -> str:
+    """``--print``: the plan as text (mlaunch.run.describe) or JSON (mlaunch.run.plan_json)."""
+    if opts.format == "json":
+        from mlaunch.run.plan_json import plan_json
+
+        return plan_json(plan, path, opts.arguments)
+    from mlaunch.run.describe import describe_plan
+
+    return describe_plan(plan, path)
 
 
 def supervise(

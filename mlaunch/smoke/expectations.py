@@ -142,6 +142,23 @@ class ExpectStep(Note):
     origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     expectation: Expectation | None = None
 
+    def describe_data(self) -> dict[str, Any]:
+        """--print --format json: what ``mlaunch test`` will check (``check`` is its kind)."""
+        e = self.expectation
+        if e is None:
+            return {"kind": "expectation", "check": None, "target": None, "description": None}
+        return {
+            "kind": "expectation",
+            "check": e.kind,
+            "target": e.target,
+            "description": e.describe(),
+            "within": e.within,
+            "rate": e.rate,
+            "state": e.state if e.kind == "lifecycle" else None,
+            "process": e.process,
+            "regex": None if e.regex is None else e.regex.pattern,
+        }
+
 
 class Expect(Action):
     """An expectation for ``mlaunch test``, written in a Python launch file.

@@ -1,0 +1,397 @@
+"""``mlaunch FILE --print --format json``: the plan as data, checked against its shipped schema.
+
+Every launch file in launches/ (Python, YAML, XML, ROS 1, the composed one) is printed as JSON
+through the real command line and validated with jsonschema; then the values are checked: a
+node's argv is the text --print's and the spawned process's, params files carry their contents,
+environment changes, origins, deferred parts as written, and a clear error for a bad --format.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shlex
+import signal
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import jsonschema
+import pytest
+from procutil import (
+    REPO,
+    Running,
+    clean_env,
+    install_package,
+    mlaunch,
+    run_mlaunch,
+    wait_until,
+)
+
+from mlaunch.schemas import PLAN_SCHEMA, load_plan_schema
+
+LAUNCHES = REPO / "launches"
+PREFIX = LAUNCHES / "examples" / "prefix"
+# Launch files that declare arguments without defaults (parts meant to be included).
+REQUIRED_ARGUMENTS = {
+    "logger.launch.xml": ["source:=driver"],
+    "sensors.launch.yaml": ["camera:=front"],
+}
+PY = sys.executable
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return clean_env(ROS_LOG_DIR=str(tmp_path / "log"), AMENT_PREFIX_PATH=str(PREFIX))
+
+
+def plan_of(*args: str, env: dict[str, str]) -> dict[str, Any]:
+    done = run_mlaunch(*args, "--print", "--format", "json", env=env)
+    assert done.returncode == 0, done.stderr
+    document: dict[str, Any] = json.loads(done.stdout)
+    return document
+
+
+def validate(document: dict[str, Any]) -> None:
+    validator = jsonschema.Draft202012Validator(load_plan_schema())
+    errors = sorted(validator.iter_errors(document), key=lambda e: list(e.path))
+    assert not errors, "\n".join(f"{list(e.path)}: {e.message[:300]}" for e in errors[:5])
+
+
+def processes(document: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    return {s["label"]: s for s in document["steps"] if s["kind"] == "process"}
+
+
+def test_the_schema_is_a_valid_draft_2020_12_schema() -> None:
+    jsonschema.Draft202012Validator.check_schema(load_plan_schema())
+    assert Path(PLAN_SCHEMA).parent.name == "schemas"
+    assert load_plan_schema()["properties"]["schema"]["const"] == "mlaunch-plan/1"  # type: ignore[index]
+
+
+LAUNCH_FILES = sorted(
+    p for p in LAUNCHES.rglob("*") if p.is_file() and re.search(r"\.launch(\.\w+)?$", p.name)
+)
+
+
+def test_every_format_is_covered() -> None:
+    suffixes = {p.name.partition(".launch")[2] for p in LAUNCH_FILES}
+    assert {"", ".py", ".yaml", ".xml"} <= suffixes  # ROS 1 (.launch) and the three ROS 2 ones
+
+
+@pytest.mark.parametrize("path", LAUNCH_FILES, ids=lambda p: str(p.relative_to(LAUNCHES)))
+def test_every_launch_file_validates(path: Path, env: dict[str, str]) -> None:
+    document = plan_of(str(path), *REQUIRED_ARGUMENTS.get(path.name, []), env=env)
+    validate(document)
+    assert document["schema"] == "mlaunch-plan/1"
+    assert document["steps"], "an empty plan checks nothing"
+    # Nothing of the run's temporary folder leaks: its files are named in plan order.
+    assert "/tmp/mlaunch-" not in json.dumps(document)
+
+
+def test_the_composed_launch_lists_its_components(env: dict[str, str]) -> None:
+    document = plan_of(str(LAUNCHES / "jtbot_composed.launch.py"), env=env)
+    (load,) = [s for s in document["steps"] if s["kind"] == "load_components"]
+    assert load["container"] == "/jtbot_container"
+    (node,) = load["nodes"]
+    assert node["plugin"] == "robot_state_publisher::RobotStatePublisher"
+    assert node["full_name"] == "/robot_state_publisher"
+    params = {p["name"]: p for p in node["parameters"]}
+    assert params["robot_description"]["type"] == "string"
+    assert params["robot_description"]["value"].lstrip().startswith("<?xml")
+    assert load["origin"]["file"] == "launches/jtbot_composed.launch.py"
+
+
+def _origin_line(path: Path, marker: str) -> int:
+    """The line of the ``Node(`` call whose arguments contain ``marker``."""
+    lines = path.read_text().splitlines()
+    at = next(i for i, line in enumerate(lines) if marker in line)
+    return next(i for i in range(at, -1, -1) if "Node(" in lines[i]) + 1
+
+
+def test_node_values(env: dict[str, str]) -> None:
+    path = LAUNCHES / "examples" / "talker_listener.launch.py"
+    document = plan_of(str(path), "rate:=7.5", env=env)
+    validate(document)
+    talker = processes(document)["talker-1"]
+    assert talker["origin"] == {
+        "file": "launches/examples/talker_listener.launch.py",
+        "line": _origin_line(path, 'executable="talker"'),
+    }
+    assert talker["node"] == {
+        "name": "talker",
+        "namespace": "/robot1",
+        "full_name": "/robot1/talker",
+        "package": "mlaunch_demo",
+        "executable": "talker",
+        "lifecycle": False,
+        "autostart": False,
+    }
+    assert talker["env"]["set"]["TALKER_MODE"] == "demo"
+    assert talker["env"]["unset"] == []
+    assert talker["respawn"]["mode"] == "always" and talker["respawn"]["delay"] == 2.0
+    assert talker["respawn"]["max_retries"] is None
+    assert talker["output"] == "screen"
+    assert talker["remaps"] == [
+        {"from": "/rosout_agg", "to": "rosout_all"},
+        {"from": "chatter", "to": "chat"},
+    ]
+    rule, *files = talker["parameters"]
+    assert rule == {"kind": "value", "name": "use_sim_time", "value": False, "type": "bool"}
+    assert [f["path"] for f in files] == [f"<run-temp>/{i}" for i in range(1, 5)]
+    assert all(f["temporary"] and f["error"] is None for f in files)
+    given = [(p["node"], p["name"], p["value"], p["type"]) for f in files for p in f["parameters"]]
+    assert given == [
+        ("/robot1/talker", "rate", 7.5, "double"),
+        ("/robot1/talker", "greeting", "hello", "string"),
+        ("/robot1/talker", "qos.depth", 10, "integer"),
+        ("/robot1/talker", "qos.reliable", True, "bool"),
+        ("/robot1/talker", "frames", ["base", "odom", "map"], "string[]"),
+    ]
+    # The file as written: launch_ros flattens nested maps to dotted names.
+    assert files[2]["contents"] == {
+        "/robot1/talker": {"ros__parameters": {"qos.depth": 10, "qos.reliable": True}}
+    }
+    # A params file of the package: its own path and its parsed contents.
+    listener = processes(document)["listener-2"]
+    (shipped,) = [p for p in listener["parameters"] if p["kind"] == "file"]
+    assert not shipped["temporary"]
+    assert shipped["path"] == str(PREFIX / "share/mlaunch_demo/config/listener.yaml")
+    config = PREFIX / "share/mlaunch_demo/config/listener.yaml"
+    import yaml
+
+    assert shipped["contents"] == yaml.safe_load(config.read_text())
+    monitor = processes(document)["monitor-3"]
+    assert monitor["stop"] == {
+        "sigterm_timeout": 1.0,
+        "sigkill_timeout": 1.0,
+        "ladder": [
+            {"signal": "SIGINT", "after": 0.0},
+            {"signal": "SIGTERM", "after": 1.0},
+            {"signal": "SIGKILL", "after": 2.0},
+        ],
+    }
+    args = {a["name"]: a for a in document["arguments"]}
+    assert args["rate"]["value"] == "7.5" and args["rate"]["given"]
+    assert args["rate"]["default"] == "5.0"
+    assert args["use_sim"]["choices"] == ["true", "false"] and not args["use_sim"]["given"]
+
+
+def test_argv_is_what_text_print_shows(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "talker_listener.launch.py")
+    document = plan_of(path, env=env)
+    text = run_mlaunch(path, "--print", env=env)
+    assert text.returncode == 0, text.stderr
+    lines = text.stdout.splitlines()
+    shown = {
+        lines[i].split()[0]: lines[i + 1].removeprefix("  argv:    ")
+        for i in range(len(lines) - 1)
+        if lines[i + 1].startswith("  argv:")
+    }
+    assert set(shown) == set(processes(document))
+    temp = re.compile(r"/tmp/mlaunch-[^/ ]+/launch_params_\w+")
+    compared = 0
+    for label, process in processes(document).items():
+        names = [shlex.quote(p) for p in process["argv"] if p.startswith("<run-temp>/")]
+        line = _renamed(temp, shown[label], names)
+        expected = shlex.join(process["argv"])
+        if re.search(r"\.\.\. <\d+ chars>$", line):  # the text shortens long command lines
+            head = shown[label].partition("/tmp/mlaunch-")[0]
+            assert expected.startswith(head), label
+            continue
+        assert line == expected, label
+        compared += 1
+    assert compared >= 2
+
+
+def _renamed(pattern: re.Pattern[str], text: str, names: list[str]) -> str:
+    """``text`` with each match of ``pattern`` replaced by the next of ``names``."""
+    replacements = iter(names)
+    return pattern.sub(lambda _match: next(replacements), text)
+
+
+def _package(tmp_path: Path) -> Path:
+    """An install prefix with package 'demo' whose program writes its argv and the contents
+    of its params files to argv.json beside it, then lives until stopped."""
+    dump = textwrap.dedent(
+        f"""\
+            #!{PY}
+            import json, os, sys, time
+            argv = sys.argv
+            files = [open(argv[i + 1]).read() for i, a in enumerate(argv) if a == "--params-file"]
+            out = os.path.join(os.path.dirname(__file__), "argv.json")
+            with open(out + ".part", "w") as f:
+                json.dump({{"argv": argv, "files": files, "cwd": os.getcwd(),
+                           "env": {{k: os.environ.get(k) for k in ("DUMP_MODE", "GONE")}}}}, f)
+            os.rename(out + ".part", out)
+            time.sleep(60)
+            """
+    )
+    return install_package(tmp_path / "install", "demo", {"dump": dump})
+
+
+LAUNCH = """
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, SetEnvironmentVariable, UnsetEnvironmentVariable
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+def generate_launch_description():
+    return LaunchDescription([
+        DeclareLaunchArgument('mode', default_value='fast'),
+        UnsetEnvironmentVariable('GONE'),
+        Node(package='demo', executable='dump', name='dumper', namespace='ns',
+             parameters=[{'speed': 2.5, 'tags': ['a', 'b']}, {'inner': {'depth': 3}}],
+             remappings=[('in', 'out')], arguments=['--flag', 'x y'],
+             additional_env={'DUMP_MODE': LaunchConfiguration('mode')},
+             output='screen', respawn=True, respawn_max_retries=2),
+    ])
+"""
+
+
+def test_argv_and_params_are_what_gets_spawned(tmp_path: Path, env: dict[str, str]) -> None:
+    prefix = _package(tmp_path)
+    env = {**env, "AMENT_PREFIX_PATH": str(prefix), "GONE": "here"}
+    launch = tmp_path / "dump.launch.py"
+    launch.write_text(LAUNCH)
+    document = plan_of(str(launch), "mode:=slow", env=env)
+    validate(document)
+    (process,) = processes(document).values()
+    # Only what differs from mlaunch's own environment (PYTHONUNBUFFERED may be inherited).
+    assert process["env"]["set"]["DUMP_MODE"] == "slow"
+    assert process["env"]["set"]["RCUTILS_LOGGING_BUFFERED_STREAM"] == "1"
+    assert "HOME" not in process["env"]["set"]
+    assert process["env"]["unset"] == ["GONE"]
+    assert process["respawn"]["max_retries"] == 2
+    assert process["origin"] == {
+        "file": str(launch),
+        "line": LAUNCH.splitlines().index(
+            next(line for line in LAUNCH.splitlines() if "Node(" in line)
+        )
+        + 1,
+    }
+    run = Running(mlaunch(str(launch), "mode:=slow"), env=env, cwd=str(tmp_path))
+    dumped = prefix / "lib/demo/argv.json"
+    try:
+        assert wait_until(dumped.exists, timeout=20), run.text
+    finally:
+        run.signal(signal.SIGINT)
+        run.finish()
+    seen = json.loads(dumped.read_text())
+    assert seen["env"] == {"DUMP_MODE": "slow", "GONE": None}
+    # The spawned argv, with the run's params files named as the plan names them.
+    temp: dict[str, str] = {}
+    for item in seen["argv"]:
+        if "/launch_params_" in item:
+            temp[item] = f"<run-temp>/{len(temp) + 1}"
+    assert [temp.get(a, a) for a in seen["argv"]] == process["argv"]
+    import yaml
+
+    files = [p for p in process["parameters"] if p["kind"] == "file"]
+    assert [yaml.safe_load(text) for text in seen["files"]] == [f["contents"] for f in files]
+    assert files[1]["parameters"] == [
+        {"node": "/ns/dumper", "name": "inner.depth", "value": 3, "type": "integer"}
+    ]
+    assert process["remaps"] == [{"from": "in", "to": "out"}]
+
+
+DEFERRED = """
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess, LogInfo, RegisterEventHandler, TimerAction, Shutdown
+from launch.event_handlers import OnProcessExit
+from launch_ros.actions import LifecycleNode
+from mlaunch.ros.lifecycle_sequence import LifecycleSequence
+from mlaunch.smoke import Expect
+
+def generate_launch_description():
+    first = ExecuteProcess(cmd=['true'], name='first', on_exit=[LogInfo(msg='bye')])
+    return LaunchDescription([
+        first,
+        RegisterEventHandler(OnProcessExit(target_action=first,
+                                           on_exit=[ExecuteProcess(cmd=['echo', 'after'])])),
+        TimerAction(period=2.5, actions=[LogInfo(msg='late'), Shutdown(reason='done')]),
+        LifecycleNode(package='demo', executable='dump', name='managed', namespace='',
+                      autostart=True),
+        LifecycleSequence(nodes=['managed'], timeout=4),
+        Expect(topic='/scan', rate=5.0, within=9),
+        LogInfo(msg='now'),
+    ])
+"""
+
+
+def test_deferred_parts_are_shown_as_written(tmp_path: Path, env: dict[str, str]) -> None:
+    prefix = _package(tmp_path)
+    env = {**env, "AMENT_PREFIX_PATH": str(prefix)}
+    launch = tmp_path / "deferred.launch.py"
+    launch.write_text(DEFERRED)
+    document = plan_of(str(launch), env=env)
+    validate(document)
+    kinds = [s["kind"] for s in document["steps"]]
+    assert kinds == [
+        "process",
+        "handler",
+        "timer",
+        "process",
+        "lifecycle_sequence",
+        "expectation",
+        "log",
+    ]
+    first, handler, timer, managed, sequence, expect, log = document["steps"]
+    assert first["required"] is False
+    assert [a["action"] for a in first["on_exit"]["actions"]] == ["LogInfo"]
+    assert handler["event"] == "process_exit" and handler["start"] == "deferred"
+    assert handler["target"].startswith("ExecuteProcess(") and not handler["any_process"]
+    (after,) = handler["actions"]
+    assert after["action"] == "ExecuteProcess" and "after" in after["summary"]
+    assert timer["period"] == 2.5
+    assert [a["action"] for a in timer["actions"]] == ["LogInfo", "Shutdown"]
+    assert managed["node"]["lifecycle"] and managed["node"]["autostart"]
+    assert sequence["nodes"] == ["/managed"] and sequence["timeout"] == 4
+    assert expect["check"] == "topic" and expect["rate"] == 5.0 and expect["within"] == 9
+    assert log["message"] == "now"
+    line = DEFERRED.splitlines().index(
+        next(x for x in DEFERRED.splitlines() if "TimerAction(" in x)
+    )
+    assert timer["origin"] == {"file": str(launch), "line": line + 1}
+
+
+def test_output_is_stable_from_run_to_run(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "talker_listener.launch.py")
+    one = run_mlaunch(path, "--print", "--format", "json", env=env)
+    two = run_mlaunch(path, "--print", "--format", "json", env=env)
+    assert one.returncode == 0 and one.stdout == two.stdout
+
+
+def test_text_stays_the_default(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    default = run_mlaunch(path, "--print", env=env)
+    text = run_mlaunch(path, "--print", "--format", "text", env=env)
+    assert default.returncode == 0 and default.stdout.startswith("Plan for ")
+    temp = re.compile(r"/tmp/mlaunch-[^/ ]+/")
+    assert temp.sub("", default.stdout) == temp.sub("", text.stdout)
+
+
+@pytest.mark.parametrize("value", ["yaml", "JSON", ""])
+def test_bad_format_names_the_valid_ones(value: str, env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    done = run_mlaunch(path, "--print", "--format", value, env=env)
+    assert done.returncode == 2
+    assert f"invalid choice: '{value}'" in done.stderr
+    assert "'text'" in done.stderr and "'json'" in done.stderr
+    assert done.stdout == ""
+
+
+def test_format_json_needs_print(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    done = run_mlaunch(path, "--format", "json", env=env)
+    assert done.returncode == 2
+    assert "--format json is for --print" in done.stderr
+    assert "process started" not in done.stdout
+
+
+def test_mlaunch_test_print_gives_the_same_plan(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    plain = run_mlaunch(path, "--print", "--format", "json", env=env)
+    smoke = run_mlaunch("test", path, "--print", "--format", "json", env=env)
+    assert smoke.returncode == 0, smoke.stderr
+    assert json.loads(smoke.stdout) == json.loads(plain.stdout)
