@@ -395,3 +395,69 @@ def test_mlaunch_test_print_gives_the_same_plan(env: dict[str, str]) -> None:
     smoke = run_mlaunch("test", path, "--print", "--format", "json", env=env)
     assert smoke.returncode == 0, smoke.stderr
     assert json.loads(smoke.stdout) == json.loads(plain.stdout)
+
+
+MORE = """
+from launch import LaunchDescription
+from launch.actions import EmitEvent, ExecuteProcess, RegisterEventHandler
+from launch.event_handlers import OnProcessIO
+from launch.events import matches_action
+from launch.events.process import SignalProcess
+from mlaunch.actions import Machine
+
+def generate_launch_description():
+    here = ExecuteProcess(cmd=['true'], name='here', machine='local', respawn='on-failure',
+                          sigterm_timeout='3', sigkill_timeout='0.5')
+    return LaunchDescription([
+        Machine(name='local', address='127.0.0.1'),
+        Machine(name='robot', address='robot-alias', user='ros', ssh_port=2200, timeout=3),
+        here,
+        ExecuteProcess(cmd=['sleep', '1'], name='far', machine='robot'),
+        RegisterEventHandler(OnProcessIO(on_stdout=lambda event: None)),
+        EmitEvent(event=SignalProcess(signal_number='SIGUSR1',
+                                      process_matcher=matches_action(here))),
+    ])
+"""
+
+
+def test_machines_io_handlers_and_events(tmp_path: Path, env: dict[str, str]) -> None:
+    launch = tmp_path / "more.launch.py"
+    launch.write_text(MORE)
+    document = plan_of(str(launch), "--launch-prefix", "env PREFIXED=1", env=env)
+    validate(document)
+    here, far = processes(document).values()
+    assert here["machine"] == {
+        "name": "local",
+        "address": "127.0.0.1",
+        "user": None,
+        "ssh_port": None,
+        "env_loader": None,
+        "timeout": 10.0,
+        "local": True,
+    }
+    assert far["machine"]["name"] == "robot" and far["machine"]["ssh_port"] == 2200
+    assert not far["machine"]["local"]
+    assert here["launch_prefix"] == ["env", "PREFIXED=1"]
+    assert here["argv"][:2] == ["env", "PREFIXED=1"] and here["argv"][2].endswith("true")
+    assert here["respawn"]["mode"] == "on-failure"
+    assert [r["after"] for r in here["stop"]["ladder"]] == [0.0, 3.0, 3.5]
+    assert document["undeclared_arguments"] == {}  # --launch-prefix is not a launch argument
+    (handler,) = [s for s in document["steps"] if s["kind"] == "handler"]
+    assert handler["event"] == "process_io" and handler["io"] == ["stdout"]
+    assert handler["any_process"] and handler["target"] is None
+    (emit,) = [s for s in document["steps"] if s["kind"] == "emit"]
+    assert emit["event"] == "SignalProcess"
+
+
+def test_undeclared_arguments_and_warnings(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    document = plan_of(path, "mode:=real", "wokers:=3", env=env)
+    validate(document)
+    assert document["undeclared_arguments"] == {"wokers": "3"}
+    assert any("'wokers' is not declared" in w for w in document["warnings"])
+    args = {a["name"]: a for a in document["arguments"]}
+    assert args["mode"]["value"] == "real" and args["mode"]["choices"] == ["sim", "real"]
+    assert args["workers"]["value"] == "2" and not args["workers"]["given"]
+    timers = [s for s in document["steps"] if s["kind"] == "timer"]
+    assert [t["period"] for t in timers] == [1.5, 5.0]
+    assert [a["action"] for a in timers[1]["actions"]] == ["Shutdown"]

@@ -61,12 +61,19 @@ def plan_json(plan: Plan, path: str, given: Mapping[str, str]) -> str:
 
 def plan_document(plan: Plan, path: str, given: Mapping[str, str]) -> dict[str, Any]:
     """The plan as plain data: ``given`` is the command line's ``name:=value`` arguments."""
+    from mlaunch.run.resolve import BUILTIN_CONFIGURATIONS  # --launch-prefix's, not the file's
+
     writer = _Writer(plan.temp_dir)
+    undeclared = {
+        k: v
+        for k, v in given.items()
+        if k not in plan.arguments and k not in BUILTIN_CONFIGURATIONS
+    }
     return {
         "schema": SCHEMA_ID,
         "launch_file": _rel(path),
         "arguments": [_argument(info, given) for info in plan.arguments.values()],
-        "undeclared_arguments": {k: v for k, v in given.items() if k not in plan.arguments},
+        "undeclared_arguments": undeclared,
         "warnings": list(plan.warnings),
         "steps": [writer.step(step) for step in plan.steps],
     }
