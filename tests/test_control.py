@@ -199,6 +199,21 @@ def test_a_user_stop_of_a_required_process_does_not_end_or_fail_the_run() -> Non
     assert h.run() == 0
 
 
+def test_a_launch_whose_processes_the_user_stopped_stays_up() -> None:
+    h = Harness([make_spec("only", SLEEPER)])
+    seen: list[bool] = []
+
+    def check() -> None:
+        # The loop has asked whether it is idle since the exit: it is not, the user may start it.
+        seen.append(h.sup.shutting_down)
+        h.shutdown()
+
+    h.when(b"ready", lambda *_: h.sup.control.stop("only", done=lambda _: h.sup.schedule(0, check)))
+    assert h.run() == 0
+    assert seen == [False]
+    assert "shutting down: test" in h.text
+
+
 def test_on_process_exit_handlers_see_a_user_stop(tmp_path: Path) -> None:
     path = write_launch(
         tmp_path,

@@ -123,10 +123,13 @@ def test_list_stop_start_restart_and_the_socket(live: Live) -> None:
     assert not re.search(r"\[talker-1\]: .*restart \d+ in ", live.run.text)
     assert live.process("talker-1")["restarts"] == 2
 
+    live.ok("stop", "sleeper")
     live.run.signal(signal.SIGINT)
     assert live.run.finish() == 130
     summary = live.run.text.split("Summary:", 1)[1]
-    assert re.search(r"sleeper-2 .*stopped by SIGINT", summary)
+    assert summary.startswith(" 2 processes\n"), summary  # none failed
+    assert re.search(r"sleeper-2 +\d+ +stopped by the user +0 ", summary), summary
+    assert re.search(r"talker-1 +\d+ +stopped by SIGINT +2 ", summary), summary
     assert not live.socket.exists()  # removed at exit
     done = live.ctl("list")
     assert done.returncode == 1 and "no running launch" in done.stderr
