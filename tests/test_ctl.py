@@ -209,3 +209,33 @@ def test_kill_9_leaves_no_socket(live: Live) -> None:
     os.kill(live.run.proc.pid, signal.SIGKILL)
     assert wait_until(lambda: not live.socket.exists(), timeout=20)
     assert wait_until(lambda: not pid_alive(live.run.proc.pid) or live.run.proc.poll() is not None)
+
+
+def test_a_stopped_mlaunch_is_reported_not_waited_on(live: Live) -> None:
+    """mlaunch suspended (SIGSTOP): its socket accepts, nobody answers; ctl says so in seconds."""
+    os.kill(live.run.proc.pid, signal.SIGSTOP)
+    try:
+        done = live.ctl("list")
+    finally:
+        os.kill(live.run.proc.pid, signal.SIGCONT)
+    assert done.returncode == 1
+    assert "does not answer" in done.stderr or "did not answer in time" in done.stderr
+
+
+def test_silent_and_vanishing_clients_do_not_stall_the_run(live: Live) -> None:
+    """A client that never sends its request, and one that leaves during a stop, change nothing
+    for the run or for the next request."""
+    silent = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    with Address(str(live.socket)) as address:
+        silent.connect(address)
+    leaving = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    with Address(str(live.socket)) as address:
+        leaving.connect(address)
+    leaving.sendall(b'{"op": "stop", "label": "talker"}\n')
+    leaving.close()
+    live.run.wait_for(r"\[talker-1\]: process stopped by the user")
+    assert live.process("talker-1")["state"] == "stopped"
+    assert live.ok("start", "talker").startswith("talker-1: running")
+    silent.close()
+    live.run.signal(signal.SIGINT)
+    assert live.run.finish() == 130
