@@ -2,9 +2,9 @@
 
 An AF_UNIX stream socket at ``<run log folder>/control/ctl.sock``: the folder is 0700 and the
 socket 0600, so only the user who runs mlaunch reaches it. It is opened on the loop's first turn
-(after the first children started: ``socket`` and ``json`` cost milliseconds) and registered in
-the loop's selector, so every request is read and carried out on the loop thread, by
-mlaunch.run.control, never racing the supervisor. It is removed when the run ends; if mlaunch is
+(after the first children started: ``socket`` costs milliseconds; ``json`` waits for the first
+request) and registered in the loop's selector, so every request is read and carried out on the
+loop thread, by mlaunch.run.control, never racing the supervisor. It is removed when the run ends; if mlaunch is
 killed, its guard removes it (mlaunch.run.guard); a socket left behind anyway is found stale by
 ``mlaunch ctl`` (nobody accepts), never waited on.
 
@@ -19,7 +19,6 @@ line), ``status`` (errors' exit-status table) and, for an unknown label, ``label
 
 from __future__ import annotations
 
-import json
 import os
 import selectors
 import socket
@@ -201,6 +200,8 @@ class _Client:
         from mlaunch.run.control import AmbiguousLabel, ControlError, UnknownLabel
 
         try:
+            import json  # at the first request, not when the socket opens
+
             request = json.loads(line)
             if not isinstance(request, dict):
                 raise ValueError("not an object")
@@ -283,6 +284,8 @@ class _Client:
         self.server.forget(self)
 
     def queue(self, message: dict[str, object]) -> None:
+        import json
+
         self.out += json.dumps(message).encode() + b"\n"
         self._send()
 
