@@ -60,7 +60,9 @@ exit status:
   2  bad input: an unknown operation or label, a RUN that names nothing or several runs
 
 A launch whose processes were all stopped this way keeps running (they can be started again);
-Ctrl-C ends it.
+Ctrl-C ends it. The launch file's exit handlers see each stop as they would see ros2 launch's
+ShutdownProcess: a process with on_exit=Shutdown() (XML on_exit="shutdown") ends the launch
+when it is stopped or restarted, with exit status 0.
 """
 
 
