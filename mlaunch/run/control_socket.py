@@ -4,9 +4,9 @@ An AF_UNIX stream socket at ``<run log folder>/control/ctl.sock``: the folder is
 socket 0600, so only the user who runs mlaunch reaches it. It is opened on the loop's first turn
 (after the first children started: ``socket`` costs milliseconds; ``json`` waits for the first
 request) and registered in the loop's selector, so every request is read and carried out on the
-loop thread, by mlaunch.run.control, never racing the supervisor. It is removed when the run ends; if mlaunch is
-killed, its guard removes it (mlaunch.run.guard); a socket left behind anyway is found stale by
-``mlaunch ctl`` (nobody accepts), never waited on.
+loop thread, by mlaunch.run.control, never racing the supervisor. It is removed when the run
+ends; if mlaunch is killed, its guard removes it (mlaunch.run.guard); a socket left behind
+anyway is found stale by ``mlaunch ctl`` (nobody accepts), never waited on.
 
 The protocol is JSON lines. A request is one line: ``{"op": "stop", "label": "talker"}`` (op:
 one of mlaunch.run.control.OPERATIONS; ``lines`` for logs). The answer is one line with ``ok``;
