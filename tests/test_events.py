@@ -21,6 +21,7 @@ from mlaunch.run.events import (
     Event,
     EventStream,
     Exited,
+    HandedOff,
     Output,
     Said,
     ShutdownBegun,
@@ -80,12 +81,21 @@ def test_a_subscriber_that_raises_leaves_the_stream_usable() -> None:
     assert [type(e) for e in seen] == [ShutdownBegun]
 
 
-def test_notes_are_passed_over_and_other_unknown_steps_refused() -> None:
-    """A Note (a container's component loads) is for what attaches; nothing else is skipped."""
+def test_a_handoff_is_emitted_and_said_when_nothing_takes_it() -> None:
+    """A Handoff (a container's component loads) goes to the part that carries it out; with
+    no such part attached it is said as an error, never dropped in silence."""
     from mlaunch.launch_ros.composition import LoadComponents
 
-    h = Harness(Plan(steps=[LoadComponents(origin="c.launch.py:1", target="/container")]))
+    step = LoadComponents(origin="c.launch.py:1", target="/container")
+    h = Harness(Plan(steps=[step]))
+    handed: list[HandedOff] = []
+    h.sup.events.subscribe(lambda e: handed.append(e) if isinstance(e, HandedOff) else None)
     assert h.run() == 0
+    assert [e.step for e in handed] == [step]
+    assert (
+        b"LoadComponents (c.launch.py:1): nothing in this run carries it out (it needs"
+        b" components); not done"
+    ) in bytes(h.screen)
 
 
 def test_the_supervisor_refuses_a_step_kind_it_does_not_know() -> None:

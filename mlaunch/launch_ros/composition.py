@@ -21,7 +21,7 @@ from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import Substitution, describe, normalize, perform_substitutions
 from mlaunch.launch_ros.actions import Node, make_namespace_absolute
 from mlaunch.launch_ros.composable import ComposableNode
-from mlaunch.run.plan import Note
+from mlaunch.run.plan import Handoff
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -31,17 +31,22 @@ if TYPE_CHECKING:
     from mlaunch.run.resolve import Resolver
 
 
-class LoadComponents(Note):
+# What a load needs attached to the run (Plan.needs): the LoadNode driver.
+COMPONENTS = frozenset({"components"})
+
+
+class LoadComponents(Handoff):
     """Load ``requests`` into the container ``target`` (a full node name), in order.
 
     ``written`` is the container's name as the launch file gave it (launch_ros's log lines show
     that, ``'box'`` rather than ``'/box'``); empty means the same as ``target``.
-    A Note: the supervisor carries nothing out for it; the LoadNode driver (attached to the run
-    when the plan has such steps) sends the requests."""
+    A Handoff: the supervisor emits it on the event stream when it reaches it (in the plan, a
+    timer or an event handler), and the LoadNode driver (mlaunch.ros.components) sends the
+    requests."""
 
     __slots__ = ("requests", "target", "written")
-    _fields = (*Note._fields, "target", "requests", "written")
-    needs = frozenset({"components"})  # the run attaches the LoadNode driver (Plan.needs)
+    _fields = (*Handoff._fields, "target", "requests", "written")
+    needs = COMPONENTS  # the run attaches the LoadNode driver (Plan.needs)
 
     def __init__(
         self,
@@ -104,6 +109,11 @@ class ComposableNodeContainer(Node):
         super().__init__(name=name, namespace=namespace, **kwargs)
         self._descriptions = _descriptions(composable_node_descriptions)
 
+    @property
+    def needs(self) -> frozenset[str]:
+        """The LoadNode driver, when there are nodes to load (seen in a timer or handler too)."""
+        return COMPONENTS if self._descriptions else frozenset()
+
     # A Node returns nothing; a container also returns the load of its nodes (as launch_ros).
     def execute(self, resolver: Resolver) -> list[Any] | None:  # type: ignore[override]
         ctx = resolver.context
@@ -120,6 +130,8 @@ class ComposableNodeContainer(Node):
 
 class LoadComposableNodes(Action):
     """Load composable nodes into a container, this launch's or one started elsewhere."""
+
+    needs = COMPONENTS  # noted in a timer or a handler body too, before it fires
 
     def __init__(
         self,

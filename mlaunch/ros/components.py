@@ -1,10 +1,17 @@
-"""The LoadNode driver: sends a run's ``LoadComponents`` steps to their containers.
+"""The LoadNode driver: sends every ``LoadComponents`` step of a run to its container.
 
-As launch_ros does it: for each step, wait until ``<container>/_container/load_node`` is
-available (rechecking every second, giving up when the run stops), then send the requests one
-after the other, each once the previous one was answered; a load that fails is logged with the
-container's error message and the next one is still sent. Each step runs in its own thread
-with its own rclpy node, so one container that never comes up does not hold the others back.
+The supervisor hands each LoadComponents step over on the event stream (``HandedOff``) when it
+reaches it: in the plan, in a timer's body, in an event handler's (a ComposableNodeContainer
+started by OnProcessStart, a LoadComposableNodes in a TimerAction), so every load goes through
+this one path, in the order the steps are reached.
+
+As launch_ros does it: each step runs in its own thread (one container that never comes up
+does not hold the others back); for each request in order, wait until
+``<container>/_container/load_node`` is available, send it, wait for the answer, then the next;
+a load that fails is logged with the container's error message and the next one is still sent.
+A pending load keeps an otherwise idle launch running (launch's completion futures); a dead
+container's loads wait for it to serve again. When the launch shuts down every wait is
+abandoned, one line per load never made, and the threads end before the run does.
 
 rclpy and composition_interfaces are imported only when a driver is made.
 """
@@ -14,18 +21,25 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
+from mlaunch.errors import MlaunchError
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.record import Record
+from mlaunch.run.events import Event, Exited, HandedOff, Said, ShutdownBegun
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.run.supervisor import Supervisor
+
 # (level, message): where the driver's lines go (the run's printer, a test's list).
 Log = Callable[[str, str], None]
 # The logger launch_ros's LoadComposableNodes logs under (its module's name).
 LOGGER = "launch_ros.actions.load_composable_nodes"
+
+# How often a wait looks at the container again; a stop ends a wait at once.
+POLL = 0.1
 
 
 class LoadResult(Record):
@@ -49,22 +63,45 @@ class LoadResult(Record):
         self.error_message = error_message
 
 
-class ComponentLoader:
-    """Loads steps into containers from threads; ``stop`` ends every wait."""
+def describe_load(request: LoadRequest) -> str:
+    """``node 'talker' of type 'composition::Talker'`` (the plugin alone when it is unnamed)."""
+    if request.node_name:
+        return f"node '{request.node_name}' of type '{request.plugin_name}'"
+    return f"a node of type '{request.plugin_name}'"
 
-    def __init__(self, context: Any, log: Log) -> None:
+
+class ComponentLoader:
+    """Loads steps into containers from threads; ``stop`` ends every wait.
+
+    ``finished(thread)`` is called from a step's thread when it has ended.
+    """
+
+    def __init__(
+        self, context: Any, log: Log, finished: Callable[[threading.Thread], None] | None = None
+    ) -> None:
         self.context = context  # an initialised rclpy Context
         self.log = log
+        self.finished = finished
         self.stop = threading.Event()
         self.results: list[LoadResult] = []
         self._threads: list[threading.Thread] = []
         self._lock = threading.Lock()
         self._count = 0
+        # The requests of each running step not answered yet, first one next.
+        self._pending: dict[int, tuple[str, list[LoadRequest]]] = {}
 
     def start(self, step: LoadComponents) -> threading.Thread:
-        """Load ``step`` in a new thread (returned, so a caller can join it)."""
+        """Load ``step`` in a new thread (returned, so a caller can join it).
+
+        Its requests are pending from now on (not from when the thread gets going), so a
+        container that dies at once is known to have had loads waiting for it.
+        """
+        with self._lock:
+            self._count += 1
+            count = self._count
+            self._pending[count] = (step.target, list(step.requests))
         thread = threading.Thread(
-            target=self.load, args=(step,), name=f"load {step.target}", daemon=True
+            target=self._run, args=(step, count), name=f"load {step.target}", daemon=True
         )
         self._threads.append(thread)
         thread.start()
@@ -79,16 +116,35 @@ class ComponentLoader:
             thread.join(max(0.0, deadline - time.monotonic()))
         return not any(t.is_alive() for t in self._threads)
 
-    def load(self, step: LoadComponents) -> list[LoadResult]:
-        """Send the step's requests in order, each once the container answered the one before."""
+    def pending(self, target: str) -> list[LoadRequest]:
+        """The requests for container ``target`` not answered yet, in the order they go out."""
+        with self._lock:
+            return [r for t, requests in self._pending.values() if t == target for r in requests]
+
+    def _run(self, step: LoadComponents, count: int) -> None:
+        try:
+            self.load(step, count)
+        except Exception as e:  # a failing rclpy call must not end the thread in silence
+            self.log("ERROR", f"Loading into container '{step.target}' failed: {e}")
+        finally:
+            with self._lock:
+                self._pending.pop(count, None)
+            if self.finished is not None:
+                self.finished(threading.current_thread())
+
+    def load(self, step: LoadComponents, count: int) -> list[LoadResult]:
+        """Send the step's requests in order, each once the container answered the one before.
+
+        Once stopped, each request not sent (or not answered) is abandoned with its own line.
+        ``count`` numbers the step (its pending requests and its loader node's name).
+        """
         import os
 
         from composition_interfaces.srv import LoadNode
         from rclpy.node import Node
 
         with self._lock:
-            self._count += 1
-            count = self._count
+            remaining = self._pending[count][1]
         # Hidden (leading '_') and unique, so it never shows among the launched nodes.
         node = Node(
             f"_mlaunch_loader_{os.getpid()}_{count}",
@@ -100,20 +156,35 @@ class ComponentLoader:
         results: list[LoadResult] = []
         try:
             client = node.create_client(LoadNode, step.service)
-            while not client.wait_for_service(timeout_sec=1.0):
-                if self.stop.is_set() or not self.context.ok():
-                    self.log("WARNING", f"Abandoning wait for the '{step.service}' service")
-                    return results
             for request in step.requests:
-                result = self._call(node, client, request, step)
-                if result is None:
-                    return results
-                results.append(result)
+                result = None
+                if self._wait_for_service(client, step, request):
+                    result = self._call(node, client, request, step)
                 with self._lock:
-                    self.results.append(result)
+                    remaining.pop(0)
+                if result is not None:
+                    results.append(result)
+                    with self._lock:
+                        self.results.append(result)
         finally:
             node.destroy_node()
         return results
+
+    def _stopping(self) -> bool:
+        return self.stop.is_set() or not self.context.ok()
+
+    def _wait_for_service(self, client: Any, step: LoadComponents, request: LoadRequest) -> bool:
+        """Wait until the container serves load_node; False (said) once the launch stops."""
+        while not self._stopping():
+            if client.service_is_ready():
+                return True
+            self.stop.wait(POLL)
+        self.log(
+            "WARNING",
+            f"Abandoning wait for the '{step.service}' service, due to shutdown:"
+            f" {describe_load(request)} was never loaded",
+        )
+        return False
 
     def _call(
         self, node: Any, client: Any, request: LoadRequest, step: LoadComponents
@@ -125,14 +196,15 @@ class ComponentLoader:
         executor.add_node(node)
         try:
             while not future.done():
-                if self.stop.is_set() or not self.context.ok():
+                if self._stopping():
                     self.log(
                         "WARNING",
-                        f"Abandoning wait for the '{step.service}' service response",
+                        f"Abandoning wait for the '{step.service}' service response, due to"
+                        f" shutdown: {describe_load(request)} may not have been loaded",
                     )
                     future.cancel()
                     return None
-                executor.spin_once(timeout_sec=0.1)
+                executor.spin_once(timeout_sec=POLL)
         finally:
             executor.remove_node(node)
             executor.shutdown()
@@ -162,48 +234,81 @@ class ComponentLoader:
 
 
 class ComponentDriver:
-    """The pipeline's components part: loads the plan's LoadComponents steps once the run starts.
+    """The pipeline's components part: loads each LoadComponents step the supervisor hands over.
 
-    Lines go to the run's output from the supervisor's loop thread (the printer is not shared
-    across threads). Loads of deferred parts (a LoadComposableNodes in a timer or an event
-    handler) are not driven yet: the supervisor runs those steps without telling its parts.
+    It subscribes to the run's event stream: a ``HandedOff`` LoadComponents starts its loads,
+    ``ShutdownBegun`` abandons every wait (as launch_ros at shutdown), the ``Exited`` of a
+    container with loads pending is said. Lines go to the run's output from the supervisor's
+    loop thread (the printer is not shared across threads).
     """
 
-    def __init__(self, supervisor: Any, steps: list[LoadComponents]) -> None:
+    def __init__(self, supervisor: Supervisor) -> None:
         import os
 
-        from mlaunch.ros.bridge import domain_id_from
-        from mlaunch.ros.lifecycle import LoopCall
+        from mlaunch.ros.graph_types import domain_id_from
+        from mlaunch.ros.handoff import LoopCall
 
+        try:
+            import composition_interfaces.srv  # noqa: F401  (the loads need it, say so now)
+            from rclpy.context import Context
+        except ImportError as e:
+            raise MlaunchError(
+                f"composable nodes are loaded with rclpy and composition_interfaces ({e}):"
+                " run ./scripts/setup, or source a ROS 2 installation"
+            ) from e
         self.supervisor = supervisor
         self.loop = LoopCall(supervisor.selector)
         environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
-        from rclpy.context import Context
-
         context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
-        self.loader = ComponentLoader(context, self._log)
-        self.steps = steps
-        supervisor.schedule(0.0, self._start, keeps_alive=False)
+        self.loader = ComponentLoader(context, self._log, self._finished)
+        supervisor.events.subscribe(self.on_event)
 
-    def _start(self) -> None:
-        for step in self.steps:
-            self.loader.start(step)
+    def on_event(self, event: Event) -> None:
+        if isinstance(event, HandedOff) and isinstance(event.step, LoadComponents):
+            event.taken = True
+            # Keeps an idle launch running until the loads are done (or the launch stops).
+            self.supervisor.busy(self.loader.start(event.step))
+        elif isinstance(event, ShutdownBegun):
+            self.loader.stop.set()
+        elif isinstance(event, Exited):
+            self._exited(event)
+
+    def _exited(self, event: Exited) -> None:
+        node = event.process.spec.node
+        target = node.fully_qualified_name if node is not None else None
+        if target is None or self.supervisor.shutting_down:
+            return
+        pending = self.loader.pending(target)
+        if not pending:
+            return
+        loads = ", ".join(describe_load(r) for r in pending)
+        self._say(
+            "WARNING",
+            f"container '{target}' exited before it loaded {loads}: the loads wait for its"
+            f" '{target}/_container/load_node' service until the launch stops (as launch_ros)",
+        )
+
+    def _finished(self, thread: threading.Thread) -> None:
+        self.loop.call_soon(lambda: self.supervisor.done(thread))
 
     def _log(self, level: str, message: str) -> None:
-        printer = self.supervisor.printer
-        self.loop.call_soon(lambda: printer.message(level, LOGGER, message))
+        """A line from a load's thread, said from the loop thread."""
+        self.loop.call_soon(lambda: self._say(level, message))
+
+    def _say(self, level: str, message: str) -> None:
+        self.supervisor.events.emit(Said(level, LOGGER, message))
 
     def close(self) -> None:
+        """At the end of the run: abandon what still waits, end the threads, say their lines."""
         self.loader.stop.set()
         self.loader.join(3.0)
+        self.loop.run_pending()  # the loop is over: the abandoned loads' lines are said here
+        self.supervisor.events.unsubscribe(self.on_event)
         self.loader.context.try_shutdown()
         self.loop.close()
 
 
-def attach(options: Any, supervisor: Any) -> ComponentDriver | None:
-    """The pipeline's components part: a driver when the plan loads composable nodes, else None."""
-    steps = [s for s in supervisor.plan.steps if isinstance(s, LoadComponents)]
-    if not steps:
-        return None
-    return ComponentDriver(supervisor, steps)
+def attach(options: Any, supervisor: Supervisor) -> ComponentDriver:
+    """The pipeline's components part, for a plan that loads composable nodes (Plan.needs)."""
+    return ComponentDriver(supervisor)

@@ -52,6 +52,10 @@ class LoopCall:
                 pass
         except BlockingIOError:
             pass
+        self.run_pending()
+
+    def run_pending(self) -> None:
+        """Run what is queued now, in the loop's thread (also once the loop has ended)."""
         while True:
             try:
                 fn = self._queue.get_nowait()

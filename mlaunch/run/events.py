@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.run.plan import ProcessSpec
+    from mlaunch.run.plan import Handoff, ProcessSpec
     from mlaunch.run.process import Process
 
 
@@ -215,12 +215,24 @@ class LaunchEvent(Event):
         self.taken = False
 
 
+class HandedOff(Event):
+    """A plan step for a part of the run (``step``: a ``Handoff``, e.g. LoadComponents) was
+    reached; the part that carries it out sets ``taken``."""
+
+    __slots__ = ("step", "taken")
+
+    def __init__(self, step: Handoff) -> None:
+        self.step = step
+        self.taken = False
+
+
 class Unclaimed(Event):
-    """Follows a LaunchEvent once every subscriber has seen it; said if nobody took it."""
+    """Follows a LaunchEvent or a HandedOff once every subscriber has seen it; said if nobody
+    took it."""
 
     __slots__ = ("launch_event",)
 
-    def __init__(self, launch_event: LaunchEvent) -> None:
+    def __init__(self, launch_event: LaunchEvent | HandedOff) -> None:
         self.launch_event = launch_event
 
 

@@ -23,6 +23,7 @@ from mlaunch.run.events import (
     Exited,
     FailedToStart,
     GaveUp,
+    HandedOff,
     Interrupted,
     NotStarted,
     Output,
@@ -480,9 +481,20 @@ class Printer:
             self.message("INFO", "launch", f"shutting down: {event.reason}")
 
     def _unclaimed(self, event: Unclaimed) -> None:
-        if not event.launch_event.taken:
-            name = type(event.launch_event.event).__name__
-            self.message("WARNING", "launch", f"event {name} has no handler in mlaunch; ignored")
+        record = event.launch_event
+        if record.taken:
+            return
+        if isinstance(record, HandedOff):
+            step = record.step
+            self.message(
+                "ERROR",
+                "launch",
+                f"{type(step).__name__} ({step.origin}): nothing in this run carries it out"
+                f" (it needs {', '.join(sorted(step.needs))}); not done",
+            )
+            return
+        name = type(record.event).__name__
+        self.message("WARNING", "launch", f"event {name} has no handler in mlaunch; ignored")
 
     def _controlled(self, event: Controlled) -> None:
         via = _VIA.get(event.by, "")

@@ -16,7 +16,7 @@ import os
 from collections.abc import Callable, Sequence
 
 from mlaunch.options import Options
-from mlaunch.run.events import Event, LaunchEvent, Started
+from mlaunch.run.events import Event, HandedOff, LaunchEvent, Started
 from mlaunch.run.plan import Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -327,12 +327,45 @@ class _LifecycleWatch:
 
 
 def components(run: Run) -> object:
-    """Composable node loading, when resolve made LoadComponents steps (Plan.needs)."""
-    if "components" not in run.plan.needs:
-        return None
-    from mlaunch.ros.components import attach
+    """Composable node loading: at once when the plan needs it, else on demand.
 
-    return attach(run.opts, run.supervisor)
+    Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
+    LoadComposableNodes in timers and handlers not yet fired; a handler written as a function
+    can still make one, so without that need a watch attaches the LoadNode driver at the first
+    LoadComponents the supervisor hands over.
+    """
+    if "components" in run.plan.needs:
+        from mlaunch.ros.components import attach
+
+        return attach(run.opts, run.supervisor)
+    return _ComponentsWatch(run)
+
+
+class _ComponentsWatch:
+    """Attaches the LoadNode driver at the first LoadComponents step handed over.
+
+    Until then it only looks at each record's class; the record that triggered it is handed to
+    the new driver, which sees every later record itself.
+    """
+
+    def __init__(self, run: Run) -> None:
+        self.run = run
+        self.driver: Any = None
+        run.supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if not isinstance(event, HandedOff) or "components" not in event.step.needs:
+            return
+        from mlaunch.ros.components import attach
+
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        self.driver = attach(self.run.opts, self.run.supervisor)
+        self.driver.on_event(event)
+
+    def close(self) -> None:
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        if self.driver is not None:
+            self.driver.close()
 
 
 def control_socket(run: Run) -> object:

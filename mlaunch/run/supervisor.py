@@ -41,6 +41,7 @@ from mlaunch.run.events import (
     Exited,
     FailedToStart,
     GaveUp,
+    HandedOff,
     LaunchEvent,
     NotStarted,
     Output,
@@ -50,6 +51,7 @@ from mlaunch.run.events import (
     StartsSkipped,
     StoppingAll,
     StrayEnded,
+    Unclaimed,
 )
 from mlaunch.run.handlers import LaunchHandlers
 from mlaunch.run.ladder import StopLadder
@@ -59,6 +61,7 @@ from mlaunch.run.plan import (
     AddHandler,
     Deferred,
     EmitEvent,
+    Handoff,
     Log,
     Note,
     Plan,
@@ -163,6 +166,8 @@ class Supervisor(Stopping):
         self._marker_env = {guards.MARKER: self.run_id}
         # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
         self._awaited: set[int] = set()
+        # Work attached parts do outside the loop (composable node loads): keeps the run alive.
+        self._work: set[object] = set()
 
     @property
     def control(self) -> Control:
@@ -226,7 +231,7 @@ class Supervisor(Stopping):
         if any(p.running for p in self.processes):
             return False
         if not self.shutting_down:
-            if self.timers.keep_alive():
+            if self.timers.keep_alive() or self._work:
                 return False
             if any(r.state == STOPPED for r in self.records.values()):
                 return False  # stopped by the user, who may start it again: not idle
@@ -239,6 +244,15 @@ class Supervisor(Stopping):
         for process in self.processes:
             self.pipes.close_all(process)
         return True
+
+    def busy(self, work: object) -> None:
+        """``work`` (a hashable token) of an attached part, such as a composable node load
+        waiting for its container, keeps an otherwise idle launch running until
+        ``done(work)``, as launch's completion futures do; a shutdown does not wait for it."""
+        self._work.add(work)
+
+    def done(self, work: object) -> None:
+        self._work.discard(work)
 
     def _lingering_pending(self) -> bool:
         """Groups whose leader is gone but a member lives on (a grandchild in the same group)."""
@@ -325,6 +339,12 @@ class Supervisor(Stopping):
             self.begin_shutdown(step.reason)
         elif isinstance(step, EmitEvent):
             self.events.emit(LaunchEvent(step.event))
+        elif isinstance(step, Handoff):
+            # For the part that carries it out (the LoadNode driver): from the plan, a timer
+            # or a handler alike, in the order the steps are reached.
+            handed = HandedOff(step)
+            self.events.emit(handed)
+            self.events.emit(Unclaimed(handed))
         elif not isinstance(step, Note):
             raise TypeError(
                 f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"

@@ -1,0 +1,285 @@
+"""Loads written in timers and event handlers reach real rclpy containers; a dead container's
+loads end cleanly at Ctrl-C.
+
+``mlaunch FILE`` runs against the recording container (tests/nodes/recording_container.py,
+which prints each request it receives) and mlaunch's container stand-in (which hosts
+robot_state_publisher's component and refuses other plugins with its reason, so a refusal
+proves the request was sent). Every wait has a deadline; the run ends on SIGINT with 130.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import requires_rclpy
+from procutil import Running, clean_env, mlaunch, pid_alive, wait_until
+from test_composition_ros import RECORDER, requires_composition_interfaces
+from test_standin_nodes import URDF
+
+pytestmark = [requires_rclpy, requires_composition_interfaces, pytest.mark.timeout(120)]
+
+PY = sys.executable
+
+HANDLERS_PY = """
+    from launch import LaunchDescription
+    from launch.actions import ExecuteProcess, RegisterEventHandler, TimerAction
+    from launch.event_handlers import OnProcessStart
+    from launch_ros.actions import ComposableNodeContainer, LoadComposableNodes, PushROSNamespace
+    from launch_ros.descriptions import ComposableNode
+
+
+    def generate_launch_description():
+        rec = ExecuteProcess(
+            cmd=[PY, RECORDER, '--ros-args', '-r', '__node:=rec'], name='rec', output='screen')
+        box = ComposableNodeContainer(
+            package='rclcpp_components', executable='component_container', name='dbox',
+            namespace='', composable_node_descriptions=[ComposableNode(
+                package='robot_state_publisher',
+                plugin='robot_state_publisher::RobotStatePublisher',
+                parameters=[{'robot_description': URDF}])])
+        return LaunchDescription([
+            rec,
+            # A load and a container with its own nodes, both started when rec starts.
+            RegisterEventHandler(OnProcessStart(target_action=rec, on_start=[
+                LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
+                    ComposableNode(package='p', plugin='p::Start', name='on_start')]),
+                box,
+            ])),
+            TimerAction(period=0.5, actions=[
+                PushROSNamespace('t'),
+                LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
+                    ComposableNode(package='p', plugin='p::Timer', name='in_timer',
+                                   parameters=[{'x': 1}])]),
+            ]),
+            # Into the container the handler above started, given as the action.
+            RegisterEventHandler(OnProcessStart(target_action=box, on_start=[
+                LoadComposableNodes(target_container=box, composable_node_descriptions=[
+                    ComposableNode(package='composition', plugin='composition::Talker',
+                                   name='talker')]),
+            ])),
+        ])
+"""
+
+TIMER_XML = """
+    <launch>
+      <executable cmd="{py} {recorder} --ros-args -r __node:=rec" name="rec" output="screen"/>
+      <timer period="0.5">
+        <push_ros_namespace namespace="t"/>
+        <load_composable_node target="/rec">
+          <composable_node pkg="p" plugin="p::Timer" name="in_timer">
+            <param name="x" value="1"/>
+          </composable_node>
+        </load_composable_node>
+        <node_container pkg="rclcpp_components" exec="component_container" name="dbox"
+                        namespace="">
+          <composable_node pkg="composition" plugin="composition::Talker" name="talker"/>
+        </node_container>
+      </timer>
+    </launch>
+"""
+
+REFUSED = (
+    "Failed to load node 'talker' of type 'composition::Talker' in container '/dbox':"
+    " mlaunch's container stand-in cannot load plugin 'composition::Talker'"
+)
+
+
+def start(path: Path, env: dict[str, str]) -> Running:
+    return Running(mlaunch(str(path)), env=env)
+
+
+def run_env(ros_env: dict[str, str], tmp_path: Path) -> dict[str, str]:
+    keys = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMENTATION")
+    env = clean_env(**{k: ros_env[k] for k in keys})
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    return env
+
+
+def recorded(run: Running) -> list[dict[str, Any]]:
+    """The requests the recording container printed (its lines in mlaunch's output)."""
+    out = []
+    for line in run.text.splitlines():
+        head, _, rest = line.partition("] ")
+        if head.startswith("[rec") and rest.startswith("{"):
+            out.append(json.loads(rest))
+    return out
+
+
+def stop(run: Running) -> int:
+    """Ctrl-C: the run ends by itself within the deadline, with the usual status."""
+    run.signal(signal.SIGINT)
+    try:
+        return run.finish(timeout=20)
+    finally:
+        run.kill()
+
+
+def test_loads_in_a_timer_and_in_handlers_reach_their_containers(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    path = tmp_path / "handlers.launch.py"
+    head = f"PY = {PY!r}\nRECORDER = {RECORDER!r}\nURDF = {URDF!r}\n"
+    path.write_text(head + textwrap.dedent(HANDLERS_PY))
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        run.wait_for(r"Loaded node '/on_start' in container '/rec'", 60)
+        run.wait_for(r"Loaded node '/t/in_timer' in container '/rec'", 60)
+        run.wait_for(r"Loaded node '/robot_state_publisher' in container '/dbox'", 60)
+        run.wait_for(REFUSED, 60)
+        assert wait_until(lambda: len(recorded(run)) >= 2, 10), run.text
+    finally:
+        code = stop(run)
+    assert code == 130, run.text
+    requests = {r["node_name"]: r for r in recorded(run)}
+    assert sorted(requests) == ["in_timer", "on_start"]
+    # Resolved when the timer fired: its pushed namespace and its parameter.
+    assert requests["in_timer"]["node_namespace"] == "/t"
+    assert requests["in_timer"]["parameters"] == [["x", 2, 1]]
+    assert "nothing in this run carries it out" not in run.text
+
+
+def test_a_timer_tag_loads_into_a_running_and_a_new_container(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    path = tmp_path / "timer.launch.xml"
+    path.write_text(textwrap.dedent(TIMER_XML).format(py=PY, recorder=RECORDER))
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        run.wait_for(r"Loaded node '/t/in_timer' in container '/rec'", 60)
+        # The container the timer started is pushed into /t; its load goes to its full name.
+        run.wait_for(REFUSED.replace("'/dbox'", "'/t/dbox'"), 60)
+    finally:
+        code = stop(run)
+    assert code == 130, run.text
+    (request,) = recorded(run)
+    assert (request["node_name"], request["node_namespace"]) == ("in_timer", "/t")
+
+
+DEAD_PY = """
+    from launch import LaunchDescription
+    from launch_ros.actions import LoadComposableNodes, Node
+    from launch_ros.descriptions import ComposableNode
+
+
+    def generate_launch_description():
+        return LaunchDescription([
+            # A "container" that never serves load_node; the test kills it.
+            Node(executable=PY, name='dead', arguments=['-c', 'import time; time.sleep(300)']),
+            LoadComposableNodes(target_container='/dead', composable_node_descriptions=[
+                ComposableNode(package='p', plugin='p::A', name='a'),
+                ComposableNode(package='p', plugin='p::B', name='b'),
+            ]),
+        ])
+"""
+
+
+def test_a_dead_containers_loads_are_said_and_ctrl_c_ends_the_run(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """As launch_ros: the loads keep waiting for the service (the launch stays up, as ros2
+    launch does) until Ctrl-C abandons them, one line each; mlaunch also says when the
+    container died with loads pending."""
+    path = tmp_path / "dead.launch.py"
+    path.write_text(f"PY = {PY!r}\n" + textwrap.dedent(DEAD_PY))
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        pid = int(run.wait_for(r"\[[^]]+-1\]: process started with pid \[(\d+)\]", 30)[1])
+        os.kill(pid, signal.SIGKILL)
+        run.wait_for(
+            r"container '/dead' exited before it loaded node 'a' of type 'p::A', node 'b' of"
+            r" type 'p::B': the loads wait",
+            30,
+        )
+        assert not pid_alive(pid)
+        assert run.proc.poll() is None, "the pending loads keep the launch up, as in ros2 launch"
+    finally:
+        code = stop(run)
+    assert code == 130, run.text
+    for name, plugin in (("a", "p::A"), ("b", "p::B")):
+        assert (
+            "Abandoning wait for the '/dead/_container/load_node' service, due to shutdown:"
+            f" node '{name}' of type '{plugin}' was never loaded"
+        ) in run.text
+
+
+OPAQUE_PY = """
+    from launch import LaunchDescription
+    from launch.actions import ExecuteProcess, OpaqueFunction, RegisterEventHandler
+    from launch.event_handlers import OnProcessStart
+    from launch_ros.actions import LoadComposableNodes
+    from launch_ros.descriptions import ComposableNode
+
+
+    def load(context):
+        return [LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
+            ComposableNode(package='p', plugin='p::Opaque', name='opaque')])]
+
+
+    def generate_launch_description():
+        rec = ExecuteProcess(
+            cmd=[PY, RECORDER, '--ros-args', '-r', '__node:=rec'], name='rec', output='screen')
+        return LaunchDescription([
+            rec,
+            RegisterEventHandler(OnProcessStart(
+                target_action=rec, on_start=[OpaqueFunction(function=load)])),
+        ])
+"""
+
+
+def test_a_load_only_a_function_makes_attaches_the_driver_when_it_comes(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """Nothing before the run shows a load (the plan does not need the driver): the first
+    LoadComponents handed over attaches it."""
+    path = tmp_path / "opaque.launch.py"
+    path.write_text(f"PY = {PY!r}\nRECORDER = {RECORDER!r}\n" + textwrap.dedent(OPAQUE_PY))
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        run.wait_for(r"Loaded node '/opaque' in container '/rec'", 60)
+    finally:
+        code = stop(run)
+    assert code == 130, run.text
+    assert [r["plugin_name"] for r in recorded(run)] == ["p::Opaque"]
+
+
+def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
+    ros_env: dict[str, str],
+) -> None:
+    """In-process: a load for a container nobody starts keeps the run up until it shuts down;
+    then the wait is abandoned (said) and ``close`` leaves no load thread behind."""
+    import threading
+
+    from test_supervision import Harness
+
+    from mlaunch.launch_ros.composition import LoadComponents
+    from mlaunch.launch_ros.load_request import LoadRequest
+    from mlaunch.ros.components import ComponentDriver
+    from mlaunch.run.events import Event, HandedOff
+    from mlaunch.run.plan import Plan
+
+    request = LoadRequest("p", "p::A", "a")
+    h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
+    driver = ComponentDriver(h.sup)
+
+    def on_event(event: Event) -> None:
+        if isinstance(event, HandedOff):  # the driver has its thread waiting by now
+            h.sup.schedule(0.0, h.shutdown)
+
+    h.sup.events.subscribe(on_event)
+    try:
+        assert h.run() == 0
+    finally:
+        driver.close()
+    h.printer.flush()
+    assert not [t for t in threading.enumerate() if t.name.startswith("load ")]
+    assert (
+        "Abandoning wait for the '/nobody/_container/load_node' service, due to shutdown:"
+        " node 'a' of type 'p::A' was never loaded"
+    ) in h.text
