@@ -208,6 +208,52 @@ def test_a_value_loadnode_cannot_carry_is_a_clear_error(prefix: Path) -> None:
         plan_of(LaunchDescription([load]), None, prefix)
 
 
+@pytest.mark.parametrize("field", ["parameters", "extra_arguments"])
+def test_a_parameter_description_is_refused_as_launch_ros_fails_on_it(
+    field: str, tmp_path: Path, prefix: Path
+) -> None:
+    """launch_ros 0.26.6 keeps Parameter(...) unevaluated in a LoadNode request and fails
+    ('invalid evaluated parameters', the launch ends with 1; checked with the reference): an
+    error at the action's line, naming the value and what to write instead."""
+    path = tmp_path / "param.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import LoadComposableNodes\n"
+        "from launch_ros.descriptions import ComposableNode\n"
+        "from launch_ros.parameter_descriptions import Parameter\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        "        LoadComposableNodes(target_container='c', composable_node_descriptions=[\n"
+        "            ComposableNode(package='p', plugin='p::P', name='n',\n"
+        f"                           {field}=[{{'x': 1}}, Parameter('y', 2)])]),\n"
+        "    ])\n"
+    )
+    with pytest.raises(MlaunchError) as caught:
+        plan_of(frontends.load(str(path)), str(path), prefix)
+    error = caught.value
+    assert error.where == f"{path}:7"
+    assert (
+        f"a ComposableNode's {field} cannot hold launch_ros.description.Parameter(name='y',"
+        " value=2, value_type=None)"
+    ) in str(error)
+    assert f"give it as a dict instead, {field}=[{{name: value}}]" in str(error)
+
+
+def test_a_parameter_description_of_a_node_not_loaded_is_no_error(prefix: Path) -> None:
+    """launch_ros builds no request for a node whose condition is false, so it never fails."""
+    from mlaunch.launch.conditions import IfCondition
+    from mlaunch.launch_ros.parameter_descriptions import Parameter
+
+    node = ComposableNode(
+        package="p",
+        plugin="p::P",
+        parameters=[Parameter("y", 2)],
+        condition=IfCondition("false"),
+    )
+    load = LoadComposableNodes(target_container="c", composable_node_descriptions=[node])
+    assert loads(plan_of(LaunchDescription([load]), None, prefix)) == []
+
+
 def test_composable_node_at_top_level_says_where_it_belongs(tmp_path: Path) -> None:
     path = tmp_path / "t.launch.xml"
     path.write_text('<launch><composable_node pkg="p" plugin="p::P" name="n"/></launch>')

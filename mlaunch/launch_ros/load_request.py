@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mlaunch.errors import SubstitutionFailure
+from mlaunch.errors import MlaunchError, SubstitutionFailure
 from mlaunch.launch.substitutions import perform_substitutions
 from mlaunch.launch_ros.actions import make_namespace_absolute, prefix_namespace
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile
@@ -128,7 +128,9 @@ def load_request(description: ComposableNode, context: LaunchContext) -> LoadReq
     typed_params = flatten(context, entries, name, namespace) if entries else []
     extra = []
     if description.extra_arguments is not None:
-        extra = flatten(context, description.extra_arguments, name, namespace)
+        extra = flatten(
+            context, description.extra_arguments, name, namespace, field="extra_arguments"
+        )
     return LoadRequest(
         package_name=package,
         plugin_name=plugin,
@@ -159,9 +161,18 @@ def _global_entries(context: LaunchContext) -> list[Any]:
 
 
 def flatten(
-    context: LaunchContext, entries: Any, node_name: str, namespace: str | None
+    context: LaunchContext,
+    entries: Any,
+    node_name: str,
+    namespace: str | None,
+    field: str = "parameters",
 ) -> list[TypedParameter]:
-    """Parameters entries (dicts, files, Parameter) as typed name/value pairs, in order."""
+    """Parameters entries (dicts, files) as typed name/value pairs, in order.
+
+    A ``Parameter(...)`` description is refused as launch_ros 0.26.6 refuses it: its request
+    builder keeps the object unevaluated and fails on it ('invalid evaluated parameters'),
+    ending the launch; mlaunch says so before anything starts.
+    """
     key = node_name.lstrip("/")
     if namespace and namespace != "/":
         key = f"{namespace.strip('/')}/{key}"
@@ -175,8 +186,11 @@ def flatten(
                 current = section
             # else: launch_ros adds the entries before this file again (see the module text).
         elif isinstance(entry, Parameter):
-            name, value = entry.evaluate(context)
-            current = {name: value}
+            raise MlaunchError(
+                f"a ComposableNode's {field} cannot hold {entry}: launch_ros fails to load"
+                " the node ('invalid evaluated parameters') and ends the launch; give it as a"
+                f" dict instead, {field}=[{{name: value}}]"
+            )
         else:
             current = params.evaluate_dict(context, entry)
         for name, value in current.items():
