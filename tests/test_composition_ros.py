@@ -25,6 +25,8 @@ from test_standin_nodes import URDF, Proc, spawn, standin
 from mlaunch import frontends
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import (
+    BOOL,
+    INTEGER,
     STRING,
     LoadRequest,
     TypedParameter,
@@ -141,6 +143,82 @@ def test_the_standin_container_hosts_robot_state_publisher_and_refuses_unknown_p
     )
     names = list_nodes(driver.context, "/box")
     assert names == ["/robot_state_publisher"]
+
+
+def test_the_standin_container_reads_extra_arguments_as_jazzys_container(
+    spawn: Callable[..., Proc], loader: Any
+) -> None:
+    """use_intra_process_comms and forward_global_arguments must be booleans (rclcpp's
+    message otherwise), other names are ignored, and forward_global_arguments=true gives the
+    component the container's own remaps (here robot_description -> desc_fwd)."""
+    driver, lines = loader
+    spawn(
+        standin(
+            "container", "--ros-args", "-r", "__node:=xbox", "-r", "robot_description:=desc_fwd"
+        ),
+        "container",
+    )
+    urdf = (TypedParameter("robot_description", STRING, URDF),)
+    rsp = "robot_state_publisher::RobotStatePublisher"
+
+    def request(name: str, *extra: TypedParameter) -> LoadRequest:
+        return LoadRequest(
+            "robot_state_publisher", rsp, name, parameters=urdf, extra_arguments=extra
+        )
+
+    driver.start(
+        LoadComponents(
+            "t",
+            "/xbox",
+            (
+                request("bad", TypedParameter("use_intra_process_comms", STRING, "yes")),
+                request("worse", TypedParameter("forward_global_arguments", INTEGER, 1)),
+                request(
+                    "plain",
+                    TypedParameter("use_intra_process_comms", BOOL, True),
+                    TypedParameter("not_read_by_rclcpp", INTEGER, 3),
+                ),
+                request("fwd", TypedParameter("forward_global_arguments", BOOL, True)),
+            ),
+        )
+    )
+    assert driver.join(30.0), "the loads did not finish within 30 s"
+    bad, worse, plain, fwd = driver.results
+    assert (bad.success, bad.error_message) == (
+        False,
+        "Extra component argument 'use_intra_process_comms' must be a boolean",
+    )
+    assert (worse.success, worse.error_message) == (
+        False,
+        "Extra component argument 'forward_global_arguments' must be a boolean",
+    )
+    assert (
+        "ERROR",
+        f"Failed to load node 'bad' of type '{rsp}' in container '/xbox': Extra component"
+        " argument 'use_intra_process_comms' must be a boolean",
+    ) in lines
+    assert (plain.success, plain.full_node_name) == (True, "/plain")
+    assert (fwd.success, fwd.full_node_name) == (True, "/fwd")
+    from rclpy.node import Node
+
+    probe = Node("graph_probe", context=driver.context)
+    try:
+        topics: dict[str, set[str]] = {"fwd": set(), "plain": set()}
+
+        def published() -> bool:
+            for name in topics:
+                try:
+                    found = probe.get_publisher_names_and_types_by_node(name, "/")
+                except Exception:  # not discovered yet
+                    continue
+                topics[name] = {topic for topic, _ in found}
+            return "/desc_fwd" in topics["fwd"] and "/robot_description" in topics["plain"]
+
+        assert wait_until(published, 15), topics
+        assert "/desc_fwd" not in topics["plain"]
+        assert "/robot_description" not in topics["fwd"]
+    finally:
+        probe.destroy_node()
 
 
 def list_nodes(context: Any, container: str) -> list[str]:

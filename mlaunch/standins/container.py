@@ -5,7 +5,10 @@ Takes the place of ``component_container``, ``component_container_mt`` and
 launch names the container) serving ``~/_container/load_node``, ``~/_container/unload_node``
 and ``~/_container/list_nodes`` (composition_interfaces) as the real container does: a loaded
 component gets the request's name, namespace, remap rules and parameters, a unique id counting
-from 1 and its full name in the response. It hosts in-process the plugins mlaunch has stand-ins
+from 1 and its full name in the response. Extra arguments are read as Jazzy's container reads
+them: ``use_intra_process_comms`` and ``forward_global_arguments`` must be booleans (else the
+load fails with rclcpp's message), the latter gives the component the container's global
+arguments, and any other name is ignored. It hosts in-process the plugins mlaunch has stand-ins
 for (``PLUGINS``); any other plugin is refused with success=false and a one-line reason, as
 the real container refuses a plugin it cannot find.
 
@@ -50,6 +53,37 @@ def refusal(package: str, plugin: str) -> str:
     )
 
 
+# The extra arguments (LoadNode's extra_arguments) rclcpp_components' manager reads in Jazzy,
+# each a boolean; it ignores any other name. rclpy has no intra-process transport, so
+# use_intra_process_comms is checked and then has no effect here.
+EXTRA_ARGUMENTS = ("use_intra_process_comms", "forward_global_arguments")
+FORWARD_WARNING = (
+    "forward_global_arguments is true by default in nodes, but is not recommended in a"
+    " component manager: the component is then influenced by the container's global"
+    " arguments, not only those meant for it"
+)
+
+
+def forward_global_arguments(extra_arguments: Sequence[Any]) -> bool:
+    """Whether the component takes the container's global arguments (False unless asked).
+
+    Checks the extra arguments as the Jazzy container does: ``use_intra_process_comms`` and
+    ``forward_global_arguments`` must be booleans (a ValueError with its message otherwise),
+    other names are ignored; the last one given wins.
+    """
+    from rcl_interfaces.msg import ParameterType
+
+    forward = False
+    for argument in extra_arguments:
+        if argument.name not in EXTRA_ARGUMENTS:
+            continue
+        if argument.value.type != ParameterType.PARAMETER_BOOL:
+            raise ValueError(f"Extra component argument '{argument.name}' must be a boolean")
+        if argument.name == "forward_global_arguments":
+            forward = bool(argument.value.bool_value)
+    return forward
+
+
 class Container:
     """The component manager: loaded components by unique id, and the three services."""
 
@@ -73,7 +107,16 @@ class Container:
             return response
         default_name, start = entry
         try:
-            component = self._make_node(request, default_name)
+            forward = forward_global_arguments(request.extra_arguments)
+        except ValueError as exc:  # as rclcpp's ComponentManagerException: refused, said
+            response.success = False
+            response.error_message = str(exc)
+            self.node.get_logger().error(response.error_message)
+            return response
+        if forward:
+            self.node.get_logger().warning(FORWARD_WARNING)
+        try:
+            component = self._make_node(request, default_name, forward)
         except Exception as exc:  # rcl refuses bad names, remaps and parameter values
             response.success = False
             response.error_message = f"Component constructor threw an exception: {exc}"
@@ -98,20 +141,25 @@ class Container:
         response.unique_id = unique_id
         return response
 
-    def _make_node(self, request: Any, default_name: str) -> Node:
+    def _make_node(self, request: Any, default_name: str, forward: bool) -> Node:
         from rclpy.node import Node
         from rclpy.parameter import Parameter
 
+        # As rclcpp's manager: the name and namespace are local remaps after the request's
+        # rules, so they win over the container's own (forward_global_arguments).
         args = ["--ros-args"]
         for rule in request.remap_rules:
             args += ["-r", rule]
+        if request.node_name:
+            args += ["-r", f"__node:={request.node_name}"]
+        if request.node_namespace:
+            args += ["-r", f"__ns:={request.node_namespace}"]
         overrides = [Parameter.from_parameter_msg(p) for p in request.parameters]
         return Node(
-            request.node_name or default_name,
-            namespace=request.node_namespace or None,
+            default_name,
             context=self.node.context,
             cli_args=args,
-            use_global_arguments=False,
+            use_global_arguments=forward,
             parameter_overrides=overrides,
             automatically_declare_parameters_from_overrides=False,
         )
