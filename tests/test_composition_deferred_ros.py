@@ -283,3 +283,52 @@ def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
         "Abandoning wait for the '/nobody/_container/load_node' service, due to shutdown:"
         " node 'a' of type 'p::A' was never loaded"
     ) in h.text
+
+
+def test_a_launch_service_loads_components_of_a_description_included_while_running(
+    ros_env: dict[str, str],
+) -> None:
+    """launch.LaunchService (launch_testing and launch_pytest run on it) attaches the same
+    LoadNode driver, also for a load whose description is included after the run began."""
+    import threading
+
+    from test_launch_service import Screen
+
+    from mlaunch.launch.actions import ExecuteProcess, LaunchDescription
+    from mlaunch.launch.launch_service import LaunchService
+    from mlaunch.launch_ros.actions import LoadComposableNodes
+    from mlaunch.launch_ros.composable import ComposableNode
+
+    screen = Screen()
+    service = LaunchService(screen=screen)
+    recorder = ExecuteProcess(
+        cmd=[PY, RECORDER, "--ros-args", "-r", "__node:=rec"], name="rec", output="screen"
+    )
+    service.include_launch_description(LaunchDescription([recorder]))
+    seen: list[str] = []
+
+    def drive() -> None:
+        """From another thread, as a test runner does: include the load once rec is up."""
+        try:
+            if not screen.wait_for("recording container ready", 60):
+                return
+            seen.append("ready")
+            load = LoadComposableNodes(
+                target_container="/rec",
+                composable_node_descriptions=[
+                    ComposableNode(package="p", plugin="p::S", name="svc")
+                ],
+            )
+            service.include_launch_description(LaunchDescription([load]))
+            if screen.wait_for("Loaded node '/svc' in container '/rec'", 60):
+                seen.append("loaded")
+        finally:
+            service.shutdown()
+
+    thread = threading.Thread(target=drive, daemon=True)
+    thread.start()
+    code = service.run()  # the main thread, as launch requires
+    thread.join(30)
+    assert seen == ["ready", "loaded"], screen.data.decode()
+    assert code == 0, screen.data.decode()
+    assert not [t for t in threading.enumerate() if t.name.startswith("load ")]

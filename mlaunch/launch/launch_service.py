@@ -193,6 +193,7 @@ class LaunchService:
         from mlaunch.run.lifeline import private_temp_dir, remove_private_dir
         from mlaunch.run.logfiles import make_run_log_dir
         from mlaunch.run.output import Printer, stdout_is_color_terminal
+        from mlaunch.run.pipeline import components_part
         from mlaunch.run.resolve import LabelCounter, ResolveOptions
         from mlaunch.run.supervisor import Supervisor
 
@@ -235,7 +236,14 @@ class LaunchService:
                 self._supervisor = supervisor
             if self._calls:
                 self._wake()
-            code = supervisor.run()
+            # Composable nodes are loaded by the same part as in ``mlaunch FILE``.
+            components = components_part(plan, supervisor)
+            try:
+                code = supervisor.run()
+            finally:
+                close = getattr(components, "close", None)
+                if close is not None:
+                    close()
             if self._error and code == 0:
                 code = 1
             return code

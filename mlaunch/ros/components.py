@@ -307,8 +307,3 @@ class ComponentDriver:
         self.supervisor.events.unsubscribe(self.on_event)
         self.loader.context.try_shutdown()
         self.loop.close()
-
-
-def attach(options: Any, supervisor: Supervisor) -> ComponentDriver:
-    """The pipeline's components part, for a plan that loads composable nodes (Plan.needs)."""
-    return ComponentDriver(supervisor)

@@ -327,18 +327,23 @@ class _LifecycleWatch:
 
 
 def components(run: Run) -> object:
-    """Composable node loading: at once when the plan needs it, else on demand.
+    """Composable node loading (``components_part``)."""
+    return components_part(run.plan, run.supervisor)
+
+
+def components_part(plan: Plan, supervisor: Supervisor) -> object:
+    """The LoadNode driver: at once when the plan needs it, else on demand.
 
     Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
     LoadComposableNodes in timers and handlers not yet fired; a handler written as a function
-    can still make one, so without that need a watch attaches the LoadNode driver at the first
-    LoadComponents the supervisor hands over.
+    (or a description a LaunchService includes later) can still make one, so without that need
+    a watch attaches the driver at the first LoadComponents the supervisor hands over.
     """
-    if "components" in run.plan.needs:
-        from mlaunch.ros.components import attach
+    if "components" in plan.needs:
+        from mlaunch.ros.components import ComponentDriver
 
-        return attach(run.opts, run.supervisor)
-    return _ComponentsWatch(run)
+        return ComponentDriver(supervisor)
+    return _ComponentsWatch(supervisor)
 
 
 class _ComponentsWatch:
@@ -348,22 +353,22 @@ class _ComponentsWatch:
     the new driver, which sees every later record itself.
     """
 
-    def __init__(self, run: Run) -> None:
-        self.run = run
+    def __init__(self, supervisor: Supervisor) -> None:
+        self.supervisor = supervisor
         self.driver: Any = None
-        run.supervisor.events.subscribe(self._on_event)
+        supervisor.events.subscribe(self._on_event)
 
     def _on_event(self, event: Event) -> None:
         if not isinstance(event, HandedOff) or "components" not in event.step.needs:
             return
-        from mlaunch.ros.components import attach
+        from mlaunch.ros.components import ComponentDriver
 
-        self.run.supervisor.events.unsubscribe(self._on_event)
-        self.driver = attach(self.run.opts, self.run.supervisor)
+        self.supervisor.events.unsubscribe(self._on_event)
+        self.driver = ComponentDriver(self.supervisor)
         self.driver.on_event(event)
 
     def close(self) -> None:
-        self.run.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.events.unsubscribe(self._on_event)
         if self.driver is not None:
             self.driver.close()
 
