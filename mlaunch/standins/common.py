@@ -25,6 +25,18 @@ class StopFlag:
         self.requested = True
 
 
+def latched(depth: int = 1) -> Any:
+    """The QoS of a latched topic: reliable and transient local, so late joiners get the last
+    ``depth`` messages (rclpy imported here)."""
+    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+    return QoSProfile(
+        depth=depth,
+        reliability=ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL,
+    )
+
+
 def install_stop_flag() -> StopFlag:
     stop = StopFlag()
     signal.signal(signal.SIGINT, stop)

@@ -6,6 +6,7 @@ Run as ``python -m mlaunch.standins.sim ARGS...`` with the arguments ``gazebo``,
 diff-drive plugin's cmd_vel topic and publishes odometry, joint states, laser scans and IMU data
 on the topics their ``<gazebo>`` plugin blocks name.
 
+The world's shapes are published for the viewer on ``/mlaunch_sim/world`` (world_topic.py).
 Spawn protocol (both topics reliable + transient_local, depth 10, std_msgs/String of JSON):
 ``/mlaunch_sim/spawn`` takes ``{"name", "x", "y", "z", "roll", "pitch", "yaw", "urdf"}`` plus
 optional ``"id"``, ``"robot_namespace"`` and ``"allow_renaming"``; ``/mlaunch_sim/spawned``
@@ -28,7 +29,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from mlaunch.errors import StandinError
-from mlaunch.standins.common import StopFlag, install_stop_flag
+from mlaunch.standins.common import StopFlag, install_stop_flag, latched
 from mlaunch.standins.diffdrive import Pose2D, describe_model
 from mlaunch.standins.plugins import ModelError
 from mlaunch.standins.sim_topics import (
@@ -44,6 +45,7 @@ from mlaunch.standins.sim_topics import (
 from mlaunch.standins.simulation import STEP_NS, Schedule, Simulation
 from mlaunch.standins.spawn_request import SpawnRequest, free_name, parse_spawn_request
 from mlaunch.standins.world import RESOURCE_PATH_VARS, World, WorldError, load_world
+from mlaunch.standins.world_topic import WORLD_TOPIC, world_message
 
 SPAWN_TOPIC = "/mlaunch_sim/spawn"
 SPAWNED_TOPIC = "/mlaunch_sim/spawned"
@@ -379,27 +381,31 @@ class RosBridge:
     """Publishers, subscriptions and reused messages around one Simulation."""
 
     def __init__(self, node: Any, sim: Simulation, clock_rate: float):
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
         from rosgraph_msgs.msg import Clock
         from std_msgs.msg import String
 
         self.node = node
         self.sim = sim
         self.sensor_qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
-        latched = QoSProfile(
-            depth=10,
-            reliability=ReliabilityPolicy.RELIABLE,
-            durability=DurabilityPolicy.TRANSIENT_LOCAL,
-        )
+        latched_10 = latched(10)
         self.clock_msg = Clock()
         self.clock_pub = make_publisher(node, Clock, "/clock", self.sensor_qos)
         self.clock_schedule = Schedule.every(clock_rate, 0)
         self.String = String
-        self.spawned_pub = make_publisher(node, String, SPAWNED_TOPIC, latched)
-        make_subscription(node, String, SPAWN_TOPIC, self.on_spawn, latched)
+        self.spawned_pub = make_publisher(node, String, SPAWNED_TOPIC, latched_10)
+        make_subscription(node, String, SPAWN_TOPIC, self.on_spawn, latched_10)
         self.outputs: list[Output] = []
         self.answered: dict[str, str] = {}  # request id -> reply
         self.tf = tf_support()
+        # The world for the viewer: latched, and only the newest one matters.
+        self.world_pub = make_publisher(node, String, WORLD_TOPIC, latched())
+        self.publish_world()
+
+    def publish_world(self) -> None:
+        """The world's shapes and where the robots' odometry frames start in it, for the viewer."""
+        text = world_message(self.sim.world, self.sim.robots.values())
+        self.world_pub.publish(self.String(data=text))
 
     # -- spawning
 
@@ -448,6 +454,7 @@ class RosBridge:
         x, y, z, roll, pitch, yaw = request.pose
         sim_robot = self.sim.add_robot(spec, Pose2D(x, y, yaw))
         self.outputs.extend(make_outputs(self.node, self.sim, sim_robot, self.sensor_qos, self.tf))
+        self.publish_world()
         say(f"spawned {spec.summary()} at x={x:g} y={y:g} z={z:g} yaw={yaw:g}")
         if roll or pitch:
             warn(

@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, NoReturn
 
 from mlaunch.errors import StandinError
-from mlaunch.standins.common import StopFlag, install_stop_flag
+from mlaunch.standins.common import StopFlag, install_stop_flag, latched
 from mlaunch.standins.sim import SPAWN_TOPIC, SPAWNED_TOPIC
 
 DEFAULT_TIMEOUT = 30.0  # spawn_entity.py's -timeout default
@@ -351,23 +351,13 @@ class _Waiter:
         return True
 
 
-def _latched() -> Any:
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-
-    return QoSProfile(
-        depth=10,
-        reliability=ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL,
-    )
-
-
 def _model_from_topic(node: Any, waiter: _Waiter, options: SpawnOptions) -> str:
     """The first message on -topic (robot_state_publisher latches robot_description)."""
     from std_msgs.msg import String
 
     received: list[str] = []
     sub = node.create_subscription(
-        String, options.value, lambda msg: received.append(msg.data), _latched()
+        String, options.value, lambda msg: received.append(msg.data), latched(10)
     )
     topic = sub.topic_name
     if not waiter.until(lambda: bool(received), options.timeout):
@@ -400,8 +390,8 @@ def _hand_over(node: Any, waiter: _Waiter, options: SpawnOptions, xml: str) -> s
         if isinstance(reply, dict) and reply.get("id") == request_id:
             replies.append(reply)
 
-    node.create_subscription(String, SPAWNED_TOPIC, on_reply, _latched())
-    publisher = node.create_publisher(String, SPAWN_TOPIC, _latched())
+    node.create_subscription(String, SPAWNED_TOPIC, on_reply, latched(10))
+    publisher = node.create_publisher(String, SPAWN_TOPIC, latched(10))
     publisher.publish(String(data=spawn_request(options, xml, request_id, node.get_namespace())))
     timeout = options.sim_timeout if options.sim_timeout is not None else options.timeout
     if not waiter.until(lambda: bool(replies), timeout):

@@ -1,16 +1,16 @@
 """Stand-in for rviz2: ``python -m mlaunch.standins.viewer [-d CONFIG] [-f FRAME] [ROS args]``.
 
 There is no RViz here, so this node serves a small web page on 127.0.0.1 that draws, top-down,
-the robot outline from ``robot_description`` at its odometry pose, the odometry trail and the
-laser scan (placed through /tf and /tf_static when they are published), and shows the depth image
-of an Image display. It takes rviz2's command line and reads the fixed frame and the topics from a
+the simulator's world (its walls and obstacles, world_topic.py), the robot outline from
+``robot_description`` at its odometry pose, the odometry trail and the laser scan (placed
+through /tf and /tf_static when they are published), and shows the depth image of an Image
+display. It takes rviz2's command line and reads the fixed frame and the topics from a
 display config (viewer_config.py). Only the standard library serves the page (http.server
 in a thread); rclpy is imported inside main() only.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import sys
@@ -19,14 +19,11 @@ import time
 from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.standins.common import init_ros, spin
+from mlaunch.standins.common import init_ros, latched, spin
 from mlaunch.standins.urdf import Circle, Robot, UrdfError, parse_urdf
 from mlaunch.standins.viewer_config import (
-    PORT_ENV,
     DisplayConfig,
     ViewerError,
     parse_args,
@@ -34,7 +31,10 @@ from mlaunch.standins.viewer_config import (
     viewer_port,
 )
 from mlaunch.standins.viewer_config import config_from_data as config_from_data
+from mlaunch.standins.viewer_http import PageServer as PageServer
+from mlaunch.standins.viewer_http import serve
 from mlaunch.standins.viewer_tf import DepthPicture, PlanarTf, compose, invert, planar, yaw_of
+from mlaunch.standins.world_topic import WORLD_TOPIC, WorldPicture
 
 if TYPE_CHECKING:
     from nav_msgs.msg import Odometry
@@ -43,7 +43,6 @@ if TYPE_CHECKING:
     from std_msgs.msg import String
 
 NODE_NAME = "rviz"
-PAGE = Path(__file__).with_name("viewer.html")
 EXIT_OK = 0
 EXIT_FAILURE = 1
 TRAIL_MAX = 5000
@@ -94,6 +93,7 @@ class ViewerState:
     tf: PlanarTf = field(default_factory=PlanarTf)
     last_poll: float = -math.inf
     depth: DepthPicture = field(default_factory=DepthPicture)
+    world: WorldPicture = field(default_factory=WorldPicture)
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def __post_init__(self) -> None:
@@ -102,6 +102,7 @@ class ViewerState:
             ("odom", self.config.odom_topic),
             ("scan", self.config.scan_topic),
             ("tf", "/tf"),
+            ("world", WORLD_TOPIC),
             *((("depth", self.config.depth_topic),) if self.config.depth_topic else ()),
         ):
             self.stats[key] = TopicStats(topic)
@@ -121,6 +122,12 @@ class ViewerState:
         with self.lock:
             self.robot, self.robot_error = robot, error
             self._seen("description", now)
+
+    def set_world(self, text: str, now: float) -> None:
+        """The simulator's world (world_topic.py); a malformed one is shown on the page."""
+        with self.lock:
+            self.world.set(text)
+            self._seen("world", now)
 
     def set_odom(self, frame: str, child: str, pose: Pose2D, now: float) -> None:
         """The robot's pose in the odometry frame; extends the trail when it moved."""
@@ -271,7 +278,13 @@ class ViewerState:
                     "encoding": self.depth.encoding,
                 },
                 "frames": self.tf.frames(),
-                "warnings": [*self.config.warnings, *self.warnings.values()],
+                # The walls under the robot, in the frame everything else here is in.
+                "world": self.world.in_frame(self.odom_frame or fixed),
+                "warnings": [
+                    *self.config.warnings,
+                    *self.warnings.values(),
+                    *((self.world.error,) if self.world.error else ()),
+                ],
             }
 
 
@@ -280,100 +293,17 @@ def _moved(transform: Pose2D, point: tuple[float, float]) -> list[float]:
     return [round(x, 5), round(y, 5)]
 
 
-# ---------------------------------------------------------------- HTTP
-
-
-def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRequestHandler]:
-    """A request handler class serving the page and its JSON for this ``state``."""
-
-    class Handler(BaseHTTPRequestHandler):
-        def do_GET(self) -> None:
-            path = self.path.split("?", 1)[0]
-            if path in ("/", "/index.html"):
-                self._send(200, "text/html; charset=utf-8", page)
-            elif path == "/state.json":
-                state.note_poll(clock())
-                body = json.dumps(state.snapshot(clock()), separators=(",", ":")).encode()
-                self._send(200, "application/json", body)
-            elif path == "/depth.png" and (png := state.depth_png()) is not None:
-                self._send(200, "image/png", png)
-            else:
-                self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
-
-        def _send(self, status: int, kind: str, body: bytes) -> None:
-            self.send_response(status)
-            self.send_header("Content-Type", kind)
-            self.send_header("Content-Length", str(len(body)))
-            self.send_header("Cache-Control", "no-store")
-            self.end_headers()
-            self.wfile.write(body)
-
-        def log_message(self, format: str, *args: Any) -> None:
-            pass  # a poll every 100 ms would flood the launch output
-
-    return Handler
-
-
-# A browser that goes away mid-request (a reload, a cancelled poll, a closed tab) is routine.
-BROWSER_GONE = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError, TimeoutError)
-
-
-class PageServer(ThreadingHTTPServer):
-    """The page's HTTP server: a browser that resets its connection is not an error.
-
-    socketserver prints a 20-line traceback into the launch output for every failed request;
-    here a reset is counted (``gone``) and anything else is one line on stderr, written in one
-    call so that concurrent requests do not interleave.
-    """
-
-    daemon_threads = True
-    gone = 0
-
-    def handle_error(self, request: Any, client_address: Any) -> None:
-        error = sys.exc_info()[1]
-        if isinstance(error, BROWSER_GONE):
-            self.gone += 1
-            return
-        try:
-            where = f"{client_address[0]}:{client_address[1]}"
-        except (TypeError, IndexError):
-            where = str(client_address)
-        line = f"viewer: a request from {where} failed: {type(error).__name__}: {error}\n"
-        try:
-            os.write(2, line.encode("utf-8", "replace"))
-        except OSError:
-            pass
-
-
-def serve(state: ViewerState, port: int, clock: Any) -> PageServer:
-    """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
-    page = PAGE.read_bytes()
-    try:
-        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock))
-    except OSError as exc:
-        raise ViewerError(
-            f"cannot listen on 127.0.0.1:{port}: {exc.strerror}; valid: a free port, or 0 for"
-            f" any free port (mlaunch --viewer-port, or {PORT_ENV})"
-        ) from None
-    threading.Thread(target=server.serve_forever, name="viewer-http", daemon=True).start()
-    return server
-
-
 # ---------------------------------------------------------------- ROS
 
 
 def subscribe(node: Node, state: ViewerState) -> None:
     """Subscribe to the robot description, odometry and scan with the QoS their publishers use."""
     from nav_msgs.msg import Odometry
-    from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy, qos_profile_sensor_data
+    from rclpy.qos import qos_profile_sensor_data
     from sensor_msgs.msg import LaserScan
     from std_msgs.msg import String
 
-    latched = QoSProfile(
-        depth=1,
-        reliability=ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL,
-    )
+    latest = latched()
 
     def on_description(msg: String) -> None:
         state.set_description(msg.data, time.monotonic())
@@ -394,12 +324,16 @@ def subscribe(node: Node, state: ViewerState) -> None:
             time.monotonic(),
         )
 
+    def on_world(msg: String) -> None:
+        state.set_world(msg.data, time.monotonic())
+
     config = state.config
-    node.create_subscription(String, config.description_topic, on_description, latched)
+    node.create_subscription(String, config.description_topic, on_description, latest)
+    node.create_subscription(String, WORLD_TOPIC, on_world, latest)
     # Best effort hears both best-effort (simulated sensors) and reliable publishers.
     node.create_subscription(Odometry, config.odom_topic, on_odom, qos_profile_sensor_data)
     node.create_subscription(LaserScan, config.scan_topic, on_scan, qos_profile_sensor_data)
-    subscribe_tf_and_depth(node, state, latched, qos_profile_sensor_data)
+    subscribe_tf_and_depth(node, state, latest, qos_profile_sensor_data)
 
 
 def subscribe_tf_and_depth(node: Node, state: ViewerState, latched: Any, sensor: Any) -> None:
