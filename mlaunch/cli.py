@@ -85,6 +85,10 @@ def program() -> None:
     from mlaunch.run.lifeline import ensure_std_streams
 
     ensure_std_streams()  # a closed stdout (mlaunch FILE >&-) must not lend its number to a file
+    if "_ARGCOMPLETE" in os.environ:  # the shell asks for completions: answered, then exit
+        from mlaunch.completion import complete
+
+        complete()
     try:
         code = main()
     except SystemExit as e:  # argparse's usage errors and --help

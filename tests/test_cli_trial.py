@@ -17,7 +17,7 @@ from conftest import requires_rclpy
 from procutil import Running, clean_env, demo_package, mlaunch, run_mlaunch
 
 from mlaunch import __version__
-from mlaunch.options import VIEWER_PORT_ENV
+from mlaunch.options import VIEWER_PORT_ENV, build_parser
 from mlaunch.run import describe, status
 from mlaunch.run.events import Output, Started
 from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
@@ -253,3 +253,24 @@ def test_quiet_launch_shows_the_viewer_address_on_the_chosen_port(
         run.kill()
     assert run.text.count("viewer: open") == 1, run.text
     assert "process started" not in run.text  # still quiet
+
+
+def test_readme_exit_status_table_is_the_codes() -> None:
+    """Every status of mlaunch.errors' table is a row of the README's, and nothing else is."""
+    from conftest import REPO
+
+    from mlaunch import errors
+
+    readme = (REPO / "README.md").read_text()
+    section = readme[readme.index("### Exit status") :]
+    rows = re.findall(r"^\| ([0-9+N]+) \| (.+) \|$", section.split("\n\n", 2)[1], re.M)
+    statuses = [status for status, _ in rows]
+    codes = [errors.EXIT_OK, errors.EXIT_FAILURE, errors.EXIT_USAGE, errors.EXIT_INTERNAL]
+    assert statuses == [*map(str, codes), f"{errors.SIGNAL_BASE}+N"]
+    meaning = dict(rows)
+    assert "130 for Ctrl-C" in meaning["128+N"]
+    assert errors.exit_for_signal(signal.SIGINT) == 130 == errors.EXIT_INTERRUPTED
+    # The same statuses in mlaunch --help's epilog.
+    epilog = build_parser().epilog or ""
+    for code in (*codes, 130):
+        assert re.search(rf"\b{code}\b", epilog), (code, epilog)

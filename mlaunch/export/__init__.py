@@ -26,6 +26,11 @@ USAGE = "mlaunch export FILE [name:=value ...] --to systemd DIR [--name NAME] [-
 
 def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
     """(export settings, the rest: the launch target, its arguments and mlaunch's options)."""
+    return build_parser().parse_known_args(args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """``mlaunch export``'s own options (the rest are mlaunch FILE's)."""
     parser = argparse.ArgumentParser(prog="mlaunch export", usage=USAGE, add_help=True)
     parser.add_argument(
         "--to",
@@ -41,7 +46,7 @@ def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
         help="where DIR will be on the robot (the units name their files there; default: DIR)",
     )
     parser.add_argument("--force", action="store_true", help="write into a non-empty DIR")
-    return parser.parse_known_args(args)
+    return parser
 
 
 def main(args: Sequence[str]) -> int:
