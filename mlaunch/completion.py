@@ -46,12 +46,14 @@ def complete() -> None:
 
 
 def _words() -> list[str]:
-    """The words of the command line before the one being completed."""
+    """The words of the command line before the one being completed, from ``mlaunch`` on."""
     from argcomplete import split_line
 
     line = os.environ.get("COMP_LINE", "")
     point = int(os.environ.get("COMP_POINT", len(line)))
-    return list(split_line(line, point)[3])
+    # _ARGCOMPLETE is where mlaunch's words start: 1 for mlaunch, 3 for python -m mlaunch.
+    start = int(os.environ.get("_ARGCOMPLETE", "1")) - 1
+    return list(split_line(line, point)[3])[start:]
 
 
 def parser_for(words: list[str]) -> argparse.ArgumentParser:

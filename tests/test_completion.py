@@ -66,12 +66,15 @@ def workspace(tmp_path: Path) -> tuple[Path, dict[str, str]]:
     return here, env
 
 
-def complete(line: str, cwd: Path, env: dict[str, str], tmp_path: Path) -> list[str]:
-    """What ``mlaunch`` offers bash for ``line`` with the cursor at its end."""
+def complete(
+    line: str, cwd: Path, env: dict[str, str], tmp_path: Path, start: int = 1
+) -> list[str]:
+    """What ``mlaunch`` offers bash for ``line`` with the cursor at its end (``start``: the
+    word mlaunch's own begin at, 3 for ``python -m mlaunch``)."""
     out = tmp_path / "completions"
     env = {
         **env,
-        "_ARGCOMPLETE": "1",
+        "_ARGCOMPLETE": str(start),
         "_ARGCOMPLETE_SUPPRESS_SPACE": "1",
         "_ARGCOMPLETE_COMP_WORDBREAKS": BASH_WORDBREAKS,
         "_ARGCOMPLETE_STDOUT_FILENAME": str(out),
@@ -151,6 +154,8 @@ def test_subcommands_and_options(workspace: tuple[Path, dict[str, str]], tmp_pat
     assert complete("mlaunch convert o", here, env, tmp_path) == ["old.launch"]
     assert complete("mlaunch ctl re", here, env, tmp_path) == ["restart"]
     assert complete("mlaunch ctl stop ", here, env, tmp_path) == []
+    line = "python3 -m mlaunch test dev.launch.py --expect-t"
+    assert complete(line, here, env, tmp_path, start=3) == ["--expect-topic"]
 
 
 def test_a_broken_launch_file_completes_nothing(
