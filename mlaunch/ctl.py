@@ -125,12 +125,18 @@ def command(args: Sequence[str]) -> int:
         request["label"] = label
     if op == "logs":
         request["lines"] = ns.lines
-    target = find_run(run, os.environ)
-    answer = ask(target, request)
-    expected_id = _run_id(run)
-    about = answer.get("run")
-    if expected_id and (not isinstance(about, dict) or about.get("run_id") != expected_id):
-        raise CtlError(f"the run in {target.folder} is not run {expected_id}", EXIT_USAGE)
+    try:
+        target = find_run(run, os.environ)
+        answer = ask(target, request)
+        expected_id = _run_id(run)
+        about = answer.get("run")
+        if expected_id and (not isinstance(about, dict) or about.get("run_id") != expected_id):
+            raise CtlError(f"the run in {target.folder} is not run {expected_id}", EXIT_USAGE)
+    except CtlError as e:
+        if ns.json:  # machine output for every failure, not only the run's answers
+            failed = {"ok": False, "error": str(e), "status": e.exit_code}
+            sys.stdout.write(json.dumps(failed, indent=2) + "\n")
+        raise
     if ns.json:
         sys.stdout.write(json.dumps(answer, indent=2) + "\n")
     if not answer.get("ok"):

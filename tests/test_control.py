@@ -284,6 +284,13 @@ def test_bad_requests_are_clear_errors_and_change_nothing() -> None:
     assert h.sup.records["talker"].restarts == 0
 
 
+def test_an_unknown_label_lists_at_most_twenty() -> None:
+    labels = [f"node{i:03d}-{i}" for i in range(250)]
+    text = str(UnknownLabel("node000-x", labels))
+    assert "did you mean 'node000-0'" in text
+    assert text.endswith("node019-19 and 230 more (mlaunch ctl list shows them))")
+
+
 def test_list_shows_every_label() -> None:
     h = Harness([make_spec("a", sleeper("a")), make_spec("b", "print('ready')")])
     rows: list[dict[str, object]] = []

@@ -187,6 +187,10 @@ def test_no_run_and_a_stale_socket(tmp_path: Path) -> None:
     env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
     done = run_mlaunch("ctl", "list", env=env, timeout=30)
     assert done.returncode == 1 and "no running launch under" in done.stderr
+    done = run_mlaunch("ctl", "list", "--json", env=env, timeout=30)
+    answer = json.loads(done.stdout)
+    assert done.returncode == 1 and answer["ok"] is False and answer["status"] == 1
+    assert answer["error"].startswith("no running launch under")
 
     # A run killed with its guard: the socket file is left, nobody accepts on it.
     folder = tmp_path / "logs" / "2026-01-01-00-00-00-000000-host-4242"

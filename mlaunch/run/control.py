@@ -52,6 +52,8 @@ if TYPE_CHECKING:
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
 OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs")
 DEFAULT_LINES = 20
+# Labels an unknown-label error lists (a launch may have hundreds).
+LISTED = 20
 
 
 class ControlError(MlaunchError):
@@ -76,7 +78,10 @@ class UnknownLabel(ControlError):
         self.labels = labels
         self.close = difflib.get_close_matches(label, labels, n=3, cutoff=0.5)
         hint = f"; did you mean {' or '.join(repr(c) for c in self.close)}?" if self.close else ""
-        super().__init__(f"no process {label!r} in this run{hint} (processes: {', '.join(labels)})")
+        shown = ", ".join(labels[:LISTED])
+        if len(labels) > LISTED:
+            shown += f" and {len(labels) - LISTED} more (mlaunch ctl list shows them)"
+        super().__init__(f"no process {label!r} in this run{hint} (processes: {shown})")
 
 
 class AmbiguousLabel(ControlError):
