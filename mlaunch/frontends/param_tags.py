@@ -170,14 +170,15 @@ def _uniform_list(p: Entity, attr: Attr, items: list[Any]) -> list[Any]:
 
 
 def _guess(text: str) -> Any:
-    """ROS 2's type guess for an untyped value: YAML int, float, bool or uniform list, else str."""
+    """ROS 2's type guess for an untyped value: YAML int, float, bool, str or uniform list, else
+    the text as written. YAML's own reading of a string counts: ``'7'`` is the text 7."""
     import yaml
 
     try:
         value = yaml.safe_load(text)
     except yaml.YAMLError:
         return text
-    if isinstance(value, (bool, int, float)):
+    if isinstance(value, (bool, int, float, str)):
         return value
     if isinstance(value, list) and value and _uniform(value):
         return value
