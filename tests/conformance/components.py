@@ -216,14 +216,8 @@ def summarize(loads: list[str], text: str) -> dict[str, Any]:
 
 
 def expected(name: str) -> dict[str, Any] | None:
-    path = EXPECTED / f"{name}.json"
-    if not path.exists():
-        return None
-    result: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
-    return result
+    return harness.expected(name, EXPECTED)
 
 
 def write_expected(name: str, summary: dict[str, Any]) -> None:
-    EXPECTED.mkdir(exist_ok=True)
-    text = json.dumps(summary, indent=1, sort_keys=True) + "\n"
-    (EXPECTED / f"{name}.json").write_text(text, encoding="utf-8")
+    harness.write_expected(name, summary, EXPECTED)

@@ -269,15 +269,28 @@ def summarize(
     }
 
 
-def expected(name: str) -> dict[str, Any] | None:
-    path = EXPECTED / f"{name}.json"
+def expected(name: str, folder: Path = EXPECTED) -> dict[str, Any] | None:
+    """The recording of case ``name`` in ``folder``, None when there is none."""
+    path = folder / f"{name}.json"
     if not path.exists():
         return None
     result: dict[str, Any] = json.loads(path.read_text(encoding="utf-8"))
     return result
 
 
-def write_expected(name: str, summary: dict[str, Any]) -> None:
-    EXPECTED.mkdir(exist_ok=True)
+def write_expected(name: str, summary: dict[str, Any], folder: Path = EXPECTED) -> None:
+    folder.mkdir(exist_ok=True)
     text = json.dumps(summary, indent=1, sort_keys=True) + "\n"
-    (EXPECTED / f"{name}.json").write_text(text, encoding="utf-8")
+    (folder / f"{name}.json").write_text(text, encoding="utf-8")
+
+
+def with_known_differences(names: list[str], known: dict[str, str]) -> list[Any]:
+    """Cases as pytest parameters, each known difference a strict xfail with its reason."""
+    import pytest
+
+    return [
+        pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=known[name]))
+        if name in known
+        else name
+        for name in names
+    ]

@@ -37,12 +37,7 @@ pytestmark = [requires_rclpy, requires_composition_interfaces, pytest.mark.timeo
 
 
 def _cases() -> list[Any]:
-    return [
-        pytest.param(case, marks=pytest.mark.xfail(strict=True, reason=KNOWN_DIFFERENCES[case]))
-        if case in KNOWN_DIFFERENCES
-        else case
-        for case in components.case_names()
-    ]
+    return harness.with_known_differences(components.case_names(), KNOWN_DIFFERENCES)
 
 
 def _diff(expected: dict[str, Any], actual: dict[str, Any]) -> str:

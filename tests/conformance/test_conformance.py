@@ -31,12 +31,7 @@ requires_reference = pytest.mark.skipif(
 
 
 def _cases() -> list[Any]:
-    return [
-        pytest.param(case, marks=pytest.mark.xfail(strict=True, reason=KNOWN_DIFFERENCES[case]))
-        if case in KNOWN_DIFFERENCES
-        else case
-        for case in harness.case_names()
-    ]
+    return harness.with_known_differences(harness.case_names(), KNOWN_DIFFERENCES)
 
 
 def _diff(expected: dict[str, Any], actual: dict[str, Any]) -> str:
