@@ -389,12 +389,46 @@ def test_format_json_needs_print(env: dict[str, str]) -> None:
     assert "process started" not in done.stdout
 
 
-def test_mlaunch_test_print_gives_the_same_plan(env: dict[str, str]) -> None:
+def test_mlaunch_test_print_adds_what_it_would_check(env: dict[str, str]) -> None:
     path = str(LAUNCHES / "examples" / "scoping.launch.py")
-    plain = run_mlaunch(path, "--print", "--format", "json", env=env)
-    smoke = run_mlaunch("test", path, "--print", "--format", "json", env=env)
-    assert smoke.returncode == 0, smoke.stderr
-    assert json.loads(smoke.stdout) == json.loads(plain.stdout)
+    plain = plan_of(path, env=env)
+    assert plain["test"] is None
+    done = run_mlaunch(
+        "test",
+        path,
+        "--print",
+        "--format",
+        "json",
+        "--expect-topic",
+        "/x:5",
+        "--hold",
+        "1",
+        env=env,
+    )
+    assert done.returncode == 0, done.stderr
+    smoke = json.loads(done.stdout)
+    validate(smoke)
+    test = smoke.pop("test")
+    assert {**smoke, "test": None} == plain  # the same plan as mlaunch FILE's
+    assert test["hold"] == 1.0 and test["allow_exit"] == []
+    checks = [(e["check"], e["target"], e["source"]) for e in test["expectations"]]
+    assert checks == [
+        ("process", "reporter-1", "default"),
+        ("process", "simulator-2", "default"),
+        ("topic", "/x", "--expect-topic '/x:5'"),
+        ("shutdown", "", "default"),
+    ]
+    assert test["expectations"][2]["rate"] == 5.0
+    # Nothing ran: no log folder, no report.
+    assert not Path(env["ROS_LOG_DIR"]).exists()
+
+
+def test_mlaunch_test_print_text_is_unchanged(env: dict[str, str]) -> None:
+    path = str(LAUNCHES / "examples" / "scoping.launch.py")
+    smoke = run_mlaunch("test", path, "--print", env=env)
+    plain = run_mlaunch(path, "--print", env=env)
+    temp = re.compile(r"/tmp/mlaunch-[^/ ]+/")
+    assert smoke.returncode == 0 and temp.sub("", smoke.stdout) == temp.sub("", plain.stdout)
 
 
 MORE = """

@@ -53,14 +53,19 @@ _ROS_VALUE_OPTIONS = frozenset(
 _SPECIAL_REMAPS = ("__node:=", "__ns:=")
 
 
-def plan_json(plan: Plan, path: str, given: Mapping[str, str]) -> str:
+def plan_json(
+    plan: Plan, path: str, given: Mapping[str, str], test: dict[str, Any] | None = None
+) -> str:
     """The plan document as JSON text (two-space indent, one trailing newline)."""
-    document = plan_document(plan, path, given)
+    document = plan_document(plan, path, given, test)
     return json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
 
 
-def plan_document(plan: Plan, path: str, given: Mapping[str, str]) -> dict[str, Any]:
-    """The plan as plain data: ``given`` is the command line's ``name:=value`` arguments."""
+def plan_document(
+    plan: Plan, path: str, given: Mapping[str, str], test: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """The plan as plain data: ``given`` is the command line's ``name:=value`` arguments,
+    ``test`` what ``mlaunch test`` would check (mlaunch.smoke), None for ``mlaunch FILE``."""
     from mlaunch.run.resolve import BUILTIN_CONFIGURATIONS  # --launch-prefix's, not the file's
 
     writer = _Writer(plan.temp_dir)
@@ -76,6 +81,7 @@ def plan_document(plan: Plan, path: str, given: Mapping[str, str]) -> dict[str, 
         "undeclared_arguments": undeclared,
         "warnings": list(plan.warnings),
         "steps": [writer.step(step) for step in plan.steps],
+        "test": test,
     }
 
 

@@ -22,6 +22,7 @@ from mlaunch.smoke.expectations import (
     ExpectStep,
     _CollectConfigurations,
     _true,
+    expectation_data,
     parse_spec,
     parse_target,
 )
@@ -64,6 +65,8 @@ def command(args: Sequence[str]) -> int:
         return int(e.code or 0)
     if opts is None:
         raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
+    if opts.print_plan and opts.format == "json":
+        return print_plan(opts, settings)
     if opts.show_args or opts.print_plan:
         return pipeline.launch(opts, pipeline.standard_parts(opts))
     return run(opts, settings)
@@ -74,27 +77,54 @@ def command(args: Sequence[str]) -> int:
 
 def run(opts: Any, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
-    from mlaunch.launch.actions import LaunchDescription
-    from mlaunch.run import pipeline
     from mlaunch.run.lifeline import Lifeline
     from mlaunch.run.logfiles import make_run_log_dir
 
     with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
-        path, description = pipeline.load_target(opts)
-        collector = _CollectConfigurations()
         log_dir = make_run_log_dir(os.environ)
-        plan, options, labels = pipeline.resolve_for_run(
-            opts,
-            path,
-            LaunchDescription([description, collector]),
-            temp_dir=life.temp_dir,
-            log_dir=log_dir,
-        )
-        # use_sim_time:=true is an ordinary launch argument; a file that declares it is
-        # expected to run on simulated time, as --use-sim-time is.
-        sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
-        expectations = build_expectations(plan, settings, collector, sim_time)
+        path, plan, options, labels, expectations = prepare(opts, settings, life, log_dir)
         return supervise(opts, settings, plan, options, labels, log_dir, path, expectations, life)
+
+
+def print_plan(opts: Any, settings: Settings) -> int:
+    """``mlaunch test FILE --print --format json``: the plan, plus what the run would check."""
+    from mlaunch.run.lifeline import Lifeline, write_stdout
+    from mlaunch.run.plan_json import plan_json
+
+    with Lifeline() as life:  # a launch file's code and Command substitutions may run
+        path, plan, _options, _labels, expectations = prepare(opts, settings, life, "")
+        test = {
+            "timeout": settings.timeout,
+            "hold": settings.hold,
+            "allow_exit": list(settings.allow_exit),
+            "expectations": [expectation_data(e) for e in expectations],
+        }
+        write_stdout(plan_json(plan, path, opts.arguments, test=test))
+    return EXIT_OK
+
+
+def prepare(
+    opts: Any, settings: Settings, life: Lifeline, log_dir: str
+) -> tuple[str, Plan, Any, Any, list[Expectation]]:
+    """Load and resolve as ``mlaunch FILE`` does, with the launch configurations collected;
+    (path, plan, resolve options, labels, the expectations of the run)."""
+    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.run import pipeline
+
+    path, description = pipeline.load_target(opts)
+    collector = _CollectConfigurations()
+    plan, options, labels = pipeline.resolve_for_run(
+        opts,
+        path,
+        LaunchDescription([description, collector]),
+        temp_dir=life.temp_dir,
+        log_dir=log_dir,
+    )
+    # use_sim_time:=true is an ordinary launch argument; a file that declares it is
+    # expected to run on simulated time, as --use-sim-time is.
+    sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
+    expectations = build_expectations(plan, settings, collector, sim_time)
+    return path, plan, options, labels, expectations
 
 
 def build_expectations(

@@ -144,20 +144,27 @@ class ExpectStep(Note):
 
     def describe_data(self) -> dict[str, Any]:
         """--print --format json: what ``mlaunch test`` will check (``check`` is its kind)."""
-        e = self.expectation
-        if e is None:
+        if self.expectation is None:
             return {"kind": "expectation", "check": None, "target": None, "description": None}
-        return {
-            "kind": "expectation",
-            "check": e.kind,
-            "target": e.target,
-            "description": e.describe(),
-            "within": e.within,
-            "rate": e.rate,
-            "state": e.state if e.kind == "lifecycle" else None,
-            "process": e.process,
-            "regex": None if e.regex is None else e.regex.pattern,
-        }
+        data = expectation_data(self.expectation)
+        del data["source"]  # the step's origin says where it was written
+        return {"kind": "expectation", **data}
+
+
+def expectation_data(e: Expectation) -> dict[str, Any]:
+    """--print --format json: one expectation as data (``check`` is its kind, ``source`` where
+    it comes from: default, a command-line option, a launch configuration, file:line)."""
+    return {
+        "check": e.kind,
+        "target": e.target,
+        "description": e.describe(),
+        "within": e.within,
+        "rate": e.rate,
+        "state": e.state if e.kind == "lifecycle" else None,
+        "process": e.process,
+        "regex": None if e.regex is None else e.regex.pattern,
+        "source": e.origin,
+    }
 
 
 class Expect(Action):
