@@ -495,3 +495,29 @@ def test_undeclared_arguments_and_warnings(env: dict[str, str]) -> None:
     timers = [s for s in document["steps"] if s["kind"] == "timer"]
     assert [t["period"] for t in timers] == [1.5, 5.0]
     assert [a["action"] for a in timers[1]["actions"]] == ["Shutdown"]
+
+
+def test_every_kind_of_step_can_be_written() -> None:
+    """Steps of the upper layers describe themselves (describe_data); the writer knows the rest.
+
+    A new step kind without either would make --print --format json an internal error.
+    """
+    import mlaunch.launch_ros.composition
+    import mlaunch.ros.lifecycle_sequence
+    import mlaunch.smoke.expectations  # noqa: F401  (they define Note steps)
+    from mlaunch.run import plan as plan_module
+    from mlaunch.run.plan_json import _Writer
+
+    known = set(_Writer(None).kinds)
+    pending = list(plan_module.Step.__subclasses__())
+    seen = []
+    while pending:
+        kind = pending.pop()
+        pending.extend(kind.__subclasses__())
+        if kind is plan_module.Note or not kind.__module__.startswith("mlaunch."):
+            continue  # the base of the upper layers' steps; a test's own step kinds
+        seen.append(kind.__name__)
+        assert kind in known or callable(getattr(kind, "describe_data", None)), kind.__name__
+    assert {"LoadComponents", "SequenceStep", "ExpectStep", "Spawn", "StartTimer"} <= set(seen)
+    schema_kinds = load_plan_schema()["$defs"]["step"]["properties"]["kind"]["enum"]  # type: ignore[index]
+    assert len(schema_kinds) == len(seen)
