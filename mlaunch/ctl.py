@@ -49,7 +49,7 @@ LABEL: a process's label (talker-1, as mlaunch prints it), or its name without t
 (talker) or its node's name, when only one process has it.
 
 RUN (default: the newest run still running, under the ROS log folder):
-  a run's log folder, or its name or part of it; mlaunch's pid; or the run id
+  a run's log folder, or its name (latest too) or part of it; mlaunch's pid; or the run id
   (MLAUNCH_RUN_ID in its processes' environment)
 
 exit status:
@@ -165,8 +165,9 @@ def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
     base = log_base_dir(environ)
     if run is None:
         return _newest_live(base)
-    if os.path.exists(run):
-        path = os.path.abspath(run)
+    under_base = os.path.join(base, run)  # a folder's name, or "latest"
+    if os.path.exists(run) or (os.sep not in run and os.path.isdir(under_base)):
+        path = os.path.realpath(run if os.path.exists(run) else under_base)
         if os.path.isdir(path):
             return _with_socket(path)
         return Target(os.path.dirname(os.path.dirname(path)), path)

@@ -179,6 +179,9 @@ def test_errors_are_clear(live: Live) -> None:
     run_id = str(about["run_id"])
     assert live.answer(run_id, "list")["run"] == about
     assert live.answer(str(live.folder), "list")["run"] == about
+    assert live.answer(live.folder.name, "list")["run"] == about
+    assert live.answer("latest", "list")["run"] == about
+    assert live.answer(live.folder.name[:19], "list")["run"] == about  # its start time
     done = live.ctl(f"{pid}-00000000", "list")
     assert done.returncode == 2 and "is not run" in done.stderr
 
