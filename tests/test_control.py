@@ -208,7 +208,10 @@ def test_a_launch_whose_processes_the_user_stopped_stays_up() -> None:
         seen.append(h.sup.shutting_down)
         h.shutdown()
 
-    h.when(b"ready", lambda *_: h.sup.control.stop("only", done=lambda _: h.sup.schedule(0, check)))
+    def stopped(info: ProcessInfo) -> None:
+        h.sup.schedule(0.0, check)
+
+    h.when(b"ready", lambda *_: h.sup.control.stop("only", done=stopped))
     assert h.run() == 0
     assert seen == [False]
     assert "shutting down: test" in h.text
