@@ -18,7 +18,7 @@ import sys
 
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
 from mlaunch.run.control import DEFAULT_LINES, OPERATIONS
-from mlaunch.run.control_socket import FOLDER, NAME, PROTOCOL, Address, socket_path
+from mlaunch.run.control_socket import FOLDER, NAME, PROTOCOL, Address, find_socket
 from mlaunch.run.logfiles import log_base_dir
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
@@ -185,7 +185,7 @@ def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
     if not named:
         recent = ", ".join(folders[:5]) or "none"
         raise CtlError(f"no run {what} under {base} (newest runs: {recent})", EXIT_USAGE)
-    live = [f for f in named if os.path.exists(socket_path(os.path.join(base, f)))]
+    live = [f for f in named if find_socket(os.path.join(base, f))]
     if len(named) > 1 and len(live) != 1:
         shown = ", ".join(named[:10]) + (f" and {len(named) - 10} more" if len(named) > 10 else "")
         raise CtlError(f"{what} names {len(named)} runs: {shown}; give one folder", EXIT_USAGE)
@@ -193,8 +193,8 @@ def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
 
 
 def _with_socket(folder: str) -> Target:
-    path = socket_path(folder)
-    if not os.path.exists(path):
+    path = find_socket(folder)
+    if path is None:
         raise CtlError(
             f"the run in {folder} is not running (its control socket {FOLDER}/{NAME} is gone)"
         )
@@ -220,11 +220,12 @@ def _newest_live(base: str) -> Target:
     stale = []
     seen = set()
     for folder in candidates:
-        if folder in seen or not os.path.exists(socket_path(folder)):
+        path = find_socket(folder) if folder not in seen else None
+        if path is None:
             continue
         seen.add(folder)
-        if _answers(socket_path(folder)):
-            return Target(folder, socket_path(folder))
+        if _answers(path):
+            return Target(folder, path)
         stale.append(folder)
     if stale:
         raise CtlError(

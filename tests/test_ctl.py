@@ -16,6 +16,7 @@ import socket
 import stat
 import subprocess
 import textwrap
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -246,3 +247,49 @@ def test_silent_and_vanishing_clients_do_not_stall_the_run(live: Live) -> None:
     silent.close()
     live.run.signal(signal.SIGINT)
     assert live.run.finish() == 130
+
+
+def test_a_log_folder_that_takes_no_socket_sends_it_to_the_runtime_folder(tmp_path: Path) -> None:
+    """In-process: the socket goes to $XDG_RUNTIME_DIR/mlaunch/, and ctl finds it from the run's
+    folder (``control/where``); a client thread asks while the loop serves."""
+    from test_supervision import Harness, make_spec
+
+    from mlaunch.ctl import ask, find_run
+    from mlaunch.run.control_socket import ControlSocket
+
+    logs = tmp_path / "run"
+    # The socket's place in the log folder is taken by a folder that is not empty.
+    (logs / "control" / "ctl.sock" / "x").mkdir(parents=True)
+    runtime = tmp_path / "runtime"
+    runtime.mkdir(mode=0o700)
+    h = Harness([make_spec("only", 'import time; print("ready", flush=True); time.sleep(60)')])
+    server = ControlSocket(h.sup, str(logs), {"XDG_RUNTIME_DIR": str(runtime)})
+    answers: list[tuple[str, dict[str, object]]] = []
+
+    def client() -> None:
+        target = find_run(str(logs), {})
+        answers.append((target.path, ask(target, {"op": "list"})))
+
+    def until_answered() -> None:
+        if answers:
+            h.shutdown()
+        else:
+            h.sup.schedule(0.02, until_answered)
+
+    def serve(*_: object) -> None:
+        assert server.open(), server.error
+        threading.Thread(target=client, daemon=True).start()
+        until_answered()
+
+    h.when(b"ready", serve)
+    try:
+        assert h.run() == 0
+    finally:
+        server.close()
+    path, answer = answers[0]
+    assert path == str(runtime / "mlaunch" / "run.sock")
+    processes = answer["processes"]
+    assert answer["ok"] is True and isinstance(processes, list)
+    assert [p["label"] for p in processes] == ["only"]
+    assert stat.S_IMODE(os.stat(runtime / "mlaunch").st_mode) == 0o700
+    assert not os.path.exists(path) and not (logs / "control" / "where").exists()

@@ -22,6 +22,8 @@ from __future__ import annotations
 import os
 import selectors
 import socket
+import stat
+from collections.abc import Mapping
 
 from mlaunch.errors import EXIT_FAILURE, EXIT_USAGE
 
@@ -32,6 +34,8 @@ if TYPE_CHECKING:
 
 FOLDER = "control"
 NAME = "ctl.sock"
+# In FOLDER when the socket is elsewhere (the log folder takes no socket): its path.
+WHERE = "where"
 PROTOCOL = 1
 # A request line longer than this is refused (a request is a few dozen bytes).
 MAX_REQUEST = 64 * 1024
@@ -70,42 +74,114 @@ class Address:
             self._fd = -1
 
 
-class ControlSocket:
-    """The listening socket and its clients, in ``supervisor.selector``; ``close`` removes it."""
+def find_socket(log_dir: str) -> str | None:
+    """The control socket of the run logging to ``log_dir`` (None when it has none)."""
+    path = socket_path(log_dir)
+    if _is_socket(path):
+        return path
+    try:
+        with open(os.path.join(log_dir, FOLDER, WHERE), encoding="utf-8") as f:
+            elsewhere = f.read().strip()
+    except (OSError, ValueError):
+        return None
+    return elsewhere if _is_socket(elsewhere) else None
 
-    def __init__(self, supervisor: Supervisor, log_dir: str) -> None:
+
+def runtime_socket_path(log_dir: str, environ: Mapping[str, str]) -> str | None:
+    """Where the socket goes when the log folder takes none: ``$XDG_RUNTIME_DIR/mlaunch/``."""
+    runtime = environ.get("XDG_RUNTIME_DIR")
+    if not runtime or not os.path.isdir(runtime):
+        return None
+    return os.path.join(runtime, "mlaunch", os.path.basename(log_dir.rstrip("/")) + ".sock")
+
+
+def _is_socket(path: str) -> bool:
+    try:
+        return stat.S_ISSOCK(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _listen(path: str) -> socket.socket:
+    """A listening socket at ``path`` (0600) in a folder of its own made 0700."""
+    folder = os.path.dirname(path)
+    os.makedirs(folder, mode=0o700, exist_ok=True)
+    os.chmod(folder, 0o700)  # made earlier with another mode: private all the same
+    try:
+        os.unlink(path)  # a run's socket path is its own: what is there is stale
+    except FileNotFoundError:
+        pass
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        with Address(path) as address:
+            listener.bind(address)
+        os.chmod(path, 0o600)
+        listener.listen(8)
+        listener.setblocking(False)
+    except BaseException:
+        listener.close()
+        raise
+    return listener
+
+
+class ControlSocket:
+    """The listening socket and its clients, in ``supervisor.selector``; ``close`` removes it.
+
+    In the run's log folder; where that takes no socket (a file system without them), in
+    ``$XDG_RUNTIME_DIR/mlaunch/``, named in the log folder's ``control/where``.
+    """
+
+    def __init__(
+        self, supervisor: Supervisor, log_dir: str, environ: Mapping[str, str] = os.environ
+    ) -> None:
         self.supervisor = supervisor
         self.path = socket_path(log_dir)
         self.log_dir = log_dir
+        self.environ = environ
         self.error = ""  # why it could not be opened
         self._listener: socket.socket | None = None
         self._clients: list[_Client] = []
 
     def open(self) -> bool:
-        """Bind and listen (False, with ``error``, when the folder takes no socket)."""
-        folder = os.path.dirname(self.path)
+        """Bind and listen (False, with ``error``, when no folder takes the socket)."""
+        listener: socket.socket | None
         try:
-            os.makedirs(folder, mode=0o700, exist_ok=True)
-            os.chmod(folder, 0o700)  # made earlier with another mode: private all the same
-            try:
-                os.unlink(self.path)  # a run's folder is its own: this is a stale socket
-            except FileNotFoundError:
-                pass
-            listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-            with Address(self.path) as address:
-                listener.bind(address)
-            os.chmod(self.path, 0o600)
-            listener.listen(8)
-            listener.setblocking(False)
+            listener = _listen(self.path)
         except OSError as e:
             self.error = f"cannot open the control socket {self.path}: {e.strerror or e}"
-            return False
+            listener = self._elsewhere()
+            if listener is None:
+                return False
         self._listener = listener
         self.supervisor.selector.register(listener, selectors.EVENT_READ, self._accept)
         guard = self.supervisor.guard
         if guard is not None:
             guard.remove_on_death(self.path)
         return True
+
+    def _elsewhere(self) -> socket.socket | None:
+        """The socket in the runtime folder, named in the log folder (None: no luck there)."""
+        path = runtime_socket_path(self.log_dir, self.environ)
+        if path is None:
+            return None
+        try:
+            listener = _listen(path)
+        except OSError as e:
+            self.error += f"; nor {path}: {e.strerror or e}"
+            return None
+        where = os.path.join(self.log_dir, FOLDER, WHERE)
+        try:
+            os.makedirs(os.path.dirname(where), mode=0o700, exist_ok=True)
+            fd = os.open(where, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            with open(fd, "w", encoding="utf-8") as f:
+                f.write(path + "\n")
+        except OSError as e:
+            listener.close()
+            os.unlink(path)
+            self.error += f"; nor can {where} name {path}: {e.strerror or e}"
+            return None
+        self.path = path
+        return listener
 
     def _accept(self, fd: int) -> None:
         assert self._listener is not None
@@ -137,9 +213,13 @@ class ControlSocket:
             _unregister(self.supervisor.selector, self._listener)
             self._listener.close()
             self._listener = None
+            for leftover in (self.path, os.path.join(self.log_dir, FOLDER, WHERE)):
+                try:
+                    os.unlink(leftover)
+                except OSError:
+                    pass
             try:
-                os.unlink(self.path)
-                os.rmdir(os.path.dirname(self.path))
+                os.rmdir(os.path.join(self.log_dir, FOLDER))
             except OSError:
                 pass
 
