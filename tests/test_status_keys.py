@@ -8,6 +8,7 @@ out (a clean exit, Ctrl-C, an exception in the loop, SIGKILL through the guard).
 from __future__ import annotations
 
 import os
+import re
 import signal
 import sys
 import termios
@@ -16,14 +17,14 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from procutil import clean_env, mlaunch, wait_for
+from procutil import clean_env, mlaunch, wait_for, wait_until
 from ptyrun import PtyRun
 from test_status import fake_usage, record
 from test_supervision import Harness
 
 from mlaunch.run.keyboard import Keyboard, decode, guard_line, parse_guard_line
 from mlaunch.run.status import StatusView
-from mlaunch.run.status_keys import Recent
+from mlaunch.run.status_keys import NOTICE_SECONDS, PANE_HELP, TABLE_HELP
 
 PY = sys.executable
 
@@ -45,8 +46,11 @@ time.sleep(600)
 
 def generate_launch_description():
     return LaunchDescription([
-        ExecuteProcess(cmd=[{PY!r}, '-c', TALKER], name='talker', output='log'),
-        ExecuteProcess(cmd=[{PY!r}, '-c', LISTENER], name='listener', output='screen'),
+        ExecuteProcess(cmd=[{PY!r}, '-c', TALKER], name='talker', output='screen',
+                       respawn=True, respawn_delay=0.3),
+        # Its stdout goes to its log file only; a respawn would wait a minute.
+        ExecuteProcess(cmd=[{PY!r}, '-c', LISTENER], name='listener', output='log',
+                       respawn=True, respawn_delay=60.0),
     ])
 """
 
@@ -84,29 +88,15 @@ def test_guard_line_carries_the_settings_back() -> None:
         os.close(slave)
 
 
-def test_recent_keeps_the_last_lines_within_its_bound() -> None:
-    recent = Recent(limit=100)
-    for i in range(50):
-        recent.add("a", b"line %d\n" % i)
-    recent.add("b", b"one\ntwo\n")
-    assert recent.lines("a", 3) == [b"line 47", b"line 48", b"line 49"]
-    assert recent.lines("b", 10) == [b"one", b"two"]
-    assert recent.lines("c", 10) == []
-    assert sum(len(line) + 1 for line in recent.lines("a", 1000)) <= 100 + 8
-    recent.add("a", b"x" * 500 + b"\nlast\n")  # one chunk bigger than the bound: its tail
-    assert recent.lines("a", 2) == [b"line 49", b"last"]
-
-
-def test_selection_moves_and_the_pane_shows_the_selected_process() -> None:
-    h = Harness([])
+def test_selection_moves_and_the_pane_shows_the_selected_process(tmp_path: Path) -> None:
+    h = Harness([], log_dir=str(tmp_path))
     view = StatusView(h.sup, size=lambda: (100, 30), color=False, sampler=fake_usage)
     keys = view.enable_keys()
-
     for name in ("a-1", "b-2", "c-3"):
         h.sup.records[name] = record(name, "running", pid=1)
-    keys.saw_output("b-2", b"first\n  indented\n")
+    (tmp_path / "b-2.log").write_bytes(b"first\n  indented\n")
     table = view.render()
-    assert "> a-1" in table and "keys:" in table.splitlines()[-1]
+    assert "> a-1" in table and table.splitlines()[-1] == TABLE_HELP
     for key in ("down", "j"):
         keys.press(key)
     assert keys.current() == "c-3"
@@ -119,11 +109,31 @@ def test_selection_moves_and_the_pane_shows_the_selected_process() -> None:
     pane = view.render().splitlines()
     assert pane[0] == "b-2: running, its last 2 lines"
     assert pane[1:3] == ["first", "  indented"]
-    assert "Esc or q" in pane[-1]
+    assert pane[-1] == PANE_HELP
     keys.press("down")  # the pane follows the selection
     assert view.render().splitlines()[0] == "c-3: running, no output yet"
     keys.press("q")
     assert "> c-3" in view.render()
+    view.close()
+
+
+def test_a_request_that_cannot_be_done_says_why_in_place_of_the_help(tmp_path: Path) -> None:
+    now = [100.0]
+    h = Harness([], log_dir=str(tmp_path), clock=lambda: now[0])
+    view = StatusView(h.sup, size=lambda: (120, 30), color=False, sampler=fake_usage)
+    keys = view.enable_keys()
+    keys.press("x")  # nothing to act on yet: nothing happens
+    assert view.render().splitlines()[-1] == TABLE_HELP
+    h.sup.records["a-1"] = record("a-1", "finished", outcome="finished cleanly")
+    keys.press("x")
+    assert view.render().splitlines()[-1] == "a-1 is not running (finished cleanly)"
+    now[0] += NOTICE_SECONDS
+    assert view.render().splitlines()[-1] == TABLE_HELP
+    keys.press("m")  # muting needs no running process
+    row = next(line for line in view.render().splitlines() if "a-1" in line)
+    assert "finished, muted" in row
+    keys.press("u")
+    assert "muted" not in view.render()
     view.close()
 
 
@@ -190,45 +200,65 @@ def run(tmp_path: Path, launch_file: Path) -> Iterator[PtyRun]:
         proc.close()
 
 
-def table_row(screen: str, name: str) -> str | None:
+def table_row(screen: str, name: str) -> str:
+    """The table's row of the process ``name`` ("" while there is none)."""
     for line in screen.splitlines():
-        if line.lstrip("> ").startswith(name):
+        if line.lstrip("> ").startswith(name + "-"):
             return line
-    return None
+    return ""
+
+
+def cell(screen: str, name: str, column: int) -> str:
+    """One cell of a row, by column (0: process); cells are at least two spaces apart."""
+    cells = re.split(r"\s{2,}", table_row(screen, name).lstrip("> "))
+    return cells[column] if column < len(cells) else ""
+
+
+def started(run: PtyRun) -> str:
+    """The screen once both processes run, the talker has printed, and the help line shows."""
+    return run.wait_screen(
+        lambda s: "running" in cell(s, "listener", 1) and "talker says 2" in s and "x stop" in s,
+        what="the table with both processes and the help line",
+    )
+
+
+def said(run: PtyRun, name: str) -> list[int]:
+    """The numbers the talker's lines printed above the table (not the table's last output)."""
+    return [int(n) for n in re.findall(rf"^\[{name}-\d+\] talker says (\d+)$", run.history(), re.M)]
 
 
 def test_status_keys_select_and_show_last_lines_in_a_terminal(run: PtyRun) -> None:
-    screen = run.wait_screen(
-        lambda s: "listener ready" in s and "talker says 2" in s and "keys:" in s,
-        what="the table with both processes and the help line",
-    )
+    screen = started(run)
     assert not run.cooked()  # cbreak while the view runs
-    assert (table_row(screen, "talker") or "").startswith("> talker")
-    assert (table_row(screen, "listener") or "").startswith("  listener")
+    assert table_row(screen, "talker").startswith("> talker")
+    assert table_row(screen, "listener").startswith("  listener")
     run.type(b"j")
-    run.wait_screen(
-        lambda s: (table_row(s, "listener") or "").startswith("> listener"), what="j moves down"
-    )
+    run.wait_screen(lambda s: table_row(s, "listener").startswith("> "), what="j moves down")
     run.type(b"\x1b[A")
-    run.wait_screen(
-        lambda s: (table_row(s, "talker") or "").startswith("> talker"), what="up moves up"
-    )
-    # The talker's output goes to its log only (output='log'), yet its pane shows it.
+    run.wait_screen(lambda s: table_row(s, "talker").startswith("> "), what="up moves up")
+    run.type(b"\x1b[B")
+    run.wait_screen(lambda s: table_row(s, "listener").startswith("> "), what="down moves down")
+    # The listener's stdout goes to its log file only (the table shows its last line), yet its
+    # pane shows it.
+    assert "[listener-2] listener ready" not in run.history()
     run.type(b"l")
-    screen = run.wait_screen("talker-1: running, its last", what="the pane")
-    assert "keys: Esc or q back" in screen
-    pane = screen[screen.index("talker-1: running") :]
-    assert "talker says" in pane and "process" not in pane.splitlines()[1]
-    said = [int(line.split()[-1]) for line in pane.splitlines() if line.startswith("talker says")]
-    # Kept up to date while it is open.
+    screen = run.wait_screen("listener-2: running, its last 1 lines", what="the listener's pane")
+    assert "Esc/q back" in screen.splitlines()[-1] or "Esc/q back" in screen
+    pane = screen[screen.index("listener-2: running") :].splitlines()
+    assert pane[1] == "listener ready"
+    run.type(b"k")  # the pane follows the selection, and is kept up to date
+    screen = run.wait_screen("talker-1: running, its last", what="the talker's pane")
+    shown = [
+        int(line.split()[-1]) for line in screen.splitlines() if line.startswith("talker says")
+    ]
     run.wait_screen(
-        lambda s: f"talker says {max(said) + 2}" in s[s.find("talker-1: running") :],
+        lambda s: f"talker says {max(shown) + 2}" in s[s.find("talker-1: running") :],
         what="the pane follows new output",
     )
     run.type(b"\x1b")
-    run.wait_screen(lambda s: "last output" in s and "Esc or q" not in s, what="Esc: the table")
-    run.type(b"l")
-    run.wait_screen("talker-1: running, its last", what="the pane again")
+    run.wait_screen(lambda s: "last output" in s and "Esc/q" not in s, what="Esc: the table")
+    run.type(b"\r")
+    run.wait_screen("talker-1: running, its last", what="Enter: the pane again")
     run.type(b"q")
     run.wait_screen(lambda s: "last output" in s, what="q: the table")
     # Ctrl-C typed on the terminal is still the usual shutdown, and the terminal is put back.
@@ -238,8 +268,77 @@ def test_status_keys_select_and_show_last_lines_in_a_terminal(run: PtyRun) -> No
     assert "user interrupted with SIGINT" in run.history()
 
 
+def test_stop_keeps_it_down_and_start_brings_it_back(run: PtyRun) -> None:
+    screen = started(run)
+    pid = cell(screen, "talker", 2)
+    run.type(b"x")  # the talker is selected: stopped, and its respawn (0.3 s) does not fight it
+    run.wait_screen(
+        lambda s: cell(s, "talker", 1) == "stopped by the user", what="the row says stopped"
+    )
+    history = run.history()
+    assert "[talker-1]: stop asked by the user (--status keys)" in history
+    assert re.search(r"\[talker-1\]: process stopped by the user \[pid \d+, ", history), history
+    assert "restart 1" not in history
+    assert not wait_until(lambda: (run.pump(), "running" in cell(run.text(), "talker", 1))[1], 1.5)
+    run.type(b"x")  # stopping it again cannot be done: the help line says why
+    run.wait_screen("talker-1 is not running (stopped by the user)", what="the notice")
+    run.type(b"s")
+    screen = run.wait_screen(
+        lambda s: cell(s, "talker", 1) == "running" and cell(s, "talker", 4) == "1",
+        what="started again, one restart",
+    )
+    assert cell(screen, "talker", 2) != pid
+    assert "[talker-1]: start asked by the user (--status keys)" in run.history()
+    run.type(b"\x03")
+    assert run.wait() == 130
+    assert run.cooked()
+
+
+def test_restart_keeps_the_label_counts_one_and_skips_the_respawn_delay(run: PtyRun) -> None:
+    screen = started(run)
+    pid = cell(screen, "listener", 2)
+    run.type(b"jr")  # the listener respawns after 60 s; a restart is at once
+    screen = run.wait_screen(
+        lambda s: cell(s, "listener", 4) == "1" and cell(s, "listener", 2) not in ("", "-", pid),
+        timeout=15,
+        what="the listener restarted with a new pid",
+    )
+    assert cell(screen, "listener", 1) == "running"
+    history = run.history()
+    assert "[listener-2]: restart asked by the user (--status keys)" in history
+    assert "[listener-2]: process stopped by the user for a restart" in history
+    assert "restart 1" not in history  # no respawn was scheduled
+    assert len(re.findall(r"\[listener-2\]: process started with pid", history)) == 2
+    run.type(b"\x03")
+    assert run.wait() == 130
+
+
+def test_mute_hides_the_output_from_the_screen_but_not_from_its_log(
+    run: PtyRun, tmp_path: Path
+) -> None:
+    started(run)
+    run.type(b"m")
+    run.wait_screen(lambda s: "muted" in cell(s, "talker", 1), what="the row says muted")
+    assert "[talker-1]: output muted by the user (--status keys)" in run.history()
+    before = max(said(run, "talker"))
+    log = tmp_path / "logs" / "latest" / "talker-1.log"
+
+    def logged() -> list[int]:
+        return [int(n) for n in re.findall(rb"^talker says (\d+)$", log.read_bytes(), re.M)]
+
+    wait_for(lambda: max(logged()) >= before + 4, 10, "the log to go on")
+    run.pump()
+    assert max(said(run, "talker")) <= before + 1  # a line on its way as m was typed, at most
+    run.type(b"u")
+    run.wait_screen(lambda s: "muted" not in cell(s, "talker", 1), what="unmuted")
+    wait_for(lambda: (run.pump(), max(said(run, "talker")) > before + 4)[1], 10, "lines again")
+    assert "[talker-1]: output unmuted by the user (--status keys)" in run.history()
+    run.type(b"\x03")
+    assert run.wait() == 130
+
+
 def test_terminal_is_put_back_when_mlaunch_is_killed(run: PtyRun) -> None:
-    run.wait_screen("keys:", what="the help line")
+    run.wait_screen("x stop", what="the help line")
     assert not run.cooked()
     os.kill(run.pid, signal.SIGKILL)
     assert run.wait() == -signal.SIGKILL
@@ -248,7 +347,7 @@ def test_terminal_is_put_back_when_mlaunch_is_killed(run: PtyRun) -> None:
 
 
 def test_terminal_is_put_back_after_sigterm(run: PtyRun) -> None:
-    run.wait_screen("keys:", what="the help line")
+    run.wait_screen("x stop", what="the help line")
     os.kill(run.pid, signal.SIGTERM)
     assert run.wait() == 143
     assert run.cooked()
@@ -260,8 +359,8 @@ def test_keys_need_a_terminal_on_stdin(tmp_path: Path, launch_file: Path) -> Non
     argv = ["/bin/sh", "-c", 'exec "$@" < /dev/null', "sh", *mlaunch(str(launch_file), "--status")]
     proc = PtyRun(argv, env=env)
     try:
-        screen = proc.wait_screen(lambda s: "listener ready" in s and "last output" in s)
-        assert "keys:" not in screen and "> talker" not in screen
+        screen = proc.wait_screen(lambda s: "talker says 1" in s and "last output" in s)
+        assert "x stop" not in screen and "> talker" not in screen
         assert proc.cooked()
         proc.type(b"\x03")
         assert proc.wait() == 130

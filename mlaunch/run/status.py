@@ -248,11 +248,17 @@ class StatusView:
     # --- what it shows --------------------------------------------------------------------------
 
     def enable_keys(self) -> StatusKeys:
-        """Select a process with the keys and show its last lines (``press`` them on
-        ``keys``); the table gets a marked row and a help line."""
+        """Select a process with the keys and act on it (``press`` them on ``keys``); the
+        table gets a marked row and a help line."""
         from mlaunch.run.status_keys import StatusKeys
 
-        self.keys = StatusKeys(lambda: list(self.supervisor.records), self.redraw)
+        supervisor = self.supervisor
+        self.keys = StatusKeys(
+            lambda: list(supervisor.records),
+            self.redraw,
+            lambda: supervisor.control,
+            supervisor.clock,
+        )
         return self.keys
 
     def read_keys(self, fd: int) -> Keyboard:
@@ -280,8 +286,6 @@ class StatusView:
         if not isinstance(event, Output):
             return
         data = event.data
-        if self.keys is not None:
-            self.keys.saw_output(event.process.label, data)
         end = len(data) - 1  # data is complete lines: it ends with a newline
         start = data.rfind(b"\n", 0, end) + 1
         self.last_line[event.process.label] = data[start : min(end, start + LAST_LINE)]
@@ -389,7 +393,9 @@ class StatusView:
         else:
             self._print_table(console, lines)
         if keys is not None:
-            console.print(Text(keys.help_line(), style="dim", no_wrap=True, overflow="ellipsis"))
+            line = keys.help_line()
+            style = "yellow" if keys.notice else "dim"
+            console.print(Text(line, style=style, no_wrap=True, overflow="ellipsis"))
         return out.getvalue().rstrip("\n")
 
     def _print_table(self, console: Console, lines: int) -> None:
@@ -432,6 +438,7 @@ class StatusView:
         for record, state, pid, uptime, cpu, rss, last in rows:
             style = STATE_STYLE.get(state, "dim")
             label = record.label
+            state = self._state_text(record)
             if self.keys is not None:
                 # A marker as well as the highlight: without colours it is all there is.
                 label = ("> " if label == selected else "  ") + label
@@ -454,13 +461,20 @@ class StatusView:
 
         assert self.keys is not None
         record = self.supervisor.records.get(label)
-        state = record.state if record is not None else "-"
-        shown = self.keys.recent.lines(label, max(1, int(lines * MAX_SHARE) - 2))
-        what = f"its last {len(shown)} lines" if shown else "no output yet"
+        state = self._state_text(record) if record is not None else "-"
+        shown, problem = self.keys.last_lines(label, max(1, int(lines * MAX_SHARE) - 2))
+        what = f"its last {len(shown)} lines" if shown else problem or "no output yet"
         console.print(Text(f"{label}: {state}, {what}", style="bold", no_wrap=True))
-        for raw in shown:
-            text = _printable(raw, strip=False)
+        for line in shown:
+            text = _printable(line.encode(), strip=False)
             console.print(Text(text, no_wrap=True, overflow="ellipsis"))
+
+    def _state_text(self, record: ProcessRecord) -> str:
+        """The state as the table shows it: whether the user stopped or muted it too."""
+        state = record.outcome if record.state == STOPPED else record.state
+        if record.label in self.printer.muted:
+            state += ", muted"
+        return state
 
 
 def _printable(raw: bytes, *, strip: bool = True) -> str:

@@ -1,77 +1,54 @@
-"""What the keys do in the ``--status`` view: select a process, look at its last lines.
+"""What the keys do in the ``--status`` view: select a process and act on it, as in rosmon.
 
-rosmon's idea on mlaunch's table: one row is selected (up/down arrows, or j/k), and keys act on
-it. ``l`` (or Enter) opens the pane of its last lines in place of the table, kept up to date
-as the process prints; Esc or ``q`` goes back to the table. A help line of the keys sits at
-the bottom of the view. The keys come from mlaunch.run.keyboard; the view (mlaunch.run.status)
-draws what this module decides.
-
-The last lines come from a bounded ring per process (``Recent``): the complete lines of its
-output as the event stream carried them, at most ``RECENT_BYTES`` each, whatever the output
-mode sends to the screen (a process whose output goes only to its log file shows here too).
+One row is selected (up/down arrows, or j/k) and the keys act on it through the run's control
+core (mlaunch.run.control, the same operations as ``mlaunch ctl``): ``s`` start, ``x`` stop,
+``r`` restart, ``m`` mute, ``u`` unmute. ``l`` (or Enter) shows its log: its last lines (control's
+``logs``: from its log file, so a process whose output goes only there shows too) in place of
+the table, kept up to date; Esc or ``q`` goes back. A help line of the keys sits at the bottom
+of the view; a request that cannot be carried out (starting a running process, acting while
+the launch shuts down) shows why there instead, for a few seconds. The keys come from
+mlaunch.run.keyboard; the view (mlaunch.run.status) draws what this module decides.
 """
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Callable
 
-# Output kept per process for the pane; a whole chunk is dropped once the rest reaches it.
-RECENT_BYTES = 64 * 1024
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.run.control import Control
 
-# The help lines (table, pane): the keys and what they do.
-TABLE_HELP = "keys: \u2191\u2193 or j k select \u00b7 l last lines \u00b7 Ctrl-C stop all"
-PANE_HELP = "keys: Esc or q back to the table \u00b7 \u2191\u2193 or j k other process"
-
-
-class Recent:
-    """The last ``limit`` bytes (or so) of each process's output, as complete lines."""
-
-    def __init__(self, limit: int = RECENT_BYTES) -> None:
-        self.limit = limit
-        self._chunks: dict[str, deque[bytes]] = {}
-        self._size: dict[str, int] = {}
-
-    def add(self, label: str, data: bytes) -> None:
-        """Complete lines (``data`` ends with a newline) of process ``label``."""
-        if len(data) > self.limit:
-            data = data[data.find(b"\n", len(data) - self.limit) + 1 :]
-        chunks = self._chunks.get(label)
-        if chunks is None:
-            chunks = self._chunks[label] = deque()
-            self._size[label] = 0
-        chunks.append(data)
-        size = self._size[label] + len(data)
-        while size > self.limit and len(chunks) > 1:
-            size -= len(chunks.popleft())
-        self._size[label] = size
-
-    def lines(self, label: str, count: int) -> list[bytes]:
-        """The last ``count`` lines of ``label`` (fewer when it printed fewer), oldest first."""
-        chunks = self._chunks.get(label)
-        if not chunks or count <= 0:
-            return []
-        out: list[bytes] = []
-        for chunk in reversed(chunks):
-            out[:0] = chunk[:-1].split(b"\n")
-            if len(out) >= count:
-                break
-        return out[-count:]
+# The help lines (table, pane): the keys and what they do, within 80 columns.
+ACTIONS_HELP = "s start  x stop  r restart  m mute  u unmute"
+TABLE_HELP = f"\u2191\u2193/jk select  {ACTIONS_HELP}  l log  Ctrl-C quit"
+PANE_HELP = f"Esc/q back  \u2191\u2193/jk other process  {ACTIONS_HELP}"
+# How long a request's problem stays in place of the help line (unless another key is pressed).
+NOTICE_SECONDS = 5.0
 
 
 class StatusKeys:
-    """The selection and the pane of one status view, moved by ``press(key)``.
+    """The selection, the pane and the key bindings of one status view: ``press(key)``.
 
     ``labels()`` gives the processes in the order the table lists them; ``changed()`` asks the
-    view to draw again at once (a key is answered now, not at the next refresh).
+    view to draw again at once (a key is answered now, not at the next refresh); ``control()``
+    gives the run's control core (made on the first key that needs it); ``clock`` times notices.
     """
 
-    def __init__(self, labels: Callable[[], list[str]], changed: Callable[[], None]) -> None:
+    def __init__(
+        self,
+        labels: Callable[[], list[str]],
+        changed: Callable[[], None],
+        control: Callable[[], Control],
+        clock: Callable[[], float],
+    ) -> None:
         self.labels = labels
         self.changed = changed
+        self.control = control
+        self.clock = clock
         self.selected: str | None = None
         self.pane: str | None = None  # the process whose last lines are shown, if any
-        self.recent = Recent()
+        self.notice = ""  # why the last request was not carried out
+        self._notice_until = 0.0
         self._keys: dict[str, Callable[[], None]] = {
             "up": self.previous,
             "k": self.previous,
@@ -81,12 +58,18 @@ class StatusKeys:
             "enter": self.open_pane,
             "esc": self.close_pane,
             "q": self.close_pane,
+            "s": lambda: self._act(lambda c, label: c.start(label, by="keys")),
+            "x": lambda: self._act(lambda c, label: c.stop(label, by="keys")),
+            "r": lambda: self._act(lambda c, label: c.restart(label, by="keys")),
+            "m": lambda: self._act(lambda c, label: c.mute(label, by="keys")),
+            "u": lambda: self._act(lambda c, label: c.unmute(label, by="keys")),
         }
 
     def press(self, key: str) -> None:
         """A key from the terminal; keys that mean nothing here are ignored."""
         action = self._keys.get(key)
         if action is not None:
+            self.notice = ""
             action()
             self.changed()
 
@@ -119,8 +102,31 @@ class StatusKeys:
     def close_pane(self) -> None:
         self.pane = None
 
-    def help_line(self) -> str:
-        return PANE_HELP if self.pane is not None else TABLE_HELP
+    def _act(self, request: Callable[[Control, str], object]) -> None:
+        """Carry out a request on the selected process; if it cannot be, say why for a while."""
+        from mlaunch.run.control import ControlError
 
-    def saw_output(self, label: str, data: bytes) -> None:
-        self.recent.add(label, data)
+        label = self.current()
+        if label is None:
+            return
+        try:
+            request(self.control(), label)
+        except ControlError as e:
+            self.notice = str(e)
+            self._notice_until = self.clock() + NOTICE_SECONDS
+
+    def last_lines(self, label: str, count: int) -> tuple[list[str], str]:
+        """(the last ``count`` lines of ``label``'s output, why there are none if so)."""
+        from mlaunch.run.control import ControlError
+
+        try:
+            return self.control().logs(label, count), ""
+        except ControlError as e:
+            return [], str(e)
+
+    def help_line(self) -> str:
+        """The keys, or why the last request was not carried out (for a few seconds)."""
+        if self.notice and self.clock() < self._notice_until:
+            return self.notice
+        self.notice = ""
+        return PANE_HELP if self.pane is not None else TABLE_HELP
