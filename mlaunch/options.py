@@ -192,8 +192,8 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         "--status",
         action="store_true",
         help="a live table of the processes below their output; in a terminal, keys: up/down"
-        " or j/k select a process, l (or Enter) shows its last lines, Esc or q goes back to the"
-        " table; Ctrl-C stops everything",
+        " or j/k select a process, s start, x stop, r restart, m mute, u unmute it, l (or Enter)"
+        " its last lines, Esc or q back to the table; Ctrl-C stops everything",
     )
     parser.add_argument(
         "-q",

@@ -73,6 +73,11 @@ class PtyRun:
             self.stream.feed(data)
             ready, _, _ = select.select([self.master], [], [], 0)
 
+    def now(self) -> str:
+        """The screen's text after reading what is there (not waiting for more)."""
+        self.pump(0)
+        return self.text()
+
     def display(self) -> list[str]:
         """The lines on the screen now, right-stripped."""
         return [line.rstrip() for line in self.screen.display]

@@ -224,6 +224,7 @@ def started(run: PtyRun) -> str:
 
 def said(run: PtyRun, name: str) -> list[int]:
     """The numbers the talker's lines printed above the table (not the table's last output)."""
+    run.pump(0)
     return [int(n) for n in re.findall(rf"^\[{name}-\d+\] talker says (\d+)$", run.history(), re.M)]
 
 
@@ -279,7 +280,7 @@ def test_stop_keeps_it_down_and_start_brings_it_back(run: PtyRun) -> None:
     assert "[talker-1]: stop asked by the user (--status keys)" in history
     assert re.search(r"\[talker-1\]: process stopped by the user \[pid \d+, ", history), history
     assert "restart 1" not in history
-    assert not wait_until(lambda: (run.pump(), "running" in cell(run.text(), "talker", 1))[1], 1.5)
+    assert not wait_until(lambda: "running" in cell(run.now(), "talker", 1), 1.5)
     run.type(b"x")  # stopping it again cannot be done: the help line says why
     run.wait_screen("talker-1 is not running (stopped by the user)", what="the notice")
     run.type(b"s")
@@ -327,11 +328,10 @@ def test_mute_hides_the_output_from_the_screen_but_not_from_its_log(
         return [int(n) for n in re.findall(rb"^talker says (\d+)$", log.read_bytes(), re.M)]
 
     wait_for(lambda: max(logged()) >= before + 4, 10, "the log to go on")
-    run.pump()
     assert max(said(run, "talker")) <= before + 1  # a line on its way as m was typed, at most
     run.type(b"u")
     run.wait_screen(lambda s: "muted" not in cell(s, "talker", 1), what="unmuted")
-    wait_for(lambda: (run.pump(), max(said(run, "talker")) > before + 4)[1], 10, "lines again")
+    wait_for(lambda: max(said(run, "talker")) > before + 4, 10, "lines again")
     assert "[talker-1]: output unmuted by the user (--status keys)" in run.history()
     run.type(b"\x03")
     assert run.wait() == 130

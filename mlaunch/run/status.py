@@ -429,6 +429,8 @@ class StatusView:
             pad_edge=False,
             show_edge=False,
             expand=True,
+            padding=(0, 1),
+            collapse_padding=True,
         )
         for name, justify in (("process", "left"), ("state", "left"), ("pid", "right"),
                               ("uptime", "right"), ("restarts", "right"), ("cpu", "right"),
