@@ -392,7 +392,8 @@ class StatusView:
             self._print_pane(console, keys.pane, lines)
         else:
             self._print_table(console, lines)
-        if keys is not None:
+        if keys is not None and (self.keyboard is None or self.keyboard.reading):
+            # (Not while mlaunch is in the background: the keys do not reach it there.)
             line = keys.help_line()
             style = "yellow" if keys.notice else "dim"
             console.print(Text(line, style=style, no_wrap=True, overflow="ellipsis"))
