@@ -393,52 +393,51 @@ def test_terminal_is_put_back_when_the_program_fails_without_closing(tmp_path: P
         proc.close()
 
 
-def test_ctrl_z_and_fg_take_the_keys_up_again(tmp_path: Path, launch_file: Path) -> None:
+@pytest.fixture
+def shell(tmp_path: Path) -> Iterator[PtyRun]:
+    """An interactive bash on a pty (job control on, no line editing), at its prompt."""
+    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"), TERM="xterm", PS1="$ ")
+    proc = PtyRun(["/bin/bash", "--norc", "--noprofile", "--noediting", "-i"], env=env)
+    try:
+        proc.wait_screen("$", what="the prompt")
+        yield proc
+    finally:
+        proc.close()
+
+
+def end_in_shell(shell: PtyRun) -> None:
+    """Ctrl-C to the launch in the foreground; the shell gets a cooked terminal back."""
+    shell.type(b"\x03")
+    shell.wait_screen("Summary: 2 processes", what="the run's end")
+    wait_for(shell.cooked, 10, "the terminal put back")
+    shell.type(b"exit\n")
+    shell.wait()
+
+
+def test_ctrl_z_and_fg_take_the_keys_up_again(shell: PtyRun, launch_file: Path) -> None:
     """Job control under a real shell: Ctrl-Z stops mlaunch and the shell gets its terminal
     back; after fg the view is in cbreak mode again and the keys work."""
-    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"), TERM="xterm", PS1="$ ")
-    shell = PtyRun(["/bin/bash", "--norc", "--noprofile", "--noediting", "-i"], env=env)
-    try:
-        shell.wait_screen("$", what="the prompt")
-        shell.type(" ".join(mlaunch(str(launch_file), "--status")).encode() + b"\n")
-        shell.wait_screen(lambda s: "x stop" in s and "talker says 2" in s, what="the view")
-        assert not shell.cooked()
-        shell.type(b"\x1a")
-        shell.wait_screen("Stopped", what="the shell's word that mlaunch stopped")
-        wait_for(shell.cooked, 10, "the shell's own terminal mode")
-        shell.type(b"fg\n")
-        wait_for(lambda: not shell.cooked(), 10, "cbreak mode again")
-        shell.type(b"j")
-        shell.wait_screen(
-            lambda s: table_row(s, "listener").startswith("> "), what="the keys work again"
-        )
-        shell.type(b"\x03")
-        shell.wait_screen("Summary: 2 processes", what="the run's end")
-        wait_for(shell.cooked, 10, "the terminal put back")
-        shell.type(b"exit\n")
-        shell.wait()
-    finally:
-        shell.close()
+    shell.type(" ".join(mlaunch(str(launch_file), "--status")).encode() + b"\n")
+    shell.wait_screen(lambda s: "x stop" in s and "talker says 2" in s, what="the view")
+    assert not shell.cooked()
+    shell.type(b"\x1a")
+    shell.wait_screen("Stopped", what="the shell's word that mlaunch stopped")
+    wait_for(shell.cooked, 10, "the shell's own terminal mode")
+    shell.type(b"fg\n")
+    wait_for(lambda: not shell.cooked(), 10, "cbreak mode again")
+    shell.type(b"j")
+    shell.wait_screen(lambda s: table_row(s, "listener").startswith("> "), what="keys work again")
+    end_in_shell(shell)
 
 
-def test_started_in_the_background_the_keys_wait_for_fg(tmp_path: Path, launch_file: Path) -> None:
+def test_started_in_the_background_the_keys_wait_for_fg(shell: PtyRun, launch_file: Path) -> None:
     """``mlaunch FILE --status &``: the terminal is the shell's (no cbreak, no help line) until
     fg brings mlaunch to the foreground."""
-    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"), TERM="xterm", PS1="$ ")
-    shell = PtyRun(["/bin/bash", "--norc", "--noprofile", "--noediting", "-i"], env=env)
-    try:
-        shell.wait_screen("$", what="the prompt")
-        shell.type(" ".join(mlaunch(str(launch_file), "--status")).encode() + b" &\n")
-        screen = shell.wait_screen(lambda s: "talker says 3" in s and "last output" in s)
-        assert "x stop" not in screen
-        assert shell.cooked()
-        shell.type(b"fg\n")
-        shell.wait_screen("x stop", what="the help line once in the foreground")
-        assert not shell.cooked()
-        shell.type(b"\x03")
-        shell.wait_screen("Summary: 2 processes", what="the run's end")
-        wait_for(shell.cooked, 10, "the terminal put back")
-        shell.type(b"exit\n")
-        shell.wait()
-    finally:
-        shell.close()
+    shell.type(" ".join(mlaunch(str(launch_file), "--status")).encode() + b" &\n")
+    screen = shell.wait_screen(lambda s: "talker says 3" in s and "last output" in s)
+    assert "x stop" not in screen
+    assert shell.cooked()
+    shell.type(b"fg\n")
+    shell.wait_screen("x stop", what="the help line once in the foreground")
+    assert not shell.cooked()
+    end_in_shell(shell)
