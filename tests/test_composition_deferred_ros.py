@@ -332,3 +332,49 @@ def test_a_launch_service_loads_components_of_a_description_included_while_runni
     assert seen == ["ready", "loaded"], screen.data.decode()
     assert code == 0, screen.data.decode()
     assert not [t for t in threading.enumerate() if t.name.startswith("load ")]
+
+
+IN_FLIGHT_PY = """
+    from launch import LaunchDescription
+    from launch_ros.actions import LoadComposableNodes, Node
+    from launch_ros.descriptions import ComposableNode
+
+
+    def generate_launch_description():
+        return LaunchDescription([
+            # Dies on the request for p::Die, after receiving it and before answering.
+            Node(executable=PY, name='rec', arguments=[RECORDER, '--exit-on', 'p::Die']),
+            LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
+                ComposableNode(package='p', plugin='p::Die', name='a'),
+                ComposableNode(package='p', plugin='p::B', name='b'),
+            ]),
+        ])
+"""
+
+
+def test_a_container_that_dies_with_a_load_in_flight(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """The request sent stays unanswered (launch_ros waits for the answer until shutdown, and
+    never sends the next one); Ctrl-C abandons both, each with its own line."""
+    path = tmp_path / "in_flight.launch.py"
+    path.write_text(f"PY = {PY!r}\nRECORDER = {RECORDER!r}\n" + textwrap.dedent(IN_FLIGHT_PY))
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        run.wait_for(
+            r"container '/rec' exited before it loaded node 'a' of type 'p::Die', node 'b' of"
+            r" type 'p::B'",
+            60,
+        )
+        assert run.proc.poll() is None, "the pending loads keep the launch up, as in ros2 launch"
+    finally:
+        code = stop(run)
+    assert code == 130, run.text
+    assert (
+        "Abandoning wait for the '/rec/_container/load_node' service response, due to shutdown:"
+        " node 'a' of type 'p::Die' may not have been loaded"
+    ) in run.text
+    assert (
+        "Abandoning wait for the '/rec/_container/load_node' service, due to shutdown:"
+        " node 'b' of type 'p::B' was never loaded"
+    ) in run.text

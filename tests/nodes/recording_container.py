@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
 """Test container: answers ``~/_container/load_node`` with success and prints each request.
 
-    python recording_container.py [--fail PLUGIN] [--ros-args -r __node:=NAME -r __ns:=NS ...]
+    python recording_container.py [--fail PLUGIN] [--exit-on PLUGIN]
+                                  [--ros-args -r __node:=NAME -r __ns:=NS ...]
 
 Each LoadNode request is one JSON line on stdout (its fields; parameters and extra arguments as
 [name, type, value]), so a test compares what a launcher sent with what it expects. ``--fail``
 answers success=false with the message 'refused by the recording container' for that plugin.
+``--exit-on`` makes the container die (status 3) on a request for that plugin, after printing
+it and before answering: a container that dies while a load is in flight.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
 from typing import Any
 
@@ -32,6 +36,7 @@ def as_json(msg: Any) -> str:
 def main() -> int:
     args = rclpy.utilities.remove_ros_args(sys.argv)[1:]
     fail = args[args.index("--fail") + 1] if "--fail" in args else None
+    exit_on = args[args.index("--exit-on") + 1] if "--exit-on" in args else None
     rclpy.init()
     node = Node("recording_container")
     count = 0
@@ -39,6 +44,8 @@ def main() -> int:
     def on_load(request: Any, response: Any) -> Any:
         nonlocal count
         print(as_json(request), flush=True)
+        if request.plugin_name == exit_on:
+            os._exit(3)  # no answer, no clean-up: the request stays in flight
         if request.plugin_name == fail:
             response.success = False
             response.error_message = "refused by the recording container"
