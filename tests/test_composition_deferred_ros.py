@@ -219,7 +219,8 @@ OPAQUE_PY = """
 
     def load(context):
         return [LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
-            ComposableNode(package='p', plugin='p::Opaque', name='opaque')])]
+            ComposableNode(package='p', plugin='p::Opaque', name='opaque'),
+            ComposableNode(package='p', plugin='p::Again', name='opaque')])]
 
 
     def generate_launch_description():
@@ -237,16 +238,22 @@ def test_a_load_only_a_function_makes_attaches_the_driver_when_it_comes(
     ros_env: dict[str, str], tmp_path: Path
 ) -> None:
     """Nothing before the run shows a load (the plan does not need the driver): the first
-    LoadComponents handed over attaches it."""
+    LoadComponents handed over attaches it. A second node of the same name is warned about
+    under the container's name, as launch_ros counts loaded names with the nodes'."""
     path = tmp_path / "opaque.launch.py"
     path.write_text(f"PY = {PY!r}\nRECORDER = {RECORDER!r}\n" + textwrap.dedent(OPAQUE_PY))
     run = start(path, run_env(ros_env, tmp_path))
     try:
-        run.wait_for(r"Loaded node '/opaque' in container '/rec'", 60)
+        run.wait_for(
+            r"\[WARNING\] \[/rec\]: there are now at least 2 nodes with the name /opaque"
+            r" created within this launch context",
+            60,
+        )
     finally:
         code = stop(run)
     assert code == 130, run.text
-    assert [r["plugin_name"] for r in recorded(run)] == ["p::Opaque"]
+    assert run.text.count("Loaded node '/opaque' in container '/rec'") == 2
+    assert [r["plugin_name"] for r in recorded(run)] == ["p::Opaque", "p::Again"]
 
 
 def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(

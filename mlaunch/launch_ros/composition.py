@@ -21,6 +21,7 @@ from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import Substitution, describe, normalize, perform_substitutions
 from mlaunch.launch_ros.actions import Node, make_namespace_absolute
 from mlaunch.launch_ros.composable import ComposableNode
+from mlaunch.launch_ros.node import node_name_counts
 from mlaunch.run.plan import Handoff
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -44,7 +45,7 @@ class LoadComponents(Handoff):
     timer or an event handler), and the LoadNode driver (mlaunch.ros.components) sends the
     requests."""
 
-    __slots__ = ("requests", "target", "written")
+    __slots__ = ("names", "requests", "target", "written")
     _fields = (*Handoff._fields, "target", "requests", "written")
     needs = COMPONENTS  # the run attaches the LoadNode driver (Plan.needs)
 
@@ -54,11 +55,15 @@ class LoadComponents(Handoff):
         target: str = "",
         requests: tuple[LoadRequest, ...] = (),
         written: str = "",
+        names: dict[str, int] | None = None,
     ) -> None:
         self.origin = origin
         self.target = target
         self.requests = requests
         self.written = written
+        # The run's count of node names (launch_ros's), which a load adds to once it succeeds;
+        # not a field: it is the run's shared state, not what the step says.
+        self.names = names
 
     @property
     def container_name(self) -> str:
@@ -168,7 +173,8 @@ class LoadComposableNodes(Action):
         if requests:
             # A relative name is resolved by launch_ros's own node, whose namespace is '/'.
             full = make_namespace_absolute(target) if target else target
-            resolver.add(LoadComponents(self.origin, full, tuple(requests), target))
+            names = node_name_counts(resolver.context)
+            resolver.add(LoadComponents(self.origin, full, tuple(requests), target, names))
 
     def _target_name(self) -> str | None:
         """The container action's full name (None when the target is given as a name)."""

@@ -55,6 +55,24 @@ Subs = tuple[Substitution, ...]
 NODE_NAMES_KEY = "unique_ros_node_names"
 
 
+def node_name_counts(ctx: LaunchContext) -> dict[str, int]:
+    """How many nodes of this run got each full name: launch_ros's count in the context's
+    globals, shared by Nodes and the components loaded into containers."""
+    counts: dict[str, int] | None = ctx.locals.get(NODE_NAMES_KEY)
+    if counts is None:
+        counts = {}
+        ctx.extend_globals({NODE_NAMES_KEY: counts})
+    return counts
+
+
+def same_name_warning(count: int, name: str) -> str:
+    """launch_ros's words for a node name given ``count`` times in one launch."""
+    return (
+        f"there are now at least {count} nodes with the name {name} created within this"
+        " launch context"
+    )
+
+
 class NodeNames(Record):
     """A node's name and namespace as resolved (None: not given, the node's own default)."""
 
@@ -323,16 +341,10 @@ class Node(ExecuteProcess):
         fqn = names.fully_qualified
         if fqn is None:
             return
-        counts: dict[str, int] | None = ctx.locals.get(NODE_NAMES_KEY)
-        if counts is None:
-            counts = {}
-            ctx.extend_globals({NODE_NAMES_KEY: counts})
+        counts = node_name_counts(ctx)
         counts[fqn] = counts.get(fqn, 0) + 1
         if counts[fqn] > 1:
-            ctx.warn(
-                f"{self.origin}: there are now at least {counts[fqn]} nodes with the name {fqn}"
-                " created within this launch context"
-            )
+            ctx.warn(f"{self.origin}: {same_name_warning(counts[fqn], fqn)}")
 
     def describe_short(self) -> str:
         parts = []

@@ -24,6 +24,7 @@ from collections.abc import Callable
 from mlaunch.errors import MlaunchError
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
+from mlaunch.launch_ros.node import same_name_warning
 from mlaunch.record import Record
 from mlaunch.run.events import Event, Exited, HandedOff, Said, ShutdownBegun
 
@@ -77,11 +78,16 @@ class ComponentLoader:
     """
 
     def __init__(
-        self, context: Any, log: Log, finished: Callable[[threading.Thread], None] | None = None
+        self,
+        context: Any,
+        log: Log,
+        finished: Callable[[threading.Thread], None] | None = None,
+        loaded: Callable[[LoadComponents, str], None] | None = None,
     ) -> None:
         self.context = context  # an initialised rclpy Context
         self.log = log
         self.finished = finished
+        self.loaded = loaded  # (step, the node's full name) after each successful load
         self.stop = threading.Event()
         self.results: list[LoadResult] = []
         self._threads: list[threading.Thread] = []
@@ -211,6 +217,8 @@ class ComponentLoader:
         response = future.result()
         name = response.full_node_name or request.node_name
         if response.success:
+            if self.loaded is not None and name:
+                self.loaded(step, name)
             self.log(
                 "INFO",
                 f"Loaded node '{response.full_node_name}' in container '{step.container_name}'",
@@ -261,7 +269,7 @@ class ComponentDriver:
         environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
         context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
-        self.loader = ComponentLoader(context, self._log, self._finished)
+        self.loader = ComponentLoader(context, self._log, self._finished, self._loaded)
         supervisor.events.subscribe(self.on_event)
 
     def on_event(self, event: Event) -> None:
@@ -288,6 +296,20 @@ class ComponentDriver:
             f"container '{target}' exited before it loaded {loads}: the loads wait for its"
             f" '{target}/_container/load_node' service until the launch stops (as launch_ros)",
         )
+
+    def _loaded(self, step: LoadComponents, name: str) -> None:
+        """A component counts among the run's node names, as launch_ros counts it; a second
+        node of the same name is warned about (under the container's name, as launch_ros)."""
+
+        def count() -> None:
+            if step.names is None:
+                return
+            step.names[name] = step.names.get(name, 0) + 1
+            if step.names[name] > 1:
+                warning = same_name_warning(step.names[name], name)
+                self.supervisor.events.emit(Said("WARNING", step.container_name, warning))
+
+        self.loop.call_soon(count)  # the count is the loop thread's, as resolve's
 
     def _finished(self, thread: threading.Thread) -> None:
         self.loop.call_soon(lambda: self.supervisor.done(thread))
