@@ -274,3 +274,19 @@ def test_readme_exit_status_table_is_the_codes() -> None:
     epilog = build_parser().epilog or ""
     for code in (*codes, 130):
         assert re.search(rf"\b{code}\b", epilog), (code, epilog)
+
+
+def test_viewer_on_a_busy_port_says_what_to_change() -> None:
+    """MLAUNCH_VIEWER_PORT is read by the viewer itself: a busy port is its one-line error."""
+    from mlaunch.standins.viewer import DisplayConfig, ViewerError, ViewerState, serve
+
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        with pytest.raises(ViewerError) as caught:
+            serve(ViewerState(DisplayConfig()), port, lambda: 0.0)
+    assert str(caught.value) == (
+        f"cannot listen on 127.0.0.1:{port}: Address already in use; valid: a free port, or 0"
+        " for any free port (mlaunch --viewer-port, or MLAUNCH_VIEWER_PORT)"
+    )
