@@ -13,7 +13,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from procutil import clean_env, demo_package, run_mlaunch
+from procutil import REPO, clean_env, demo_package, run_mlaunch
 
 # bash's default COMP_WORDBREAKS: ':' and '=' break words, as in name:=value.
 BASH_WORDBREAKS = " \t\n\"'><=;|&(:"
@@ -185,3 +185,19 @@ def test_a_launch_never_loads_argcomplete(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "mlaunch.run.supervisor" in done.stderr  # the import log is there
     assert "argcomplete" not in done.stderr and "mlaunch.completion" not in done.stderr
+
+
+def test_setup_turns_completion_on_in_the_venv(tmp_path: Path) -> None:
+    """./scripts/setup hooked argcomplete into .venv's activate: bash completes mlaunch then."""
+    activate = REPO / ".venv" / "bin" / "activate"
+    if not activate.exists():
+        pytest.skip("no .venv here: ./scripts/setup makes it")
+    done = subprocess.run(
+        ["bash", "-c", f"source {activate} && complete -p mlaunch"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env=clean_env(),
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().endswith("-F _python_argcomplete mlaunch"), done.stdout
