@@ -319,7 +319,7 @@ def _table(rows: list[dict[str, object]]) -> str:
             str(r["state"]),
             str(r["pid"] or "-"),
             str(r["restarts"]),
-            _uptime(r["uptime"]),
+            _uptime(r["uptime"], r.get("restart_in")),
             "yes" if r["muted"] else "",
             str(r["outcome"] or ""),
         )
@@ -332,7 +332,9 @@ def _table(rows: list[dict[str, object]]) -> str:
     )
 
 
-def _uptime(value: object) -> str:
+def _uptime(value: object, restart_in: object = None) -> str:
+    if isinstance(restart_in, (int, float)):
+        return f"restart in {restart_in:.1f} s"
     if not isinstance(value, (int, float)):
         return "-"
     from mlaunch.run.status import format_duration

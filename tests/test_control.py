@@ -248,13 +248,16 @@ def test_a_stop_cancels_a_pending_respawn() -> None:
 
     def on_exit(event: Event) -> None:
         if isinstance(event, RespawnScheduled):
+            pending = h.sup.control.info("crash")
+            assert pending.restart_in is not None and 29 < pending.restart_in <= 30
+            assert pending.uptime is None and pending.state == "restarting"
             h.sup.control.stop("crash", done=infos.append)
             h.sup.schedule(0.0, h.shutdown)
 
     h.sup.events.subscribe(on_exit)
     assert h.run() == 0
     assert h.elapsed < 5
-    assert infos and infos[0].state == STOPPED
+    assert infos and infos[0].state == STOPPED and infos[0].restart_in is None
     assert h.sup.records["crash"].state == STOPPED
 
 

@@ -99,10 +99,11 @@ class ProcessInfo:
     """One label as the user sees it: what ``list`` shows and ``done`` callbacks receive.
 
     ``uptime`` is seconds since its current instance started (None when not running);
+    ``restart_in`` seconds until respawn starts it again (None unless one is pending);
     ``outcome`` how it last ended ("" while its first instance runs).
     """
 
-    __slots__ = ("label", "muted", "outcome", "pid", "restarts", "state", "uptime")
+    __slots__ = ("label", "muted", "outcome", "pid", "restart_in", "restarts", "state", "uptime")
 
     def __init__(
         self,
@@ -113,6 +114,7 @@ class ProcessInfo:
         uptime: float | None,
         muted: bool,
         outcome: str,
+        restart_in: float | None = None,
     ) -> None:
         self.label = label
         self.state = state
@@ -121,6 +123,7 @@ class ProcessInfo:
         self.uptime = uptime
         self.muted = muted
         self.outcome = outcome
+        self.restart_in = restart_in
 
     def __repr__(self) -> str:
         return f"ProcessInfo({self.as_dict()!r})"
@@ -177,7 +180,9 @@ class Control:
         record = self.record(label)
         label = record.label
         running = record.state in (RUNNING, STOPPING)
-        uptime = max(0.0, self.supervisor.clock() - record.started_at) if running else None
+        now = self.supervisor.clock()
+        uptime = max(0.0, now - record.started_at) if running else None
+        restart_at = record.restart_at if record.state == RESTARTING else None
         return ProcessInfo(
             label=label,
             state=record.state,
@@ -186,6 +191,7 @@ class Control:
             uptime=uptime,
             muted=self.is_muted(label),
             outcome=record.outcome,
+            restart_in=None if restart_at is None else max(0.0, restart_at - now),
         )
 
     def processes(self) -> list[ProcessInfo]:
