@@ -284,12 +284,15 @@ def write_expected(name: str, summary: dict[str, Any], folder: Path = EXPECTED) 
     (folder / f"{name}.json").write_text(text, encoding="utf-8")
 
 
-def with_known_differences(names: list[str], known: dict[str, str]) -> list[Any]:
-    """Cases as pytest parameters, each known difference a strict xfail with its reason."""
+def with_known_differences(
+    names: list[str], known: dict[str, str], raises: type[BaseException] | None = None
+) -> list[Any]:
+    """Cases as pytest parameters, each known difference a strict xfail with its reason (that
+    fails only by raising ``raises``, when given: any other failure is a failure)."""
     import pytest
 
     return [
-        pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=known[name]))
+        pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=known[name], raises=raises))
         if name in known
         else name
         for name in names

@@ -21,7 +21,11 @@ import harness
 import pytest
 from conftest import requires_rclpy
 
-KNOWN_DIFFERENCES: dict[str, str] = {}
+# Cases whose log lines differ from the reference's on purpose; their requests must still match.
+KNOWN_DIFFERENCES: dict[str, str] = {
+    "ghost.launch.py": "on purpose: at shutdown mlaunch says which loads it abandoned, one line"
+    " each (launch_ros says it once, for the first, naming only the service)",
+}
 
 REFERENCE = harness.reference_environ()
 requires_reference = pytest.mark.skipif(
@@ -36,8 +40,14 @@ requires_composition_interfaces = pytest.mark.skipif(
 pytestmark = [requires_rclpy, requires_composition_interfaces, pytest.mark.timeout(150)]
 
 
+class LogDifference(Exception):
+    """The launcher's log lines differ from the reference's (the requests matched)."""
+
+
 def _cases() -> list[Any]:
-    return harness.with_known_differences(components.case_names(), KNOWN_DIFFERENCES)
+    return harness.with_known_differences(
+        components.case_names(), KNOWN_DIFFERENCES, raises=LogDifference
+    )
 
 
 def _diff(expected: dict[str, Any], actual: dict[str, Any]) -> str:
@@ -67,7 +77,11 @@ def test_mlaunch_matches_reference(case: str, tmp_path: Path, ros_env: dict[str,
         f"no recording for {case}: run tests/conformance/record.py --components {case}"
     )
     actual = components.run_case("mlaunch", case, tmp_path, None, ros_env)
-    assert actual == expected, f"{case} differs from ros2 launch:\n{_diff(expected, actual)}"
+    assert actual["loads"] == expected["loads"], (
+        f"{case}: the requests differ from ros2 launch's:\n{_diff(expected, actual)}"
+    )
+    if actual != expected:
+        raise LogDifference(f"{case} logs otherwise than ros2 launch:\n{_diff(expected, actual)}")
 
 
 @requires_reference
