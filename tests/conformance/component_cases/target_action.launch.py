@@ -1,4 +1,4 @@
-# loads: 4 -- target_container given as the container action (in a pushed namespace, named by a launch argument), loaded from another namespace, a refused load, a skipped LoadComposableNodes, a container whose every node is skipped
+# loads: 5 -- target_container given as the container action (in a pushed namespace, named by a launch argument), loaded from another namespace, a refused load (named and unnamed), a skipped LoadComposableNodes, a container whose every node is skipped
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, GroupAction
 from launch.conditions import IfCondition
@@ -46,6 +46,7 @@ def generate_launch_description():
                                 parameters=[{"container": LaunchConfiguration("container_name")}],
                             ),
                             ComposableNode(package="demo", plugin="demo::Unnamed"),
+                            ComposableNode(package="demo", plugin="demo::Broken"),
                         ],
                     ),
                 ]
