@@ -177,10 +177,11 @@ def test_node_values(env: dict[str, str]) -> None:
     assert args["use_sim"]["choices"] == ["true", "false"] and not args["use_sim"]["given"]
 
 
-def test_argv_is_what_text_print_shows(env: dict[str, str]) -> None:
-    path = str(LAUNCHES / "examples" / "talker_listener.launch.py")
-    document = plan_of(path, env=env)
-    text = run_mlaunch(path, "--print", env=env)
+@pytest.mark.parametrize("path", LAUNCH_FILES, ids=lambda p: str(p.relative_to(LAUNCHES)))
+def test_argv_is_what_text_print_shows(path: Path, env: dict[str, str]) -> None:
+    arguments = REQUIRED_ARGUMENTS.get(path.name, [])
+    document = plan_of(str(path), *arguments, env=env)
+    text = run_mlaunch(str(path), "--print", *arguments, env=env)
     assert text.returncode == 0, text.stderr
     lines = text.stdout.splitlines()
     shown = {
@@ -190,18 +191,18 @@ def test_argv_is_what_text_print_shows(env: dict[str, str]) -> None:
     }
     assert set(shown) == set(processes(document))
     temp = re.compile(r"/tmp/mlaunch-[^/ ]+/launch_params_\w+")
-    compared = 0
     for label, process in processes(document).items():
-        names = [shlex.quote(p) for p in process["argv"] if p.startswith("<run-temp>/")]
+        argv = process["argv"]
+        shell = " ".join(argv) + "   [via /bin/sh -c]"
+        expected = shell if process["shell"] else shlex.join(argv)
+        names = [shlex.quote(p) for p in argv if p.startswith("<run-temp>/")]
         line = _renamed(temp, shown[label], names)
-        expected = shlex.join(process["argv"])
-        if re.search(r"\.\.\. <\d+ chars>$", line):  # the text shortens long command lines
-            head = shown[label].partition("/tmp/mlaunch-")[0]
-            assert expected.startswith(head), label
+        cut = re.search(r"\.\.\. <\d+ chars>$", line)
+        if cut:  # the text shortens long command lines: what it shows up to a temporary path
+            head = line[: cut.start()].partition("<run-temp>/")[0]
+            assert head and expected.startswith(head), label
             continue
         assert line == expected, label
-        compared += 1
-    assert compared >= 2
 
 
 def _renamed(pattern: re.Pattern[str], text: str, names: list[str]) -> str:
@@ -300,19 +301,23 @@ from launch import LaunchDescription
 from launch.actions import ExecuteProcess, LogInfo, RegisterEventHandler, TimerAction, Shutdown
 from launch.event_handlers import OnProcessExit
 from launch_ros.actions import LifecycleNode
+from launch_ros.event_handlers import OnStateTransition
 from mlaunch.ros.lifecycle_sequence import LifecycleSequence
 from mlaunch.smoke import Expect
 
 def generate_launch_description():
     first = ExecuteProcess(cmd=['true'], name='first', on_exit=[LogInfo(msg='bye')])
+    managed = LifecycleNode(package='demo', executable='dump', name='managed', namespace='',
+                            autostart=True)
     return LaunchDescription([
         first,
         RegisterEventHandler(OnProcessExit(target_action=first,
                                            on_exit=[ExecuteProcess(cmd=['echo', 'after'])])),
         TimerAction(period=2.5, actions=[LogInfo(msg='late'), Shutdown(reason='done')]),
-        LifecycleNode(package='demo', executable='dump', name='managed', namespace='',
-                      autostart=True),
+        managed,
         LifecycleSequence(nodes=['managed'], timeout=4),
+        RegisterEventHandler(OnStateTransition(target_lifecycle_node=managed, goal_state='active',
+                                               entities=[LogInfo(msg='up')])),
         Expect(topic='/scan', rate=5.0, within=9),
         LogInfo(msg='now'),
     ])
@@ -333,10 +338,11 @@ def test_deferred_parts_are_shown_as_written(tmp_path: Path, env: dict[str, str]
         "timer",
         "process",
         "lifecycle_sequence",
+        "handler",
         "expectation",
         "log",
     ]
-    first, handler, timer, managed, sequence, expect, log = document["steps"]
+    first, handler, timer, managed, sequence, transition, expect, log = document["steps"]
     assert first["required"] is False
     assert [a["action"] for a in first["on_exit"]["actions"]] == ["LogInfo"]
     assert handler["event"] == "process_exit" and handler["start"] == "deferred"
@@ -347,6 +353,10 @@ def test_deferred_parts_are_shown_as_written(tmp_path: Path, env: dict[str, str]
     assert [a["action"] for a in timer["actions"]] == ["LogInfo", "Shutdown"]
     assert managed["node"]["lifecycle"] and managed["node"]["autostart"]
     assert sequence["nodes"] == ["/managed"] and sequence["timeout"] == 4
+    assert transition["event"] == "state_transition"
+    assert transition["handler"] == "OnStateTransition(goal_state='active')"
+    assert transition["target"].startswith("LifecycleNode(") and not transition["any_process"]
+    assert handler["handler"] == "OnProcessExit"
     assert expect["check"] == "topic" and expect["rate"] == 5.0 and expect["within"] == 9
     assert log["message"] == "now"
     line = DEFERRED.splitlines().index(

@@ -245,12 +245,17 @@ def deferred_data(body: Deferred) -> dict[str, Any]:
 
 
 def _entity(entity: Any) -> dict[str, Any]:
-    describe = getattr(entity, "describe_short", None)
     return {
         "action": type(entity).__name__,
-        "summary": describe() if describe is not None else type(entity).__name__,
+        "summary": _summary(entity),
         "origin": origin_data(getattr(entity, "origin", "") or ""),
     }
+
+
+def _summary(thing: Any) -> str:
+    """An action or handler as written (its describe_short), else its class name."""
+    describe = getattr(thing, "describe_short", None)
+    return str(describe()) if describe is not None else type(thing).__name__
 
 
 def _log(step: Log) -> dict[str, Any]:
@@ -284,6 +289,7 @@ def _handler(step: AddHandler) -> dict[str, Any]:
         "origin": origin_data(step.origin),
         "start": "deferred",
         "event": step.kind,
+        "handler": _summary(step.handler) if step.handler is not None else None,
         "target": described,
         "any_process": step.matcher is None,
         "once": step.once,
