@@ -41,11 +41,10 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.machines.spec import MachineSpec
-    from mlaunch.run.plan import NodeInfo
+    from mlaunch.run.plan import ArgumentInfo, NodeInfo
 
 SCHEMA_ID = "mlaunch-plan/1"
 TEMP_PLACEHOLDER = "<run-temp>"
-FORMATS = ("text", "json")
 # rcl's command line: options that take the next token (mlaunch reads -r, -p and --params-file).
 _ROS_VALUE_OPTIONS = frozenset(
     {"-r", "--remap", "-p", "--param", "--params-file", "--log-level", "-e", "--enclave"}
@@ -96,7 +95,7 @@ def origin_data(origin: str) -> dict[str, Any] | None:
     return {"file": _rel(file), "line": int(line)}
 
 
-def _argument(info: Any, given: Mapping[str, str]) -> dict[str, Any]:
+def _argument(info: ArgumentInfo, given: Mapping[str, str]) -> dict[str, Any]:
     return {
         "name": info.name,
         "value": info.value,
@@ -161,7 +160,7 @@ class _Writer:
             "start": "launch",
             "argv": argv,
             "shell": spec.shell,
-            "launch_prefix": list(getattr(spec, "launch_prefix", ())),
+            "launch_prefix": list(spec.launch_prefix),
             "cwd": spec.cwd,
             "env": _env(spec.env_changes),
             "output": spec.output,
