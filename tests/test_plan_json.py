@@ -533,3 +533,55 @@ def test_every_kind_of_step_can_be_written() -> None:
     assert {"LoadComponents", "SequenceStep", "ExpectStep", "Spawn", "StartTimer"} <= set(seen)
     schema_kinds = load_plan_schema()["$defs"]["step"]["properties"]["kind"]["enum"]  # type: ignore[index]
     assert len(schema_kinds) == len(seen)
+
+
+ODD = """
+from launch import LaunchDescription
+from launch_ros.actions import Node
+from launch_ros.parameter_descriptions import ParameterFile
+
+def generate_launch_description():
+    return LaunchDescription([
+        Node(package='demo', executable='dump', name='odd',
+             parameters=[ParameterFile(FILE), {'when': 'yes'}]),
+    ])
+"""
+
+
+def test_values_json_cannot_spell_stay_valid(tmp_path: Path, env: dict[str, str]) -> None:
+    """Non-finite doubles, nulls, dates and lists no ROS parameter can hold stay valid JSON."""
+    prefix = _package(tmp_path)
+    params = tmp_path / "odd.yaml"
+    params.write_text(
+        "/**:\n  ros__parameters:\n    big: .inf\n    small: -.inf\n    nothing: ~\n"
+        "    day: 2024-01-02\n    mixed: [1, a]\n    nested:\n      deep: .nan\n"
+    )
+    launch = tmp_path / "odd.launch.py"
+    launch.write_text(ODD.replace("FILE", repr(str(params))))
+    document = plan_of(str(launch), env={**env, "AMENT_PREFIX_PATH": str(prefix)})
+    validate(document)
+    (process,) = processes(document).values()
+    shipped, written = process["parameters"]
+    assert shipped["path"] == str(params) and not shipped["temporary"]
+    typed = {p["name"]: (p["value"], p["type"]) for p in shipped["parameters"]}
+    assert typed == {
+        "big": (".inf", "double"),
+        "small": ("-.inf", "double"),
+        "nothing": (None, "not set"),
+        "day": ("2024-01-02", "string"),  # PyYAML reads a date; rcl reads text
+        "mixed": ([1, "a"], "unsupported"),
+        "nested.deep": (".nan", "double"),
+    }
+    assert shipped["contents"]["/**"]["ros__parameters"]["nested"] == {"deep": ".nan"}
+    assert written["temporary"] and written["parameters"][0]["value"] == "yes"
+
+
+def test_an_unreadable_params_file_is_said(tmp_path: Path, env: dict[str, str]) -> None:
+    from mlaunch.run.plan_json import params_file_data
+
+    missing = params_file_data(str(tmp_path / "gone.yaml"), "gone.yaml")
+    assert missing["contents"] is None and "cannot be read" in missing["error"]
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("a: [1,\n")
+    data = params_file_data(str(broken), str(broken))
+    assert data["contents"] is None and data["error"].startswith("not valid YAML")

@@ -401,7 +401,17 @@ def _yaml_value(text: str) -> Any:
 
 def _typed(name: str, value: Any) -> dict[str, Any]:
     """One parameter: its name, its value as JSON data and its ROS type."""
+    value = _as_rcl_reads(value)
     return {"name": name, "value": json_safe(value), "type": type_name(value)}
+
+
+def _as_rcl_reads(value: Any) -> Any:
+    """PyYAML's dates and times as the text they are to rcl, which knows no such type."""
+    if isinstance(value, list):
+        return [_as_rcl_reads(v) for v in value]
+    if value is None or isinstance(value, (bool, int, float, str, dict, tuple)):
+        return value
+    return str(value)
 
 
 def json_safe(value: Any) -> Any:
