@@ -59,7 +59,7 @@ class Options:
         self.color = color
         self.log_max_bytes = log_max_bytes
         self.log_keep = log_keep
-        self.format = "text"  # --format: how --print writes the plan (text or json)
+        self.format = "text"  # --format: how --print and --show-args write (text or json)
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -136,8 +136,8 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         "--format",
         choices=("text", "json"),
         default="text",
-        help="how --print writes the plan: text to read (default), or json for tools"
-        " (the schema: docs/plan-json.md)",
+        help="how --print and --show-args write: text to read (default), or json for tools"
+        " (the schemas: docs/plan-json.md)",
     )
     parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
     parser.add_argument(
@@ -295,8 +295,11 @@ def parse_options(argv: Sequence[str]) -> Options:
     )
     opts.capture = ns.capture_at_definition
     opts.format = ns.format
-    if opts.format != "text" and not opts.print_plan:
-        raise UsageError(f"--format {opts.format} is for --print (-p): the plan as {opts.format}")
+    if opts.format != "text" and not (opts.print_plan or opts.show_args):
+        raise UsageError(
+            f"--format {opts.format} is for --print (-p) and --show-args (-s): the plan or the"
+            f" arguments as {opts.format}"
+        )
     opts.scoped_parameters = ns.scoped_parameters
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):

@@ -29,7 +29,7 @@ from procutil import (
     wait_until,
 )
 
-from mlaunch.schemas import PLAN_SCHEMA, load_plan_schema
+from mlaunch.schemas import ARGUMENTS_SCHEMA, PLAN_SCHEMA, load_plan_schema, load_schema
 
 LAUNCHES = REPO / "launches"
 PREFIX = LAUNCHES / "examples" / "prefix"
@@ -395,7 +395,7 @@ def test_format_json_needs_print(env: dict[str, str]) -> None:
     path = str(LAUNCHES / "examples" / "scoping.launch.py")
     done = run_mlaunch(path, "--format", "json", env=env)
     assert done.returncode == 2
-    assert "--format json is for --print" in done.stderr
+    assert "--format json is for --print (-p) and --show-args (-s)" in done.stderr
     assert "process started" not in done.stdout
 
 
@@ -585,3 +585,25 @@ def test_an_unreadable_params_file_is_said(tmp_path: Path, env: dict[str, str]) 
     broken.write_text("a: [1,\n")
     data = params_file_data(str(broken), str(broken))
     assert data["contents"] is None and data["error"].startswith("not valid YAML")
+
+
+@pytest.mark.parametrize("path", LAUNCH_FILES, ids=lambda p: str(p.relative_to(LAUNCHES)))
+def test_show_args_as_json(path: Path, env: dict[str, str]) -> None:
+    """--show-args --format json validates and lists the arguments the text table lists."""
+    given = REQUIRED_ARGUMENTS.get(path.name, [])
+    done = run_mlaunch(str(path), "--show-args", "--format", "json", *given, env=env)
+    assert done.returncode == 0, done.stderr
+    document = json.loads(done.stdout)
+    schema = load_schema(ARGUMENTS_SCHEMA)
+    jsonschema.Draft202012Validator.check_schema(schema)
+    errors = list(jsonschema.Draft202012Validator(schema).iter_errors(document))
+    assert not errors, errors[0].message
+    text = run_mlaunch(str(path), "--show-args", *given, env=env)
+    rows = text.stdout.splitlines()[4:]
+    names = [row.split()[0].rstrip("*") for row in rows if row.startswith("  ") and row[2] != " "]
+    assert [a["name"] for a in document["arguments"]] == names
+    for argument in document["arguments"]:
+        value = next(
+            (g.partition(":=")[2] for g in given if g.startswith(argument["name"] + ":=")), None
+        )
+        assert argument["value"] == value and argument["given"] == (value is not None)

@@ -145,7 +145,12 @@ def launch(opts: Options, attach: Sequence[Attach]) -> int:
                 infos = collect_arguments(
                     description, path=path, arguments=opts.arguments, environ=os.environ
                 )
-            write_stdout(format_arguments(infos))
+            if opts.format == "json":
+                from mlaunch.run.plan_json import arguments_json
+
+                write_stdout(arguments_json(infos, path, opts.arguments))
+            else:
+                write_stdout(format_arguments(infos))
             return 0
         log_dir = ""
         if not opts.print_plan:

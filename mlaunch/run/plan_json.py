@@ -37,13 +37,14 @@ from mlaunch.run.plan import (
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
-    from collections.abc import Callable, Mapping
+    from collections.abc import Callable, Mapping, Sequence
     from typing import Any
 
     from mlaunch.machines.spec import MachineSpec
     from mlaunch.run.plan import ArgumentInfo, NodeInfo
 
 SCHEMA_ID = "mlaunch-plan/1"
+ARGUMENTS_SCHEMA_ID = "mlaunch-arguments/1"
 TEMP_PLACEHOLDER = "<run-temp>"
 # rcl's command line: options that take the next token (mlaunch reads -r, -p and --params-file).
 _ROS_VALUE_OPTIONS = frozenset(
@@ -58,6 +59,20 @@ def plan_json(
     """The plan document as JSON text (two-space indent, one trailing newline)."""
     document = plan_document(plan, path, given, test)
     return json.dumps(document, indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+
+
+def arguments_json(infos: Sequence[ArgumentInfo], path: str, given: Mapping[str, str]) -> str:
+    """``--show-args --format json``: every argument the file and the files it includes by a
+    path known before running declare (mlaunch.run.resolve.collect_arguments). Nothing is
+    resolved: ``value`` is the command line's or null; ``conditional``: under a condition or
+    in a timer."""
+    arguments = [{**_argument(info, given), "value": given.get(info.name)} for info in infos]
+    document = {
+        "schema": ARGUMENTS_SCHEMA_ID,
+        "launch_file": _rel(path),
+        "arguments": arguments,
+    }
+    return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
 
 
 def plan_document(

@@ -1,6 +1,7 @@
 """The JSON Schemas of what mlaunch writes as data, shipped with the package.
 
-``plan-1.json`` describes ``mlaunch FILE --print --format json`` (docs/plan-json.md). mlaunch
+``plan-1.json`` describes ``mlaunch FILE --print --format json``, ``arguments-1.json``
+``mlaunch FILE --show-args --format json`` (docs/plan-json.md). mlaunch
 never validates its own output at run time (no validator is a dependency); tools and the tests
 read the schema from here.
 """
@@ -9,13 +10,20 @@ from __future__ import annotations
 
 import os
 
-PLAN_SCHEMA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "plan-1.json")
+HERE = os.path.dirname(os.path.abspath(__file__))
+PLAN_SCHEMA = os.path.join(HERE, "plan-1.json")
+ARGUMENTS_SCHEMA = os.path.join(HERE, "arguments-1.json")
+
+
+def load_schema(path: str) -> dict[str, object]:
+    """A JSON Schema of this folder, parsed."""
+    import json
+
+    with open(path, encoding="utf-8") as f:
+        schema: dict[str, object] = json.load(f)
+    return schema
 
 
 def load_plan_schema() -> dict[str, object]:
     """The plan document's JSON Schema, parsed."""
-    import json
-
-    with open(PLAN_SCHEMA, encoding="utf-8") as f:
-        schema: dict[str, object] = json.load(f)
-    return schema
+    return load_schema(PLAN_SCHEMA)
