@@ -337,7 +337,7 @@ def _uptime(value: object, restart_in: object = None) -> str:
         return f"restart in {restart_in:.1f} s"
     if not isinstance(value, (int, float)):
         return "-"
-    from mlaunch.run.status import format_duration
+    from mlaunch.run.summary import format_duration
 
     return format_duration(float(value))
 

@@ -15,10 +15,9 @@ from test_supervision import Harness, make_spec
 
 from mlaunch.run.plan import ProcessSpec, RespawnPolicy
 from mlaunch.run.records import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
-from mlaunch.run.status import (
+from mlaunch.run.status import StatusView, attach_status_view
+from mlaunch.run.summary import (
     ExitSummary,
-    StatusView,
-    attach_status_view,
     format_bytes,
     format_duration,
     render_summary,

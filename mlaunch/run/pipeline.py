@@ -421,10 +421,10 @@ def status_view(run: Run) -> object:
 
 
 class _ExitSummary:
-    """Prints mlaunch.run.status's exit summary at close, importing it only then.
+    """Prints mlaunch.run.summary's exit summary at close, importing it only then.
 
-    mlaunch.run.status (with typing) costs ~1.5 ms, which attaching before the run would spend
-    before the first child starts.
+    Importing it costs start-up time that attaching before the run would spend before the first
+    child starts.
     """
 
     def __init__(self, supervisor: Supervisor, *, quiet: bool) -> None:
@@ -432,7 +432,7 @@ class _ExitSummary:
         self.quiet = quiet
 
     def close(self) -> None:
-        from mlaunch.run.status import ExitSummary
+        from mlaunch.run.summary import ExitSummary
 
         ExitSummary(self.supervisor, quiet=self.quiet).close()
 
