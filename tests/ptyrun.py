@@ -61,6 +61,9 @@ class PtyRun:
 
     def pump(self, timeout: float = 0.05) -> None:
         """Feed the emulator what the program wrote (waiting up to ``timeout`` for some)."""
+        if self.master < 0:
+            select.select([], [], [], timeout)  # hung up: only the wait
+            return
         ready, _, _ = select.select([self.master], [], [], timeout)
         while ready:
             try:
@@ -120,6 +123,11 @@ class PtyRun:
         modes = self.modes()
         return bool(modes & termios.ICANON and modes & termios.ECHO)
 
+    def hang_up(self) -> None:
+        """Close the terminal's window: the program's session gets SIGHUP, reads get nothing."""
+        os.close(self.master)
+        self.master = -1
+
     # --- the end -----------------------------------------------------------------------------
 
     def poll(self) -> int | None:
@@ -157,6 +165,8 @@ class PtyRun:
     def close(self) -> None:
         self.kill()
         for fd in (self.master, self.slave):
+            if fd < 0:
+                continue
             try:
                 os.close(fd)
             except OSError:

@@ -441,3 +441,30 @@ def test_started_in_the_background_the_keys_wait_for_fg(shell: PtyRun, launch_fi
     shell.wait_screen("x stop", what="the help line once in the foreground")
     assert not shell.cooked()
     end_in_shell(shell)
+
+
+def test_a_hung_up_terminal_is_no_longer_read() -> None:
+    """After a hangup the terminal is readable forever with nothing to read: selecting it
+    again would spin the loop through the whole shutdown."""
+    master, slave = os.openpty()
+    h = Harness([])
+    keyboard = Keyboard(h.sup.selector, lambda key: None, fd=slave)
+    keyboard.foreground = lambda: True  # type: ignore[method-assign]
+    try:
+        assert keyboard.start() and keyboard.reading
+        os.close(master)  # the terminal window closes
+        ready = h.sup.selector.select(5)
+        assert [key.fd for key, _ in ready] == [slave]
+        for key, _ in ready:
+            key.data(key.fd)
+        assert not keyboard.reading
+        assert h.sup.selector.select(0) == []
+        keyboard.close()
+    finally:
+        os.close(slave)
+
+
+def test_a_closed_terminal_window_is_a_sighup_shutdown(run: PtyRun) -> None:
+    started(run)
+    run.hang_up()
+    assert run.wait() == 129

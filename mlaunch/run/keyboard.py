@@ -222,9 +222,11 @@ class Keyboard:
         try:
             data = os.read(fd, 1024)
         except OSError:
-            self._read_from_loop(False)  # the terminal went away (hung up)
-            return
-        if not data and not self._partial:
+            data = b""
+        if not data:
+            # Readable yet nothing to read: the terminal hung up (SIGHUP is on its way).
+            # Selecting it again would spin the loop for as long as the shutdown takes.
+            self._read_from_loop(False)
             return
         keys, self._partial = decode(self._partial + data)
         for key in keys:
