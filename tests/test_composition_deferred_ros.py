@@ -385,3 +385,40 @@ def test_a_container_that_dies_with_a_load_in_flight(
         "Abandoning wait for the '/rec/_container/load_node' service, due to shutdown:"
         " node 'b' of type 'p::B' was never loaded"
     ) in run.text
+
+
+def test_a_load_that_raises_ends_the_launch_with_1(ros_env: dict[str, str], tmp_path: Path) -> None:
+    """An integer LoadNode's int64 cannot carry fails when the request is sent: launch's run
+    loop catches the exception, shuts down and exits 1 (checked with the reference)."""
+    path = tmp_path / "raises.launch.py"
+    path.write_text(
+        f"PY = {PY!r}\nRECORDER = {RECORDER!r}\n"
+        + textwrap.dedent(
+            """
+            from launch import LaunchDescription
+            from launch.actions import ExecuteProcess
+            from launch_ros.actions import LoadComposableNodes
+            from launch_ros.descriptions import ComposableNode
+
+
+            def generate_launch_description():
+                return LaunchDescription([
+                    ExecuteProcess(cmd=[PY, RECORDER, '--ros-args', '-r', '__node:=rec'],
+                                   name='rec', output='screen'),
+                    LoadComposableNodes(target_container='/rec', composable_node_descriptions=[
+                        ComposableNode(package='p', plugin='p::A', name='a',
+                                       parameters=[{'x': 2**70}])]),
+                ])
+            """
+        )
+    )
+    run = start(path, run_env(ros_env, tmp_path))
+    try:
+        code = run.finish(60)
+    finally:
+        run.kill()
+    assert code == 1, run.text
+    assert "[ERROR] [launch_ros.actions.load_composable_nodes]: Loading into container '/rec'" in (
+        run.text
+    )
+    assert "shutting down: loading into container '/rec' failed" in run.text

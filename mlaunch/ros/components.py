@@ -11,7 +11,8 @@ does not hold the others back); for each request in order, wait until
 a load that fails is logged with the container's error message and the next one is still sent.
 A pending load keeps an otherwise idle launch running (launch's completion futures); a dead
 container's loads wait for it to serve again. When the launch shuts down every wait is
-abandoned, one line per load never made, and the threads end before the run does.
+abandoned, one line per load never made, and the threads end before the run does. A load that
+raises ends the launch with status 1, as launch's run loop does with the exception.
 
 rclpy and composition_interfaces are imported only when a driver is made.
 """
@@ -21,7 +22,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
-from mlaunch.errors import MlaunchError
+from mlaunch.errors import EXIT_FAILURE, MlaunchError
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.launch_ros.node import same_name_warning
@@ -83,11 +84,13 @@ class ComponentLoader:
         log: Log,
         finished: Callable[[threading.Thread], None] | None = None,
         loaded: Callable[[LoadComponents, str], None] | None = None,
+        failed: Callable[[LoadComponents], None] | None = None,
     ) -> None:
         self.context = context  # an initialised rclpy Context
         self.log = log
         self.finished = finished
         self.loaded = loaded  # (step, the node's full name) after each successful load
+        self.failed = failed  # (step) when sending its requests raised
         self.stop = threading.Event()
         self.results: list[LoadResult] = []
         self._threads: list[threading.Thread] = []
@@ -131,7 +134,9 @@ class ComponentLoader:
         try:
             self.load(step, count)
         except Exception as e:  # a failing rclpy call must not end the thread in silence
-            self.log("ERROR", f"Loading into container '{step.target}' failed: {e}")
+            self.log("ERROR", f"Loading into container '{step.container_name}' failed: {e}")
+            if self.failed is not None:
+                self.failed(step)
         finally:
             with self._lock:
                 self._pending.pop(count, None)
@@ -269,7 +274,9 @@ class ComponentDriver:
         environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
         context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
-        self.loader = ComponentLoader(context, self._log, self._finished, self._loaded)
+        self.loader = ComponentLoader(
+            context, self._log, self._finished, self._loaded, self._failed
+        )
         supervisor.events.subscribe(self.on_event)
 
     def on_event(self, event: Event) -> None:
@@ -310,6 +317,17 @@ class ComponentDriver:
                 self.supervisor.events.emit(Said("WARNING", step.container_name, warning))
 
         self.loop.call_soon(count)  # the count is the loop thread's, as resolve's
+
+    def _failed(self, step: LoadComponents) -> None:
+        """A load raised (a value the message cannot carry, an rclpy failure): as launch, whose
+        run loop catches the exception, the launch shuts down and exits 1."""
+
+        def fail() -> None:
+            supervisor = self.supervisor
+            supervisor.exit_code = max(supervisor.exit_code, EXIT_FAILURE)
+            supervisor.begin_shutdown(f"loading into container '{step.container_name}' failed")
+
+        self.loop.call_soon(fail)
 
     def _finished(self, thread: threading.Thread) -> None:
         self.loop.call_soon(lambda: self.supervisor.done(thread))
