@@ -112,6 +112,8 @@ class ComponentLoader:
         thread = threading.Thread(
             target=self._run, args=(step, count), name=f"load {step.target}", daemon=True
         )
+        # Ended threads are forgotten: a long run with many loads keeps only the live ones.
+        self._threads = [t for t in self._threads if t.is_alive()]
         self._threads.append(thread)
         thread.start()
         return thread
