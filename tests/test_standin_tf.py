@@ -48,7 +48,9 @@ TF_PROBE = textwrap.dedent(
                     "stamp": [t.header.stamp.sec, t.header.stamp.nanosec]}
         return on
 
-    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+    # Depth 100 as tf2's static listener: each static broadcaster latches its own message, and
+    # with depth 1 one that arrives while the other waits to be taken replaces it.
+    latched = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
     node.create_subscription(TFMessage, "/tf_static", keep("/tf_static"), latched)
     node.create_subscription(TFMessage, "/tf", keep("/tf"), 100)

@@ -333,7 +333,9 @@ def subscribe(node: Node, state: ViewerState) -> None:
     # Best effort hears both best-effort (simulated sensors) and reliable publishers.
     node.create_subscription(Odometry, config.odom_topic, on_odom, qos_profile_sensor_data)
     node.create_subscription(LaserScan, config.scan_topic, on_scan, qos_profile_sensor_data)
-    subscribe_tf_and_depth(node, state, latest, qos_profile_sensor_data)
+    # /tf_static has one latched message per broadcaster: depth 100, as tf2's static listener,
+    # so one that arrives while another waits to be taken does not replace it.
+    subscribe_tf_and_depth(node, state, latched(100), qos_profile_sensor_data)
 
 
 def subscribe_tf_and_depth(node: Node, state: ViewerState, latched: Any, sensor: Any) -> None:
