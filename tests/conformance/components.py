@@ -13,7 +13,8 @@ The summary of a run (``summarize``) is what the two launchers must agree on:
   whole: package, plugin, name, namespace, log level, remap rules, parameters and extra
   arguments as [name, ParameterType, value];
 - ``log``: the lines of the launcher's ``launch_ros`` loggers (a load's success or failure,
-  with the container's message), sorted, since loads into different containers race.
+  with the container's message) and its warnings of node names given twice, sorted, since
+  loads into different containers race.
 
 Order across containers is not compared (each container is loaded by its own thread in either
 launcher); the cases send each container's requests from one action, whose order is defined.
@@ -47,6 +48,9 @@ ROS_VARIABLES = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMEN
 # A launcher's launch_ros log line: '[LEVEL] [launch_ros...]: message'.
 _LAUNCH_ROS_LINE = re.compile(r"^\[(INFO|WARNING|ERROR|DEBUG)\] \[(launch_ros[^\]]*)\]: (.*)$")
 _ANSWER = re.compile(r"^(Loaded node '|Failed to load node ')")
+# launch_ros's warning for a node name given twice (under the container's or the node's logger).
+_ANY_LINE = re.compile(r"^\[(INFO|WARNING|ERROR|DEBUG)\] \[([^\]]+)\]: (.*)$")
+_NAME_COUNT = re.compile(r"^there are now at least \d+ nodes with the name ")
 # Deadlines: generous for a loaded 2-core machine; a healthy run takes a few seconds.
 LOAD_DEADLINE = 60.0
 STOP_DEADLINE = 20.0
@@ -208,10 +212,11 @@ def summarize(loads: list[str], text: str) -> dict[str, Any]:
         per_container.setdefault(record.pop("container"), []).append(record)
     log = []
     for raw in text.splitlines():
-        match = _LAUNCH_ROS_LINE.match(raw.rstrip("\r"))
+        match = _LAUNCH_ROS_LINE.match(raw.rstrip("\r")) or _ANY_LINE.match(raw.rstrip("\r"))
         if match:
             level, logger, message = match.groups()
-            log.append(f"{level} [{logger}] {message}")
+            if logger.startswith("launch_ros") or _NAME_COUNT.match(message):
+                log.append(f"{level} [{logger}] {message}")
     return {"loads": per_container, "log": sorted(log)}
 
 

@@ -8,7 +8,9 @@ container's full name, then every field of the request (parameters and extra arg
 their ParameterType and the value of that type). It answers success with a full node name that
 is unique within the container (``namespace/name``, or ``/unnamed_N`` without a name) unless the
 plugin is named by ``--fail PLUGIN`` (repeatable): then success is false with the error message
-``recording container refuses PLUGIN``.
+``recording container refuses PLUGIN``. With ``--echo-names`` the full name is ``namespace/name``
+even when it was given before (as rclcpp's containers do), so a launcher's count of node names
+shows.
 
 It imports only rclpy and composition_interfaces, never mlaunch: it is the witness, the same
 under either launcher.
@@ -67,11 +69,12 @@ def as_record(container, request):
 def main():
     args = rclpy.utilities.remove_ros_args(sys.argv)[1:]
     refused = {args[i + 1] for i, a in enumerate(args[:-1]) if a == "--fail"}
+    echo_names = "--echo-names" in args
     records = os.path.join(os.environ["CONF_RECORD_DIR"], "loads.jsonl")
     rclpy.init(args=sys.argv)
     node = Node("recording_container")
     container = node.get_fully_qualified_name()
-    given = set()
+    given = []  # the full names answered, in order
 
     def on_load(request, response):
         line = (json.dumps(as_record(container, request), sort_keys=True) + "\n").encode()
@@ -86,10 +89,10 @@ def main():
         namespace = (request.node_namespace or "/").rstrip("/")
         name = f"{namespace}/{request.node_name or 'unnamed'}"
         full, n = name, 1
-        while full in given:
+        while full in given and not echo_names:
             n += 1
             full = f"{name}_{n}"
-        given.add(full)
+        given.append(full)
         response.success = True
         response.full_node_name = full
         response.unique_id = len(given)
