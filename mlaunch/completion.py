@@ -13,7 +13,8 @@ What completes where:
 - after a launch file: ``name:=`` for each argument it declares (with its included files', as
   ``--show-args`` lists them), and ``name:=value`` for an argument with choices;
 - options after ``-``, with the subcommand's own for ``mlaunch test`` and ``mlaunch export``;
-- ``mlaunch ctl``: its operations (the labels belong to the live run and are not offered).
+- ``mlaunch ctl``: its operations, then the labels of the run it would talk to (asked over
+  its control socket, as ``mlaunch ctl list``).
 
 Completion never prints: the shell side sends stdout and stderr to /dev/null, and a launch file
 that cannot be read simply completes nothing.
@@ -152,12 +153,26 @@ def ros1_file_completer(prefix: str, parsed_args: Any) -> list[str]:
 
 @quietly
 def ctl_completer(prefix: str, parsed_args: Any) -> list[str]:
-    """``mlaunch ctl``: its operations, until one is given (labels belong to the live run)."""
+    """``mlaunch ctl [RUN] OPERATION LABEL``: the operations, then the live run's labels."""
     from mlaunch.run.control import OPERATIONS
 
-    if any(w in OPERATIONS for w in parsed_args.words or ()):
+    words = list(parsed_args.words or ())
+    at = next((i for i, w in enumerate(words) if w in OPERATIONS), None)
+    if at is None:
+        return [op for op in OPERATIONS if op.startswith(prefix)]
+    if words[at] == "list" or len(words) > at + 1:
         return []
-    return [op for op in OPERATIONS if op.startswith(prefix)]
+    return [label for label in live_labels(words[0] if at else None) if label.startswith(prefix)]
+
+
+def live_labels(run: str | None) -> list[str]:
+    """The labels of the run ``mlaunch ctl`` would talk to (the newest live one by default)."""
+    from mlaunch.ctl import ask, find_run
+    from mlaunch.run.control_socket import PROTOCOL
+
+    answer = ask(find_run(run, os.environ), {"version": PROTOCOL, "op": "list"})
+    processes = answer.get("processes")
+    return [str(p["label"]) for p in processes] if isinstance(processes, list) else []
 
 
 @quietly

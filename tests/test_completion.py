@@ -7,13 +7,14 @@ from ``_ARGCOMPLETE_STDOUT_FILENAME`` as here.
 
 from __future__ import annotations
 
+import signal
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 import pytest
-from procutil import REPO, clean_env, demo_package, run_mlaunch
+from procutil import REPO, Running, clean_env, demo_package, mlaunch, run_mlaunch, wait_for
 
 # bash's default COMP_WORDBREAKS: ':' and '=' break words, as in name:=value.
 BASH_WORDBREAKS = " \t\n\"'><=;|&(:"
@@ -61,7 +62,7 @@ def workspace(tmp_path: Path) -> tuple[Path, dict[str, str]]:
     (here / "dev.launch.py").write_text(DEMO_LAUNCH.replace("'inner.launch.py'", "'none.py'"))
     (here / "launches").mkdir()
     (here / "data.csv").write_text("")
-    env = clean_env(AMENT_PREFIX_PATH=str(prefix))
+    env = clean_env(AMENT_PREFIX_PATH=str(prefix), ROS_LOG_DIR=str(tmp_path / "log"))
     env.pop("MLAUNCH_PACKAGE_PATH", None)
     return here, env
 
@@ -156,6 +157,44 @@ def test_subcommands_and_options(workspace: tuple[Path, dict[str, str]], tmp_pat
     assert complete("mlaunch ctl stop ", here, env, tmp_path) == []
     line = "python3 -m mlaunch test dev.launch.py --expect-t"
     assert complete(line, here, env, tmp_path, start=3) == ["--expect-topic"]
+
+
+TWO_SLEEPERS = f"""\
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+def generate_launch_description():
+    sleep = [{sys.executable!r}, '-c', 'import time; time.sleep(60)']
+    return LaunchDescription([
+        ExecuteProcess(cmd=sleep, name='left'),
+        ExecuteProcess(cmd=sleep, name='right'),
+    ])
+"""
+
+
+def test_ctl_completes_the_live_runs_labels(
+    workspace: tuple[Path, dict[str, str]], tmp_path: Path
+) -> None:
+    here, env = workspace
+    path = here / "two.launch.py"
+    path.write_text(TWO_SLEEPERS)
+    run = Running(mlaunch(str(path)), env=env, cwd=str(here))
+    try:
+        run.wait_for(r"\[right-2\]: process started", timeout=30)
+        # The control socket opens on the loop's first turn: ask until the run answers.
+        labels = wait_for(
+            lambda: complete("mlaunch ctl stop ", here, env, tmp_path) or None,
+            20,
+            "the run's labels",
+        )
+        assert labels == ["left-1", "right-2"]
+        assert complete("mlaunch ctl restart r", here, env, tmp_path) == ["right-2"]
+        assert complete("mlaunch ctl list ", here, env, tmp_path) == []
+        assert complete("mlaunch ctl stop left-1 ", here, env, tmp_path) == []
+    finally:
+        run.signal(signal.SIGINT)
+        run.finish(timeout=20)
+        run.kill()
 
 
 def test_a_broken_launch_file_completes_nothing(
