@@ -114,6 +114,8 @@ def test_selection_moves_and_the_pane_shows_the_selected_process(tmp_path: Path)
     assert view.render().splitlines()[0] == "c-3: running, no output yet"
     keys.press("q")
     assert "> c-3" in view.render()
+    view.color = True  # with colours the selected label is highlighted (reverse video) too
+    assert "\x1b[7m> c-3" in view.render()
     view.close()
 
 

@@ -364,7 +364,8 @@ class StatusView:
                 # A marker as well as the highlight: without colours it is all there is.
                 label = ("> " if label == selected else "  ") + label
             table.add_row(
-                Text(label),
+                # The label cell alone: a whole reversed row shows gaps at the column breaks.
+                Text(label, style="reverse" if record.label == selected else ""),
                 Text(state, style=style),
                 Text(pid),
                 Text(uptime),
@@ -372,7 +373,6 @@ class StatusView:
                 Text(cpu),
                 Text(rss),
                 Text(last, style="dim"),
-                style="reverse" if record.label == selected else None,
             )
         console.print(table)
 
