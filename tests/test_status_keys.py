@@ -470,3 +470,23 @@ def test_a_closed_terminal_window_is_a_sighup_shutdown(run: PtyRun) -> None:
     started(run)
     run.hang_up()
     assert run.wait() == 129
+
+
+def test_a_narrow_terminal_drops_whole_columns_instead_of_cutting_numbers() -> None:
+    h = Harness([])
+    width = [80]
+    view = StatusView(h.sup, size=lambda: (width[0], 30), color=False, sampler=fake_usage)
+    view.enable_keys()
+    h.sup.records["robot_state_publisher-1"] = record(
+        "robot_state_publisher-1", "running", pid=12345
+    )
+    h.sup.records["spawner-2"] = record("spawner-2", "stopped", outcome="stopped by the user")
+    view.usage = fake_usage({12345: []})
+    view.last_line["robot_state_publisher-1"] = b"publishing the robot description"
+    wide = view.render().splitlines()
+    assert wide[1].split() == ["process", "state", "pid", "uptime", "restarts", "cpu"]
+    assert "12345" in wide[3] and "12%" in wide[3] and "stopped by the user" in wide[4]
+    assert all(len(line) <= 79 and "\u2026" not in line for line in wide)
+    width[0] = 120
+    assert "memory" in view.render() and "last output" in view.render()
+    view.close()

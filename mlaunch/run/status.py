@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from mlaunch.run.events import Event, Output
 from mlaunch.run.records import (
@@ -53,6 +53,14 @@ STATE_STYLE = {
     GAVE_UP: "bold red",
     STOPPED: "blue",  # by the user: neither a failure nor the end
 }
+# The table's columns, and which go first when the terminal is too narrow for all of them.
+COLUMNS = (
+    ("process", "left"), ("state", "left"), ("pid", "right"), ("uptime", "right"),
+    ("restarts", "right"), ("cpu", "right"), ("memory", "right"), ("last output", "left"),
+)  # fmt: skip
+DROP_ORDER = (7, 6, 5, 3, 4, 2)
+LAST_OUTPUT_MIN = 12  # narrower, the last output says nothing: the column goes
+COLUMN_GAP = 2
 # Which rows to keep when there are more processes than room: trouble first.
 STATE_ORDER = {FAILED: 0, GAVE_UP: 0, RESTARTING: 1, STOPPING: 2, STOPPED: 2, RUNNING: 3}
 
@@ -351,30 +359,37 @@ class StatusView:
             padding=(0, 1),
             collapse_padding=True,
         )
-        for name, justify in (("process", "left"), ("state", "left"), ("pid", "right"),
-                              ("uptime", "right"), ("restarts", "right"), ("cpu", "right"),
-                              ("memory", "right")):  # fmt: skip
-            table.add_column(name, justify=justify, no_wrap=True)  # type: ignore[arg-type]
-        table.add_column("last output", no_wrap=True, overflow="ellipsis", ratio=1)
+        cells, styles = self._cells(rows, selected)
+        shown = fitting_columns(cells, console.width)
+        for i in shown:
+            name, justify = COLUMNS[i]
+            if name == "last output":
+                table.add_column(name, no_wrap=True, overflow="ellipsis", ratio=1)
+            else:
+                table.add_column(name, justify=justify, no_wrap=True)  # type: ignore[arg-type]
+        for row, (label_style, state_style) in zip(cells, styles, strict=True):
+            # The label cell alone is highlighted: a reversed row shows gaps at column breaks.
+            row_styles = {0: label_style, 1: state_style, 7: "dim"}
+            table.add_row(*(Text(row[i], style=row_styles.get(i, "")) for i in shown))
+        console.print(table)
+
+    def _cells(
+        self, rows: list[tuple[ProcessRecord, str, str, str, str, str, str]], selected: str | None
+    ) -> tuple[list[tuple[str, ...]], list[tuple[str, str]]]:
+        """Each row's cells as text (COLUMNS), and the styles of its label and state."""
+        cells: list[tuple[str, ...]] = []
+        styles: list[tuple[str, str]] = []
         for record, state, pid, uptime, cpu, rss, last in rows:
-            style = STATE_STYLE.get(state, "dim")
             label = record.label
-            state = self._state_text(record)
             if self.keys is not None:
                 # A marker as well as the highlight: without colours it is all there is.
                 label = ("> " if label == selected else "  ") + label
-            table.add_row(
-                # The label cell alone: a whole reversed row shows gaps at the column breaks.
-                Text(label, style="reverse" if record.label == selected else ""),
-                Text(state, style=style),
-                Text(pid),
-                Text(uptime),
-                Text(str(record.restarts)),
-                Text(cpu),
-                Text(rss),
-                Text(last, style="dim"),
+            text = self._state_text(record)
+            cells.append((label, text, pid, uptime, str(record.restarts), cpu, rss, last))
+            styles.append(
+                ("reverse" if record.label == selected else "", STATE_STYLE.get(state, "dim"))
             )
-        console.print(table)
+        return cells, styles
 
     def _print_pane(self, console: Console, label: str, lines: int) -> None:
         """The last lines ``label`` printed, as many as the table's share of the screen."""
@@ -396,6 +411,22 @@ class StatusView:
         if record.label in self.printer.muted:
             state += ", muted"
         return state
+
+
+def fitting_columns(cells: Sequence[Sequence[str]], width: int) -> list[int]:
+    """Which of COLUMNS fit ``width`` whole: on a narrow terminal the least needed go first
+    (last output, then memory, cpu, uptime, restarts, pid) rather than every number being cut.
+    Process and state always stay (a long label is cut instead)."""
+    widths = [
+        max([len(name), *(len(row[i]) for row in cells)]) for i, (name, _) in enumerate(COLUMNS)
+    ]
+    widths[-1] = LAST_OUTPUT_MIN
+    shown = list(range(len(COLUMNS)))
+    for i in DROP_ORDER:
+        if sum(widths[j] for j in shown) + COLUMN_GAP * (len(shown) - 1) <= width:
+            break
+        shown.remove(i)
+    return shown
 
 
 def _printable(raw: bytes, *, strip: bool = True) -> str:
