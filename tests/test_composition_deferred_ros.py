@@ -422,3 +422,54 @@ def test_a_load_that_raises_ends_the_launch_with_1(ros_env: dict[str, str], tmp_
         run.text
     )
     assert "shutting down: loading into container '/rec' failed" in run.text
+
+
+SMOKE_PY = """
+    from launch import LaunchDescription
+    from launch.actions import TimerAction
+    from launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
+    from launch_ros.descriptions import ComposableNode
+
+
+    def generate_launch_description():
+        box = ComposableNodeContainer(
+            package='rclcpp_components', executable='component_container', name='tbox',
+            namespace='')
+        return LaunchDescription([
+            box,
+            TimerAction(period=0.5, actions=[
+                LoadComposableNodes(target_container=box, composable_node_descriptions=[
+                    ComposableNode(package='robot_state_publisher',
+                                   plugin='robot_state_publisher::RobotStatePublisher',
+                                   name='rsp', parameters=[{'robot_description': URDF}]),
+                    ComposableNode(package='composition', plugin='composition::Talker',
+                                   name='talker'),
+                ]),
+            ]),
+        ])
+"""
+
+
+def test_mlaunch_test_expects_the_nodes_a_timer_loads(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """mlaunch test treats components loaded later as nodes the graph must show: the one the
+    stand-in hosts passes, the plugin it refuses fails the test."""
+    import subprocess
+
+    path = tmp_path / "smoke.launch.py"
+    path.write_text(f"URDF = {URDF!r}\n" + textwrap.dedent(SMOKE_PY))
+    done = subprocess.run(
+        mlaunch("test", str(path), "--timeout", "10"),
+        capture_output=True,
+        text=True,
+        env=run_env(ros_env, tmp_path),
+        timeout=120,
+    )
+    out = done.stdout + done.stderr
+    assert done.returncode == 1, out
+    rows = [line.split(None, 1) for line in out.splitlines() if "is in the ROS graph" in line]
+    ok = [rest for status, rest in rows if status == "ok"]
+    failed = [rest for status, rest in rows if status == "FAIL"]
+    assert any("node /rsp is in the ROS graph" in r for r in ok), out
+    assert [r for r in failed if "node /talker is in the ROS graph" in r], out

@@ -10,7 +10,7 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.run.events import Event, Exited, Output, Started
+from mlaunch.run.events import Event, Exited, HandedOff, Output, Started
 from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
@@ -75,10 +75,7 @@ class SmokeRun:
         supervisor.events.subscribe(self._on_event)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
         if any(e.kind in GRAPH_KINDS for e in expectations):
-            self._checker = threading.Thread(
-                target=self._check_graph, name="mlaunch-test-graph", daemon=True
-            )
-            self._checker.start()
+            self._start_checker()
 
     def elapsed(self) -> float:
         return self.supervisor.clock() - self.started_at
@@ -97,6 +94,8 @@ class SmokeRun:
             self._on_process(True, event.process)
         elif isinstance(event, Outcome):
             self._on_transition(event)
+        elif isinstance(event, HandedOff):
+            self._on_handoff(event.step)
 
     def _on_output(self, label: str, data: bytes) -> None:
         lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
@@ -128,6 +127,40 @@ class SmokeRun:
                 self._met(e, f"running (pid {process.pid})")
             return
         self._exited(e, process)
+
+    def _on_handoff(self, step: object) -> None:
+        """Components loaded later (a timer's or a handler's loads) are nodes the graph must
+        show, as the plan's are; the plan's own are expected already."""
+        names = getattr(step, "component_names", None)
+        if names is None or self.phase == "done":
+            return
+        keys = {e.key() for e in self.expectations}
+        target = getattr(step, "target", "")
+        labels = [
+            p.label
+            for p in self.supervisor.processes
+            if p.spec.node is not None and p.spec.node.fully_qualified_name == target
+        ]
+        added = False
+        for name in names():
+            if ("node", name) not in keys:
+                e = Expectation("node", name, origin="loaded later", labels=labels)
+                self.expectations.insert(len(self.expectations) - 1, e)  # before 'shutdown'
+                added = True
+        if added and (self._checker is None or not self._checker.is_alive()):
+            self._start_checker()
+
+    def _checker_ended(self, thread: threading.Thread) -> None:
+        """The checker found nothing left to check; start it again if something came since
+        (and no newer checker took over)."""
+        if self._checker is thread and self._graph_expectations() and not self._stop.is_set():
+            self._start_checker()
+
+    def _start_checker(self) -> None:
+        self._checker = threading.Thread(
+            target=self._check_graph, name="mlaunch-test-graph", daemon=True
+        )
+        self._checker.start()
 
     def _exited(self, e: Expectation, process: Process) -> None:
         from mlaunch.run.process import describe_status
@@ -265,6 +298,9 @@ class SmokeRun:
                 ]
             self.loop.call_soon(lambda f=findings: self._apply(f))  # type: ignore[misc]
             if not self._graph_expectations():
+                # A component loaded later may add one as this thread ends: the loop looks.
+                me = threading.current_thread()
+                self.loop.call_soon(lambda me=me: self._checker_ended(me))  # type: ignore[misc]
                 return
             self._stop.wait(GRAPH_PERIOD)
 
