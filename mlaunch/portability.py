@@ -176,6 +176,14 @@ class _Walker:
                 f" write {name}: {text.lower()} (a YAML boolean, unquoted)",
                 attr,
             )
+        if kind == "bool" and name == "allow_substs" and quoted:
+            self.add(
+                e,
+                f"Jazzy's param takes allow_substs {text!r} in YAML as substitutions, which its"
+                " ParameterFile refuses (a TypeError); write allow_substs: true or false (a YAML"
+                " boolean, unquoted)",
+                attr,
+            )
         if kind == "respawn" and "$(" not in text and not reads_as_bool(text):
             self.add(
                 e,

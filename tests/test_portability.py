@@ -45,6 +45,12 @@ BAD = {
         "launch:\n- set_parameter: {name: p, value: 1}\n",
         "'value' as text",
     ),
+    "yaml_text_allow_substs": (
+        "a.launch.yaml",
+        "launch:\n- node:\n    pkg: conf_pkg\n    exec: recorder\n    param:\n"
+        "    - {from: /dev/null, allow_substs: 'true'}\n",
+        "a YAML boolean, unquoted",
+    ),
     "xml_respawn_on_failure": (
         "a.launch.xml",
         '<launch><executable cmd="/bin/true" respawn="on-failure"/></launch>',
