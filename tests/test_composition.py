@@ -208,6 +208,34 @@ def test_a_value_loadnode_cannot_carry_is_a_clear_error(prefix: Path) -> None:
         plan_of(LaunchDescription([load]), None, prefix)
 
 
+def test_a_params_files_text_use_sim_time_is_sent_as_launch_ros_sends_it(
+    tmp_path: Path, prefix: Path
+) -> None:
+    """Written in the launch file it is an error (every node rejects it); read from a params
+    file it goes out as written, and the container refuses that one load (conformance case
+    nav2_like)."""
+    params = tmp_path / "p.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    use_sim_time: $(var x)\n")
+    load = LoadComposableNodes(
+        target_container="c",
+        composable_node_descriptions=[
+            ComposableNode(package="p", plugin="p::P", name="n", parameters=[str(params)])
+        ],
+    )
+    ((_, (request,)),) = loads(plan_of(LaunchDescription([load]), None, prefix))
+    assert request.parameters == (p("use_sim_time", STRING, "$(var x)"),)
+    written = LoadComposableNodes(
+        target_container="c",
+        composable_node_descriptions=[
+            ComposableNode(
+                package="p", plugin="p::P", name="n", parameters=[{"use_sim_time": "maybe"}]
+            )
+        ],
+    )
+    with pytest.raises(MlaunchError, match="use_sim_time"):
+        plan_of(LaunchDescription([written]), None, prefix)
+
+
 @pytest.mark.parametrize("field", ["parameters", "extra_arguments"])
 def test_a_parameter_description_is_refused_as_launch_ros_fails_on_it(
     field: str, tmp_path: Path, prefix: Path

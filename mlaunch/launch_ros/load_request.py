@@ -223,7 +223,9 @@ def _file_section(context: LaunchContext, path: Path, key: str) -> dict[str, Any
         raise SubstitutionFailure(
             f"parameter file {str(path)!r}: ros__parameters of {key!r} is not a mapping"
         )
-    return params.evaluate_dict(context, params.normalize_dict(chosen))
+    # A file's use_sim_time goes out as written: launch_ros does not check it (nor does mlaunch
+    # for a Node's params file, which the node reads itself); the container answers the load.
+    return params.evaluate_dict(context, params.normalize_dict(chosen), check_clock=False)
 
 
 def _sections(data: dict[Any, Any], keys: list[str], out: dict[str, Any]) -> dict[str, Any]:

@@ -183,8 +183,14 @@ def _kind(item: Any, name: Subs) -> type:
 # --- evaluation -----------------------------------------------------------------------------
 
 
-def evaluate_dict(context: LaunchContext, params: NormalizedDict) -> dict[str, Any]:
-    """Names performed, values typed: the dict written to a params file."""
+def evaluate_dict(
+    context: LaunchContext, params: NormalizedDict, *, check_clock: bool = True
+) -> dict[str, Any]:
+    """Names performed, values typed: the dict written to a params file.
+
+    ``check_clock=False`` passes a use_sim_time that is not a boolean on, as ROS 2 does: for the
+    contents of a params file, which reach a Node unread and a component in its LoadNode request
+    (the container refuses that one load, with its message)."""
     out: dict[str, Any] = {}
     for raw_name, value in params.items():
         name = perform_substitutions(context, raw_name)
@@ -195,7 +201,7 @@ def evaluate_dict(context: LaunchContext, params: NormalizedDict) -> dict[str, A
                 e.message = f"parameter {name!r}: {e.message}"
                 e.args = (e.message,)
             raise
-        if name == USE_SIM_TIME and not isinstance(out[name], bool):
+        if check_clock and name == USE_SIM_TIME and not isinstance(out[name], bool):
             raise _not_a_clock_switch(context, value, out[name])
     return out
 
