@@ -19,7 +19,7 @@ from typing import IO
 import pytest
 from procutil import wait_until
 
-from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 
 PY = sys.executable
 
@@ -136,10 +136,10 @@ class Mlaunch:
 
 def assert_nothing_left(run_id: str, pids: list[int], timeout: float = 10.0) -> None:
     def clean() -> bool:
-        return not any(alive(pid) for pid in pids) and not guards.marked(run_id)
+        return not any(alive(pid) for pid in pids) and not proctable.marked(run_id)
 
     ok = wait_until(clean, timeout)
-    leftovers = [pid for pid in pids if alive(pid)] + [p.pid for p in guards.marked(run_id)]
+    leftovers = [pid for pid in pids if alive(pid)] + [p.pid for p in proctable.marked(run_id)]
     for pid in leftovers:
         try:
             os.kill(pid, signal.SIGKILL)

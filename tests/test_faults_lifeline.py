@@ -252,6 +252,7 @@ def test_the_marker_scan_finds_a_process_in_the_middle_of_exec() -> None:
     # While a process runs execve() its environment reads empty for a moment; a sweep that
     # looked just then used to miss a stray (setsid here is exec'ing sleep when it is scanned).
     from mlaunch.run import guard as guards
+    from mlaunch.run import proctable
 
     run_id = guards.new_run_id()
     env = dict(os.environ, MLAUNCH_RUN_ID=run_id)
@@ -262,8 +263,8 @@ def test_the_marker_scan_finds_a_process_in_the_middle_of_exec() -> None:
         )
         assert sh.stdout is not None
         pid = int(sh.stdout.readline())
-        info = guards.proc_info(pid)  # looked at first, at once: the race is in the first ms
-        if info is not None and not guards.marked(run_id, [info]):
+        info = proctable.proc_info(pid)  # looked at first, at once: the race is in the first ms
+        if info is not None and not proctable.marked(run_id, [info]):
             missed.append(pid)
         sh.wait()
         os.kill(pid, signal.SIGKILL)

@@ -26,6 +26,7 @@ from procutil import wait_until
 from test_supervision import Harness, gone, make_spec
 
 from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 from mlaunch.run.events import Event, Output
 from mlaunch.run.output import Printer
 from mlaunch.run.plan import Plan, Spawn
@@ -266,10 +267,10 @@ def test_tree_finds_descendants_at_any_depth() -> None:
     try:
         assert p.stdout is not None
         grandchild = int(p.stdout.readline())
-        found = {proc.pid: proc for proc in guards.tree(os.getpid())}
+        found = {proc.pid: proc for proc in proctable.tree(os.getpid())}
         assert p.pid in found and grandchild in found
         assert found[grandchild].ppid == p.pid
-        assert {q.pid for q in guards.descendants(os.getpid())} >= {p.pid, grandchild}
+        assert {q.pid for q in proctable.descendants(os.getpid())} >= {p.pid, grandchild}
     finally:
         p.kill()
         os.kill(grandchild, signal.SIGKILL)
@@ -278,13 +279,13 @@ def test_tree_finds_descendants_at_any_depth() -> None:
 
 def counting_marker_scans(monkeypatch: object) -> list[str]:
     calls: list[str] = []
-    original = guards.marked
+    original = proctable.marked
 
-    def marked(run_id: str, procs: object = None) -> list[guards.ProcInfo]:
+    def marked(run_id: str, procs: object = None) -> list[proctable.ProcInfo]:
         calls.append(run_id)
         return original(run_id, procs)  # type: ignore[arg-type]
 
-    monkeypatch.setattr(guards, "marked", marked)  # type: ignore[attr-defined]
+    monkeypatch.setattr(proctable, "marked", marked)  # type: ignore[attr-defined]
     return calls
 
 

@@ -20,7 +20,7 @@ from pathlib import Path
 import pytest
 from procutil import wait_until
 
-from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 from mlaunch.run.events import Event, Exited, Output, Started
 from mlaunch.run.logfiles import LogFile
 from mlaunch.run.output import Printer
@@ -147,7 +147,7 @@ class Harness:
         finally:
             self.elapsed = time.monotonic() - start
             self.printer.flush()
-            left = guards.marked(self.sup.run_id)
+            left = proctable.marked(self.sup.run_id)
             for proc in left:
                 os.kill(proc.pid, signal.SIGKILL)
             assert not left, f"processes of the run left behind: {left}"

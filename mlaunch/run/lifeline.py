@@ -29,6 +29,7 @@ import time
 
 from mlaunch.errors import exit_for_signal
 from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -74,10 +75,10 @@ class Lifeline:
     def __enter__(self) -> Lifeline:
         for sig in STOP_SIGNALS:
             self._old_handlers[sig] = signal.signal(sig, self._on_signal)
-        self._old_marker = self.environ.get(guards.MARKER)
+        self._old_marker = self.environ.get(proctable.MARKER)
         # Inherited by every process started from now on: Command substitutions, a launch
         # file's own subprocesses and their descendants, whatever session they move to.
-        self.environ[guards.MARKER] = self.run_id
+        self.environ[proctable.MARKER] = self.run_id
         self.temp_dir = private_temp_dir()
         from mlaunch.run.cgroup import RunCgroup
 
@@ -137,9 +138,9 @@ class Lifeline:
                 self.guard.close()  # goodbye: mlaunch has ended what it started
         finally:
             if self._old_marker is None:
-                self.environ.pop(guards.MARKER, None)
+                self.environ.pop(proctable.MARKER, None)
             else:
-                self.environ[guards.MARKER] = self._old_marker
+                self.environ[proctable.MARKER] = self._old_marker
             for sig, handler in self._old_handlers.items():
                 signal.signal(sig, handler)  # type: ignore[arg-type]
 
@@ -153,7 +154,7 @@ def end_leftovers(
     Returns how many processes there were.
     """
     me = os.getpid()
-    found = {p.pid for p in guards.marked(run_id)}
+    found = {p.pid for p in proctable.marked(run_id)}
     if cgroup is not None:
         found.update(cgroup.members())
     first = [pid for pid in found if pid != me and pid not in exclude]
@@ -173,7 +174,7 @@ def end_leftovers(
 
 
 def _alive(pid: int) -> bool:
-    info = guards.proc_info(pid)
+    info = proctable.proc_info(pid)
     return info is not None and not info.zombie
 
 

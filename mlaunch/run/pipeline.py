@@ -255,7 +255,7 @@ def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
     if not remote_machines(labels):
         return None
     from mlaunch.machines.remote import Spawner
-    from mlaunch.run.guard import MARKER
+    from mlaunch.run.proctable import MARKER
 
     return Spawner(os.environ, {MARKER: run_id})
 

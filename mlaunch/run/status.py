@@ -230,7 +230,7 @@ class StatusView:
 
     def _groups(self) -> dict[int, list[int]]:
         """Living members of each running process's group (one /proc scan for all)."""
-        from mlaunch.run.guard import scan
+        from mlaunch.run.proctable import scan
 
         running = {p.pid for p in self.supervisor.processes if p.running}
         groups: dict[int, list[int]] = {pgid: [] for pgid in running}

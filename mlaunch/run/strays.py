@@ -18,7 +18,7 @@ import signal
 import time
 from collections.abc import Callable, Iterable
 
-from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -117,7 +117,7 @@ class Strays:
 
     def find(
         self, ours: Iterable[int], skip: int | None, *, thorough: bool = False
-    ) -> list[guards.ProcInfo]:
+    ) -> list[proctable.ProcInfo]:
         """Processes of the run outside our own children (``ours``): descendants, and marked ones.
 
         The walk down our process tree is cheap and, as subreaper, sees every descendant that
@@ -125,17 +125,17 @@ class Strays:
         environment (~ms), so it is made only when something may have escaped the walk.
         ``skip``: the guard's pid.
         """
-        found: dict[int, guards.ProcInfo] = {}
+        found: dict[int, proctable.ProcInfo] = {}
         if self.subreaper or self.adopt:
-            found.update((p.pid, p) for p in guards.tree(os.getpid()))
+            found.update((p.pid, p) for p in proctable.tree(os.getpid()))
         if thorough or not self.subreaper or self.escaped:
-            found.update((p.pid, p) for p in guards.marked(self.run_id))
+            found.update((p.pid, p) for p in proctable.marked(self.run_id))
         if self.cgroup is not None:
             # Whatever it did (a daemon that cleared its environment and left before we
             # were subreaper), a process of the run is in its cgroup.
             me = os.getpid()
             for pid in self.cgroup.members():
-                info = guards.proc_info(pid) if pid != me and pid not in found else None
+                info = proctable.proc_info(pid) if pid != me and pid not in found else None
                 if info is not None and not info.zombie:
                     found[pid] = info
         if skip is not None:

@@ -34,6 +34,7 @@ from collections.abc import Callable
 
 from mlaunch.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
 from mlaunch.run import guard as guards
+from mlaunch.run import proctable
 from mlaunch.run.events import (
     Completed,
     Event,
@@ -163,7 +164,7 @@ class Supervisor(Stopping):
         self._stop_presses = 0
         self._skipped = 0  # starts a description asked for while shutting down
         self._kill_now = False
-        self._marker_env = {guards.MARKER: self.run_id}
+        self._marker_env = {proctable.MARKER: self.run_id}
         # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
         self._awaited: set[int] = set()
         # Work attached parts do outside the loop (composable node loads): keeps the run alive.
