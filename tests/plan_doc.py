@@ -4,6 +4,7 @@ validating it against the shipped schema, and a demo package whose program repor
 from __future__ import annotations
 
 import json
+import os
 import re
 import sys
 import textwrap
@@ -50,6 +51,12 @@ def validate(document: dict[str, Any]) -> None:
     validator = jsonschema.Draft202012Validator(load_plan_schema())
     errors = sorted(validator.iter_errors(document), key=lambda e: list(e.path))
     assert not errors, "\n".join(f"{list(e.path)}: {e.message[:300]}" for e in errors[:5])
+
+
+def absolute_origin(origin: dict[str, Any]) -> dict[str, Any]:
+    """An origin with its file made absolute: the JSON writes it relative to the current folder
+    when that climbs less than two folders, which depends on where the checkout is (/tmp/x in CI)."""
+    return {**origin, "file": os.path.abspath(origin["file"])}
 
 
 def processes(document: dict[str, Any]) -> dict[str, dict[str, Any]]:
