@@ -79,6 +79,16 @@ def recorded(proc: Proc, count: int) -> Callable[[], bool]:
     return check
 
 
+def stalled(container: Proc, lines: list[tuple[str, str]]) -> str:
+    """Why the loads did not finish: what the container received and said, what the driver said."""
+    received = container.stdout().splitlines()
+    return (
+        f"the loads did not finish within 30 s; the container received {len(received)}"
+        f" requests (last: {received[-1:]}), its stderr ends {container.stderr()[-1500:]!r};"
+        f" the driver said {lines}"
+    )
+
+
 @pytest.mark.parametrize("suffix", ["py", "xml", "yaml"])
 def test_the_recording_container_receives_launch_ros_requests(
     suffix: str, prefix: Path, spawn: Callable[..., Proc], loader: Any
@@ -101,7 +111,7 @@ def test_the_recording_container_receives_launch_ros_requests(
     steps = [s for s in plan.steps if isinstance(s, LoadComponents)]
     for step in steps:
         driver.start(step)
-        assert driver.join(30.0), "the loads did not finish within 30 s"
+        assert driver.join(30.0), stalled(container, lines)
     want = [as_lists(r) for _, requests in EXPECTED for r in requests]
     assert wait_until(recorded(container, len(want)), 10), "the recorded requests"
     got = [json.loads(line) for line in container.stdout().splitlines()]
