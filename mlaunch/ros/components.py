@@ -43,6 +43,16 @@ LOGGER = "launch_ros.actions.load_composable_nodes"
 # How often a wait looks at the container again; a stop ends a wait at once.
 POLL = 0.1
 
+# How long a client lets discovery settle after it first sees the container's service, before
+# its first request. Seeing the service means this side has matched the container's endpoints;
+# the container may not yet have matched this client's response reader, and Fast DDS then drops
+# the answer after the container has loaded the node ("failed to send response (timeout): client
+# will not receive response", the container waiting only 100 ms for the match). The load is
+# made but its answer never comes, and sending again would load the node twice. Seen about once
+# in four full test suites on an idle 2-core machine; waiting here costs each step this much
+# once, while a lost answer costs the launch its component.
+DISCOVERY_SETTLE = 0.5
+
 
 class LoadResult(Record):
     """What a container answered to one request."""
@@ -98,6 +108,8 @@ class ComponentLoader:
         self._count = 0
         # The requests of each running step not answered yet, first one next.
         self._pending: dict[int, tuple[str, list[LoadRequest]]] = {}
+        # When each client (by id) first saw its service, for the discovery settle.
+        self._seen: dict[int, float] = {}
 
     def start(self, step: LoadComponents) -> threading.Thread:
         """Load ``step`` in a new thread (returned, so a caller can join it).
@@ -167,6 +179,7 @@ class ComponentLoader:
             enable_rosout=False,
         )
         results: list[LoadResult] = []
+        client = None
         try:
             client = node.create_client(LoadNode, step.service)
             for request in step.requests:
@@ -181,6 +194,7 @@ class ComponentLoader:
                         self.results.append(result)
         finally:
             node.destroy_node()
+            self._seen.pop(id(client), None)  # the id may be reused by a later client
         return results
 
     def _stopping(self) -> bool:
@@ -190,7 +204,9 @@ class ComponentLoader:
         """Wait until the container serves load_node; False (said) once the launch stops."""
         while not self._stopping():
             if client.service_is_ready():
-                return True
+                if self._settled(client):
+                    return True
+                continue
             self.stop.wait(POLL)
         self.log(
             "WARNING",
@@ -198,6 +214,21 @@ class ComponentLoader:
             f" {describe_load(request)} was never loaded",
         )
         return False
+
+    def _settled(self, client: Any) -> bool:
+        """True once ``client`` has seen its service for DISCOVERY_SETTLE seconds (see there).
+
+        Waits out what is left of it (a stop ends the wait at once); later requests of the same
+        client go at once.
+        """
+        import time
+
+        seen = self._seen.setdefault(id(client), time.monotonic())
+        left = seen + DISCOVERY_SETTLE - time.monotonic()
+        if left > 0:
+            self.stop.wait(left)
+            return False
+        return True
 
     def _call(
         self, node: Any, client: Any, request: LoadRequest, step: LoadComponents
