@@ -207,6 +207,7 @@ class ComponentLoader:
                 if self._settled(client):
                     return True
                 continue
+            self._seen.pop(id(client), None)  # a container that comes back settles again
             self.stop.wait(POLL)
         self.log(
             "WARNING",
