@@ -13,11 +13,11 @@ import os
 import shutil
 import socket
 import subprocess
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from procutil import wait_until
 
 SSHD = shutil.which("sshd") or ("/usr/sbin/sshd" if os.path.exists("/usr/sbin/sshd") else None)
 HOST_ALIAS = "mltest"
@@ -64,16 +64,17 @@ def _free_port() -> int:
 
 
 def _wait_listening(address: str, port: int, process: subprocess.Popen[bytes], log: Path) -> None:
-    deadline = time.monotonic() + START_DEADLINE
-    while time.monotonic() < deadline:
+    def listening() -> bool:
         if process.poll() is not None:
             raise RuntimeError(f"sshd exited at start: {log.read_text()}")
         try:
             with socket.create_connection((address, port), timeout=0.2):
-                return
+                return True
         except OSError:
-            time.sleep(0.02)
-    raise RuntimeError(f"sshd did not listen on port {port} within {START_DEADLINE} s")
+            return False
+
+    if not wait_until(listening, START_DEADLINE):
+        raise RuntimeError(f"sshd did not listen on port {port} within {START_DEADLINE} s")
 
 
 def start(

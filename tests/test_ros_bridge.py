@@ -327,13 +327,14 @@ def test_sigint_just_before_spin_exits_0(ros_env: dict[str, str], tmp_path: Path
     try:
         started = [children.start(f"i{n}", "introspect.py") for n in range(3)]
         pending = list(started)
-        deadline = time.monotonic() + STARTUP
-        while pending and time.monotonic() < deadline:
+
+        def all_printed() -> bool:
             for child in [c for c in pending if c.out().endswith("\n")]:
                 child.proc.send_signal(signal.SIGINT)
                 pending.remove(child)
-            time.sleep(0.005)
-        assert not pending, "introspect printed no JSON line"
+            return not pending
+
+        assert wait_until(all_printed, STARTUP, interval=0.005), "introspect printed no JSON line"
         for child in started:
             assert child.proc.wait(timeout=5) == 0, child.err()
             assert "Traceback" not in child.err(), child.err()
