@@ -26,6 +26,7 @@ import time
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from mlaunch.ros.discovery import Settling
 from mlaunch.ros.graph_types import (
     INSTALL_HINT,
     NODE_NAME,
@@ -90,6 +91,7 @@ class RosGraph:
         self._pending: list[TopicWatch] = []
         self._poll_timer: Any = None
         self._clients: dict[str, Any] = {}
+        self._settling = Settling()  # per service: when its client first saw it
         self._calls: list[PendingCall] = []
         self._transition_callbacks: dict[str, list[Callable[[TransitionEvent], None]]] = {}
 
@@ -465,10 +467,14 @@ class RosGraph:
         ready = self.wait_for(lambda _g: client.service_is_ready(), deadline - time.monotonic())
         self._require_running()  # closed meanwhile: say so, not "service not available"
         if not ready:
+            self._settling.forget(service)  # a server that comes back settles again
             raise RosTimeout(
                 f"service {service} not available within {timeout:g} s: "
                 "is the node running, and is it a managed (lifecycle) node?"
             )
+        left = self._settling.left(service)  # let the server match our reader (ros.discovery)
+        if left > 0:
+            self.wait_for(lambda _g: False, min(left, max(0.0, deadline - time.monotonic())))
         call = PendingCall(client.call_async(request), threading.Event())
         call.future.add_done_callback(lambda _f: call.done.set())
         with self._lock:

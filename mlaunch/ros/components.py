@@ -27,6 +27,7 @@ from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.launch_ros.node import same_name_warning
 from mlaunch.record import Record
+from mlaunch.ros.discovery import Settling
 from mlaunch.run.events import Event, Exited, HandedOff, Said, ShutdownBegun
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -42,16 +43,6 @@ LOGGER = "launch_ros.actions.load_composable_nodes"
 
 # How often a wait looks at the container again; a stop ends a wait at once.
 POLL = 0.1
-
-# How long a client lets discovery settle after it first sees the container's service, before
-# its first request. Seeing the service means this side has matched the container's endpoints;
-# the container may not yet have matched this client's response reader, and Fast DDS then drops
-# the answer after the container has loaded the node ("failed to send response (timeout): client
-# will not receive response", the container waiting only 100 ms for the match). The load is
-# made but its answer never comes, and sending again would load the node twice. Seen about once
-# in four full test suites on an idle 2-core machine; waiting here costs each step this much
-# once, while a lost answer costs the launch its component.
-DISCOVERY_SETTLE = 0.5
 
 
 class LoadResult(Record):
@@ -108,8 +99,8 @@ class ComponentLoader:
         self._count = 0
         # The requests of each running step not answered yet, first one next.
         self._pending: dict[int, tuple[str, list[LoadRequest]]] = {}
-        # When each client (by id) first saw its service, for the discovery settle.
-        self._seen: dict[int, float] = {}
+        # When each client (by id) first saw its service (mlaunch.ros.discovery).
+        self._settling = Settling()
 
     def start(self, step: LoadComponents) -> threading.Thread:
         """Load ``step`` in a new thread (returned, so a caller can join it).
@@ -194,7 +185,7 @@ class ComponentLoader:
                         self.results.append(result)
         finally:
             node.destroy_node()
-            self._seen.pop(id(client), None)  # the id may be reused by a later client
+            self._settling.forget(id(client))  # the id may be reused by a later client
         return results
 
     def _stopping(self) -> bool:
@@ -207,7 +198,7 @@ class ComponentLoader:
                 if self._settled(client):
                     return True
                 continue
-            self._seen.pop(id(client), None)  # a container that comes back settles again
+            self._settling.forget(id(client))  # a container that comes back settles again
             self.stop.wait(POLL)
         self.log(
             "WARNING",
@@ -217,15 +208,11 @@ class ComponentLoader:
         return False
 
     def _settled(self, client: Any) -> bool:
-        """True once ``client`` has seen its service for DISCOVERY_SETTLE seconds (see there).
+        """True once ``client`` has seen its service long enough (mlaunch.ros.discovery).
 
-        Waits out what is left of it (a stop ends the wait at once); later requests of the same
-        client go at once.
+        Waits out what is left (a stop ends the wait at once); later requests go at once.
         """
-        import time
-
-        seen = self._seen.setdefault(id(client), time.monotonic())
-        left = seen + DISCOVERY_SETTLE - time.monotonic()
+        left = self._settling.left(id(client))
         if left > 0:
             self.stop.wait(left)
             return False
