@@ -78,11 +78,11 @@ def test_importtime_parser_takes_the_last_interpreter() -> None:
     first = header + "import time:      5000 |       5000 | ros_wheels_bootstrapper\n"
     second = header + (
         "import time:       300 |        300 |     rclpy.x\n"
-        "import time:      1000 |       1300 |   mlaunch.run.plan\n"
+        "import time:      1000 |       1300 |   mlaunch.plan.steps\n"
         "import time:      2000 |       3300 | mlaunch.cli\n"
     )
     info = bench.parse_importtime(first + second)
-    assert [t["module"] for t in info["top"]] == ["mlaunch.cli", "mlaunch.run.plan", "rclpy.x"]
+    assert [t["module"] for t in info["top"]] == ["mlaunch.cli", "mlaunch.plan.steps", "rclpy.x"]
     assert [t["depth"] for t in info["top"]] == [0, 1, 2]
     assert info["modules"] == 3 and info["total_ms"] == pytest.approx(3.3)
     assert info["rclpy_imported"] is True

@@ -309,9 +309,9 @@ HEAVY_AT_START = (
     "tempfile",
     # mlaunch ctl's socket opens on the loop's first turn, after the first children.
     "socket",
-    "mlaunch.run.control",
-    "mlaunch.run.control_socket",
-    "json",  # only --print --format json (mlaunch.run.plan_json) and the ROS bridge need it
+    "mlaunch.parts.control",
+    "mlaunch.parts.control_socket",
+    "json",  # only --print --format json (mlaunch.resolve.plan_json) and the ROS bridge need it
 )
 
 
@@ -323,7 +323,7 @@ def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
     """
     code = (
         "import sys\n"
-        "import mlaunch.run.supervisor as sup\n"
+        "import mlaunch.engine.supervisor as sup\n"
         "seen = []\n"
         "original = sup.Supervisor.start\n"
         "def start(self, *a, **k):\n"
@@ -353,7 +353,7 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     assert loaded_at_first_child(path, env) == []
     show = (
         "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '--show-args']);"
-        " runtime = ('mlaunch.run.supervisor', 'mlaunch.run.process', 'mlaunch.run.output', 'subprocess', 'selectors');"
+        " runtime = ('mlaunch.engine.supervisor', 'mlaunch.engine.process', 'mlaunch.engine.output', 'subprocess', 'selectors');"
         " print('SHOW-ARGS', sorted(m for m in runtime if m in sys.modules)); sys.exit(rc)"
     )
     done = __import__("subprocess").run(

@@ -17,13 +17,14 @@ from conftest import requires_rclpy
 from procutil import Running, clean_env, demo_package, mlaunch, run_mlaunch
 
 from mlaunch import __version__
-from mlaunch.options import VIEWER_PORT_ENV, build_parser
-from mlaunch.run import describe, status
-from mlaunch.run.events import Output, Started
-from mlaunch.run.logfiles import DEFAULT_ROTATE_BYTES
-from mlaunch.run.output import Printer
-from mlaunch.run.plan import ArgumentInfo, ProcessSpec
-from mlaunch.run.process import Process
+from mlaunch.app.options import VIEWER_PORT_ENV, build_parser
+from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES
+from mlaunch.engine.output import Printer
+from mlaunch.engine.process import Process
+from mlaunch.parts import status
+from mlaunch.plan.events import Output, Started
+from mlaunch.plan.steps import ArgumentInfo, ProcessSpec
+from mlaunch.resolve import describe
 from mlaunch.standins.viewer_config import PORT_ENV
 
 PY = sys.executable
@@ -256,10 +257,10 @@ def test_quiet_launch_shows_the_viewer_address_on_the_chosen_port(
 
 
 def test_readme_exit_status_table_is_the_codes() -> None:
-    """Every status of mlaunch.errors' table is a row of the README's, and nothing else is."""
+    """Every status of mlaunch.plan.errors' table is a row of the README's, and nothing else is."""
     from conftest import REPO
 
-    from mlaunch import errors
+    from mlaunch.plan import errors
 
     readme = (REPO / "README.md").read_text()
     section = readme[readme.index("### Exit status") :]

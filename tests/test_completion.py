@@ -222,8 +222,8 @@ def test_a_launch_never_loads_argcomplete(tmp_path: Path) -> None:
     env = clean_env(ROS_LOG_DIR=str(tmp_path / "log"), PYTHONPROFILEIMPORTTIME="1")
     done = run_mlaunch(str(path), env=env)
     assert done.returncode == 0, done.stderr
-    assert "mlaunch.run.supervisor" in done.stderr  # the import log is there
-    assert "argcomplete" not in done.stderr and "mlaunch.completion" not in done.stderr
+    assert "mlaunch.engine.supervisor" in done.stderr  # the import log is there
+    assert "argcomplete" not in done.stderr and "mlaunch.cli.completion" not in done.stderr
 
 
 def test_setup_turns_completion_on_in_the_venv(tmp_path: Path) -> None:

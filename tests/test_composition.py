@@ -11,7 +11,6 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.errors import LaunchFileError, MlaunchError
 from mlaunch.launch.actions import LaunchDescription
 from mlaunch.launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
 from mlaunch.launch_ros.composable import ComposableNode
@@ -26,10 +25,11 @@ from mlaunch.launch_ros.load_request import (
     LoadRequest,
     TypedParameter,
 )
+from mlaunch.plan.errors import LaunchFileError, MlaunchError
+from mlaunch.plan.steps import Plan
+from mlaunch.resolve.describe import describe_plan
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 from mlaunch.ros import packages
-from mlaunch.run.describe import describe_plan
-from mlaunch.run.plan import Plan
-from mlaunch.run.resolve import ResolveOptions, resolve
 
 HERE = Path(__file__).parent / "launches" / "composition"
 

@@ -15,8 +15,8 @@ import pytest
 from test_supervision import Harness, plan_from, write_launch
 
 from mlaunch.launch_ros.composition import LoadComponents
-from mlaunch.run.events import Event, HandedOff, ShutdownBegun, Started
-from mlaunch.run.plan import Plan
+from mlaunch.plan.events import Event, HandedOff, ShutdownBegun, Started
+from mlaunch.plan.steps import Plan
 
 # A process that lives until the test's run is shut down, and one that exits at once.
 DEFERRED = """

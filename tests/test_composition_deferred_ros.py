@@ -267,9 +267,9 @@ def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
 
     from mlaunch.launch_ros.composition import LoadComponents
     from mlaunch.launch_ros.load_request import LoadRequest
-    from mlaunch.ros.components import ComponentDriver
-    from mlaunch.run.events import Event, HandedOff
-    from mlaunch.run.plan import Plan
+    from mlaunch.parts.components import ComponentDriver
+    from mlaunch.plan.events import Event, HandedOff
+    from mlaunch.plan.steps import Plan
 
     request = LoadRequest("p", "p::A", "a")
     h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
@@ -301,8 +301,8 @@ def test_a_launch_service_loads_components_of_a_description_included_while_runni
 
     from test_launch_service import Screen
 
+    from mlaunch.app.launch_service import LaunchService
     from mlaunch.launch.actions import ExecuteProcess, LaunchDescription
-    from mlaunch.launch.launch_service import LaunchService
     from mlaunch.launch_ros.actions import LoadComposableNodes
     from mlaunch.launch_ros.composable import ComposableNode
 

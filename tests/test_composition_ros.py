@@ -47,7 +47,7 @@ def loader(ros_env: dict[str, str]) -> Iterator[tuple[Any, list[tuple[str, str]]
     """A ComponentLoader on its own rclpy context in the test's domain, and its log lines."""
     import rclpy
 
-    from mlaunch.ros.components import ComponentLoader
+    from mlaunch.parts.components import ComponentLoader
 
     context = rclpy.Context()
     rclpy.init(context=context)

@@ -1,4 +1,4 @@
-"""The control core (mlaunch.run.control) driven in-process on a live Supervisor.
+"""The control core (mlaunch.parts.control) driven in-process on a live Supervisor.
 
 Each request is made from inside the loop when a child says something (the harness's hooks),
 as the control socket and the --status keys make them; the test then reads the records, the
@@ -13,10 +13,10 @@ from typing import TypeVar
 import pytest
 from test_supervision import Harness, make_spec, plan_from, write_launch
 
-from mlaunch.run.control import ControlError, ProcessInfo, UnknownLabel
-from mlaunch.run.events import Controlled, Event, Exited, RespawnScheduled, Started
-from mlaunch.run.plan import RespawnPolicy
-from mlaunch.run.records import RUNNING, STOPPED
+from mlaunch.engine.records import RUNNING, STOPPED
+from mlaunch.parts.control import ControlError, ProcessInfo, UnknownLabel
+from mlaunch.plan.events import Controlled, Event, Exited, RespawnScheduled, Started
+from mlaunch.plan.steps import RespawnPolicy
 
 E = TypeVar("E", bound=Event)
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 from test_roslaunch import fresh_packages, package, plan_of, summarize, write
 
-from mlaunch.ros1 import convert
+from mlaunch.commands import convert
 
 __all__ = ["fresh_packages"]  # the autouse fixture, used here too
 

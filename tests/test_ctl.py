@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 from procutil import Running, clean_env, mlaunch, pid_alive, run_mlaunch, wait_for, wait_until
 
-from mlaunch.run.control_socket import Address
+from mlaunch.parts.control_socket import Address
 
 LAUNCH = """
 import sys
@@ -254,8 +254,8 @@ def test_a_log_folder_that_takes_no_socket_sends_it_to_the_runtime_folder(tmp_pa
     folder (``control/where``); a client thread asks while the loop serves."""
     from test_supervision import Harness, make_spec
 
-    from mlaunch.ctl import ask, find_run
-    from mlaunch.run.control_socket import ControlSocket
+    from mlaunch.commands.ctl import ask, find_run
+    from mlaunch.parts.control_socket import ControlSocket
 
     logs = tmp_path / "run"
     # The socket's place in the log folder is taken by a folder that is not empty.

@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 from procutil import clean_env
 
-from mlaunch import errors
-from mlaunch.errors import (
+from mlaunch.plan import errors
+from mlaunch.plan.errors import (
     EXIT_FAILURE,
     EXIT_INTERNAL,
     EXIT_INTERRUPTED,

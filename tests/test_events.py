@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from test_supervision import Harness, plan_from
 
-from mlaunch.run.events import (
+from mlaunch.plan.events import (
     Event,
     EventStream,
     Exited,
@@ -28,7 +28,7 @@ from mlaunch.run.events import (
     Started,
     StoppingAll,
 )
-from mlaunch.run.plan import Plan, Step
+from mlaunch.plan.steps import Plan, Step
 
 PY = sys.executable
 REFERENCE_ENV = Path.home() / ".cache" / "ros2-launch-jazzy" / "env.sh"
@@ -191,7 +191,7 @@ def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
     from mlaunch.launch.actions import EmitEvent, ExecuteProcess, RegisterEventHandler, TimerAction
     from mlaunch.launch.event_handlers import OnProcessExit
     from mlaunch.launch_ros.events import ChangeState
-    from mlaunch.run.resolve import resolve
+    from mlaunch.resolve.resolver import resolve
 
     def needs(*entities: object) -> set[str]:
         from mlaunch.launch.actions import LaunchDescription
@@ -208,11 +208,11 @@ def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
 
 def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> None:
     """A ChangeState from a handler written as a function: no need was visible before the run."""
+    from mlaunch.app import pipeline
+    from mlaunch.app.options import Options
     from mlaunch.launch_ros.events import ChangeState
-    from mlaunch.options import Options
-    from mlaunch.ros.lifecycle import LifecycleManager
-    from mlaunch.run import pipeline
-    from mlaunch.run.events import LaunchEvent
+    from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.plan.events import LaunchEvent
 
     h = Harness(Plan())
     run = pipeline.Run(Options("x.launch.py"), h.sup.plan, h.sup)

@@ -19,7 +19,7 @@ from typing import IO
 import pytest
 from procutil import wait_until
 
-from mlaunch.run import proctable
+from mlaunch.engine import proctable
 
 PY = sys.executable
 
@@ -349,7 +349,7 @@ def test_a_plain_run_imports_nothing_heavy_before_the_first_child(tmp_path: Path
 def test_guard_start_up_cost(tmp_path: Path) -> None:
     code = (
         "import time\n"
-        "from mlaunch.run.guard import Guard\n"
+        "from mlaunch.engine.guard import Guard\n"
         "costs = []\n"
         "for i in range(5):\n"
         "    t = time.perf_counter(); g = Guard.start(f'probe-{i}')\n"

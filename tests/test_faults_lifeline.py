@@ -251,8 +251,8 @@ def test_a_reader_that_goes_away_ends_mlaunch_like_a_unix_tool(tmp_path: Path, v
 def test_the_marker_scan_finds_a_process_in_the_middle_of_exec() -> None:
     # While a process runs execve() its environment reads empty for a moment; a sweep that
     # looked just then used to miss a stray (setsid here is exec'ing sleep when it is scanned).
-    from mlaunch.run import guard as guards
-    from mlaunch.run import proctable
+    from mlaunch.engine import guard as guards
+    from mlaunch.engine import proctable
 
     run_id = guards.new_run_id()
     env = dict(os.environ, MLAUNCH_RUN_ID=run_id)
@@ -294,7 +294,7 @@ def run_cgroup_available() -> str:
     """Why this machine gives a run no cgroup ("" when it does), asked as mlaunch asks."""
     code = (
         "import os\n"
-        "from mlaunch.run.cgroup import RunCgroup\n"
+        "from mlaunch.engine.cgroup import RunCgroup\n"
         "group, why = RunCgroup.create(os.environ)\n"
         "if group is not None:\n"
         "    why = '' if group.enter() else f'cannot move into {group.path}'\n"
@@ -345,7 +345,7 @@ def test_pkill_9_f_of_mlaunch_leaves_nothing_not_even_a_daemon(tmp_path: Path) -
 
 
 def test_the_guard_is_not_named_after_mlaunch() -> None:
-    from mlaunch.run.guard import Guard
+    from mlaunch.engine.guard import Guard
 
     guard = Guard.start("probe-title")
     try:
@@ -360,7 +360,7 @@ def test_the_guard_is_not_named_after_mlaunch() -> None:
 
 
 def test_a_normal_run_leaves_no_cgroup_behind(tmp_path: Path) -> None:
-    from mlaunch.run.cgroup import PREFIX, cgroup2_root, own_cgroup
+    from mlaunch.engine.cgroup import PREFIX, cgroup2_root, own_cgroup
 
     if run_cgroup_available():
         pytest.skip(f"no run cgroup here: {run_cgroup_available()}")

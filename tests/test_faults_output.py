@@ -17,7 +17,7 @@ from pathlib import Path
 from test_output_flow import deadline_sleep, flood_code
 from test_supervision import Harness, make_spec
 
-from mlaunch.run.screen import Screen
+from mlaunch.engine.screen import Screen
 
 QUIET = """
 import sys, time

@@ -10,11 +10,11 @@ from typing import Any
 import pytest
 
 from mlaunch import frontends
-from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError
 from mlaunch.launch import actions
 from mlaunch.launch.conditions import IfCondition, UnlessCondition
-from mlaunch.run.plan import Log, Plan, RequestShutdown, StartTimer
-from mlaunch.run.resolve import ResolveOptions, resolve
+from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError, MlaunchError
+from mlaunch.plan.steps import Log, Plan, RequestShutdown, StartTimer
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 
 ENV = {"PATH": os.environ["PATH"], "HOME": "/home/u", "KEEP": "k"}
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import sys
 import threading
 
+from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import (
     ExecuteProcess,
     LaunchDescription,
@@ -13,7 +14,6 @@ from mlaunch.launch.actions import (
     RegisterEventHandler,
 )
 from mlaunch.launch.event_handlers import OnProcessIO, OnProcessStart
-from mlaunch.launch.launch_service import LaunchService
 
 DEADLINE = 30.0
 
@@ -168,7 +168,7 @@ def test_events_emitted_before_run_wait_for_it() -> None:
 def test_importable_as_launch_launch_service() -> None:
     import importlib
 
-    from mlaunch import compat
+    from mlaunch.app import compat
 
     compat.install()
     module = importlib.import_module("launch")

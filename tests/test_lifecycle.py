@@ -16,15 +16,15 @@ import pytest
 from conftest import requires_rclpy
 from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
 
-from mlaunch.errors import LaunchFileError
 from mlaunch.launch.actions import DeclareLaunchArgument, GroupAction, LaunchDescription
-from mlaunch.ros.handoff import LoopCall
-from mlaunch.ros.lifecycle_sequence import (
+from mlaunch.launch_ros.lifecycle_sequence import (
     LifecycleSequence,
     SequenceStep,
     sequence_from_arguments,
 )
-from mlaunch.run.resolve import resolve
+from mlaunch.parts.handoff import LoopCall
+from mlaunch.plan.errors import LaunchFileError
+from mlaunch.resolve.resolver import resolve
 
 LAUNCHES = Path(__file__).resolve().parent / "launches"
 
@@ -104,11 +104,11 @@ def test_plain_plans_attach_nothing_and_lifecycle_plans_attach_without_rclpy() -
     code = f"""
 import sys
 from mlaunch.launch.actions import LaunchDescription, TimerAction
-from mlaunch.ros.lifecycle import attach
-from mlaunch.run.output import Printer
-from mlaunch.run.resolve import resolve
+from mlaunch.parts.lifecycle import attach
+from mlaunch.engine.output import Printer
+from mlaunch.resolve.resolver import resolve
 from mlaunch.launch_ros.actions import LifecycleNode
-from mlaunch.run.supervisor import Supervisor
+from mlaunch.engine.supervisor import Supervisor
 node = LifecycleNode(executable={sys.executable!r}, name="cam", namespace="r", autostart=True)
 ld = LaunchDescription([TimerAction(period=5.0, actions=[node])])
 plan = resolve(ld, path=None, arguments={{}}, environ={{}})

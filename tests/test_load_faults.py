@@ -17,7 +17,7 @@ from procutil import clean_env, run_mlaunch
 
 from mlaunch.frontends.limits import DEPTH_LIMIT
 from mlaunch.frontends.suggest import LISTED, Suggester
-from mlaunch.run.resolve import undeclared_argument_warnings
+from mlaunch.resolve.resolver import undeclared_argument_warnings
 
 PY = sys.executable
 

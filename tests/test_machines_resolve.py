@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.errors import MlaunchError
-from mlaunch.run.plan import Plan
-from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
+from mlaunch.plan.errors import MlaunchError
+from mlaunch.plan.steps import Plan
+from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
 
 EXAMPLES_PREFIX = Path(__file__).resolve().parent.parent / "launches" / "examples" / "prefix"
 
@@ -152,7 +152,7 @@ ROS1 = """<launch>
 
 @pytest.mark.parametrize("fmt", ["ros1", "py", "yaml", "xml"])
 def test_ros1_machines_run_and_convert_alike(tmp_path: Path, fmt: str) -> None:
-    from mlaunch.ros1.convert import convert
+    from mlaunch.commands.convert import convert
 
     source = tmp_path / "m.launch"
     source.write_text(ROS1)
@@ -215,5 +215,5 @@ def test_a_launch_without_machines_never_imports_them(tmp_path: Path) -> None:
         check=False,
     )
     assert done.returncode == 0, done.stderr
-    assert "| mlaunch.run.supervisor" in done.stderr  # the run really happened
+    assert "| mlaunch.engine.supervisor" in done.stderr  # the run really happened
     assert "mlaunch.machines" not in done.stderr

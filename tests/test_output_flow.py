@@ -25,14 +25,14 @@ import pytest
 from procutil import wait_until
 from test_supervision import Harness, gone, make_spec
 
-from mlaunch.run import guard as guards
-from mlaunch.run import proctable
-from mlaunch.run.events import Event, Output
-from mlaunch.run.output import Printer
-from mlaunch.run.plan import Plan, Spawn
-from mlaunch.run.screen import Screen
-from mlaunch.run.strays import Strays
-from mlaunch.run.supervisor import Supervisor
+from mlaunch.engine import guard as guards
+from mlaunch.engine import proctable
+from mlaunch.engine.output import Printer
+from mlaunch.engine.screen import Screen
+from mlaunch.engine.strays import Strays
+from mlaunch.engine.supervisor import Supervisor
+from mlaunch.plan.events import Event, Output
+from mlaunch.plan.steps import Plan, Spawn
 
 PY = sys.executable
 DROP = re.compile(rb"the terminal fell behind: (\d+) lines")

@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 from mlaunch import frontends
-from mlaunch.run.plan import (
+from mlaunch.plan.steps import (
     AddHandler,
     Deferred,
     EmitEvent,
@@ -28,7 +28,7 @@ from mlaunch.run.plan import (
     Spawn,
     StartTimer,
 )
-from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve, resolve_deferred
+from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve, resolve_deferred
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "launches" / "examples"
 FORMATS = ("py", "yaml", "xml")

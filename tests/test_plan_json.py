@@ -183,10 +183,10 @@ def test_every_kind_of_step_can_be_written() -> None:
     A new step kind without either would make --print --format json an internal error.
     """
     import mlaunch.launch_ros.composition
-    import mlaunch.ros.lifecycle_sequence
+    import mlaunch.launch_ros.lifecycle_sequence
     import mlaunch.smoke.expectations  # noqa: F401  (they define Note steps)
-    from mlaunch.run import plan as plan_module
-    from mlaunch.run.plan_json import _Writer
+    from mlaunch.plan import steps as plan_module
+    from mlaunch.resolve.plan_json import _Writer
 
     known = set(_Writer(None).kinds)
     pending = list(plan_module.Step.__subclasses__())

@@ -171,8 +171,8 @@ from launch.actions import ExecuteProcess, LogInfo, RegisterEventHandler, TimerA
 from launch.event_handlers import OnProcessExit
 from launch_ros.actions import LifecycleNode
 from launch_ros.event_handlers import OnStateTransition
-from mlaunch.ros.lifecycle_sequence import LifecycleSequence
-from mlaunch.smoke import Expect
+from mlaunch.launch_ros.lifecycle_sequence import LifecycleSequence
+from mlaunch.commands.smoke import Expect
 
 def generate_launch_description():
     first = ExecuteProcess(cmd=['true'], name='first', on_exit=[LogInfo(msg='bye')])
@@ -342,7 +342,7 @@ def test_values_json_cannot_spell_stay_valid(tmp_path: Path, env: dict[str, str]
 
 
 def test_an_unreadable_params_file_is_said(tmp_path: Path, env: dict[str, str]) -> None:
-    from mlaunch.run.plan_json import params_file_data
+    from mlaunch.resolve.plan_json import params_file_data
 
     missing = params_file_data(str(tmp_path / "gone.yaml"), "gone.yaml")
     assert missing["contents"] is None and "cannot be read" in missing["error"]

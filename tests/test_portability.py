@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import jazzy, portability
-from mlaunch.portability_python import api
+from mlaunch.check import jazzy, portability
+from mlaunch.check.portability_python import api
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "tests" / "conformance"))
@@ -291,7 +291,7 @@ def test_convert_output_loads_under_jazzy(fmt: str, tmp_path: Path) -> None:
 
 @requires_reference
 def test_table_names_match_the_reference() -> None:
-    """The tag and substitution names of mlaunch.jazzy, and jazzy_python.json, are Jazzy's."""
+    """The tag and substitution names of mlaunch.check.jazzy, and jazzy_python.json, are Jazzy's."""
     assert REFERENCE is not None
     script = (
         "import json, launch, launch_ros, launch.frontend.expose as e\n"

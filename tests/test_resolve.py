@@ -9,7 +9,6 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.errors import LaunchArgumentError, LaunchFileError, MlaunchError, SubstitutionFailure
 from mlaunch.launch.actions import (
     AppendEnvironmentVariable,
     DeclareLaunchArgument,
@@ -30,9 +29,15 @@ from mlaunch.launch.conditions import IfCondition, UnlessCondition
 from mlaunch.launch.event_handlers import OnProcessExit
 from mlaunch.launch.launch_description_sources import PythonLaunchDescriptionSource
 from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
-from mlaunch.run.binding import PRAGMA
-from mlaunch.run.plan import AddHandler, Log, Plan, StartTimer
-from mlaunch.run.resolve import (
+from mlaunch.plan.errors import (
+    LaunchArgumentError,
+    LaunchFileError,
+    MlaunchError,
+    SubstitutionFailure,
+)
+from mlaunch.plan.steps import AddHandler, Log, Plan, StartTimer
+from mlaunch.resolve.binding import PRAGMA
+from mlaunch.resolve.resolver import (
     LabelCounter,
     ResolveOptions,
     collect_arguments,

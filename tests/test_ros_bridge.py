@@ -22,8 +22,8 @@ import pytest
 from conftest import REPO, requires_rclpy
 from procutil import wait_until
 
-from mlaunch.ros.bridge import RosGraph
-from mlaunch.ros.graph_types import (
+from mlaunch.parts.bridge import RosGraph
+from mlaunch.parts.graph_types import (
     INSTALL_HINT,
     GraphNotRunning,
     RosInputError,
@@ -126,7 +126,7 @@ def test_importing_the_bridge_does_not_import_rclpy() -> None:
     result = run_python(
         "import sys, time\n"
         "t = time.perf_counter()\n"
-        "import mlaunch.ros.bridge\n"
+        "import mlaunch.parts.bridge\n"
         "ms = (time.perf_counter() - t) * 1000\n"
         "ros = sorted(m for m in sys.modules if m.split('.')[0] in "
         "('rclpy', 'rpyutils', 'std_msgs', 'lifecycle_msgs', 'rosidl_runtime_py'))\n"
@@ -135,14 +135,14 @@ def test_importing_the_bridge_does_not_import_rclpy() -> None:
     assert result.returncode == 0, result.stderr
     loaded, import_ms = result.stdout.rsplit(" ", 1)
     assert loaded == "[]"
-    print(f"import mlaunch.ros.bridge: {import_ms.strip()} ms")
+    print(f"import mlaunch.parts.bridge: {import_ms.strip()} ms")
 
 
 def test_without_rclpy_start_says_how_to_install_it() -> None:
     result = run_python(
         "import sys\n"
         "sys.modules['rclpy'] = None  # as if the ros extra were not installed\n"
-        "from mlaunch.ros.bridge import RosGraph, RosUnavailable\n"
+        "from mlaunch.parts.bridge import RosGraph, RosUnavailable\n"
         "graph = RosGraph()\n"
         "try:\n"
         "    graph.start()\n"

@@ -17,7 +17,6 @@ import pytest
 import yaml
 
 from mlaunch import standins
-from mlaunch.errors import LaunchFileError, MlaunchError, PackageNotFoundError, SubstitutionFailure
 from mlaunch.launch.actions import GroupAction, LaunchDescription
 from mlaunch.launch.substitutions import LaunchConfiguration, TextSubstitution, perform
 from mlaunch.launch_ros.actions import (
@@ -41,10 +40,16 @@ from mlaunch.launch_ros.events import (
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
 from mlaunch.launch_ros.substitutions import FindPackageShare
 from mlaunch.launch_ros.substitutions import Parameter as ParameterSubstitution
+from mlaunch.plan.errors import (
+    LaunchFileError,
+    MlaunchError,
+    PackageNotFoundError,
+    SubstitutionFailure,
+)
+from mlaunch.plan.steps import Plan, ProcessSpec
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 from mlaunch.ros import packages
 from mlaunch.ros.search import PackageSearch
-from mlaunch.run.plan import Plan, ProcessSpec
-from mlaunch.run.resolve import ResolveOptions, resolve
 
 THIS = os.path.abspath(__file__)
 
@@ -477,7 +482,7 @@ def test_global_parameter_values_use_python_str_and_yaml_lists(prefix: Path, tem
 
 def test_parameter_substitution_reads_globals(prefix: Path, temp_dir: str) -> None:
     from mlaunch.launch.actions import LogInfo
-    from mlaunch.run.plan import Log
+    from mlaunch.plan.steps import Log
 
     entities = [
         SetParameter("speed", 1.5),
@@ -852,7 +857,7 @@ def test_find_package_share_joins_with_slash(prefix: Path, temp_dir: str) -> Non
 
 def test_text_values_rcl_would_retype_are_quoted(prefix: Path, temp_dir: str) -> None:
     """launch_ros writes plain y, 1e3, inf: rcl reads a bool or doubles. mlaunch quotes them."""
-    from mlaunch.ros.params import rcl_reads_as_text
+    from mlaunch.launch_ros.params import rcl_reads_as_text
 
     node = Node(
         package="demo",

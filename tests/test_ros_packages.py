@@ -14,16 +14,16 @@ from pathlib import Path
 import pytest
 
 from mlaunch import frontends
-from mlaunch.errors import LaunchFileError
 from mlaunch.launch.actions import LaunchDescription, LogInfo
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import perform
 from mlaunch.launch_ros.substitutions import FindPackagePrefix, FindPackageShare
+from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.steps import Log
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 from mlaunch.ros import ament_index, packages
 from mlaunch.ros.packages import PackageNotFoundError
 from mlaunch.ros.search import PackageSearch, searching
-from mlaunch.run.plan import Log
-from mlaunch.run.resolve import ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 

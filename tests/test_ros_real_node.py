@@ -32,9 +32,9 @@ from mlaunch.launch_ros.actions import (
     with_use_sim_time,
 )
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterValue
+from mlaunch.plan.steps import ProcessSpec
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 from mlaunch.ros import packages
-from mlaunch.run.plan import ProcessSpec
-from mlaunch.run.resolve import ResolveOptions, resolve
 
 pytestmark = [requires_rclpy, pytest.mark.timeout(60)]
 

@@ -18,10 +18,10 @@ import pytest
 import yaml
 
 from mlaunch import frontends
-from mlaunch.errors import MlaunchError
+from mlaunch.plan.errors import MlaunchError
+from mlaunch.plan.steps import Plan, ProcessSpec
+from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
 from mlaunch.ros import packages
-from mlaunch.run.plan import Plan, ProcessSpec
-from mlaunch.run.resolve import LabelCounter, ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 PREFIX = REPO / "launches" / "examples" / "prefix"

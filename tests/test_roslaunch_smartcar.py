@@ -15,9 +15,9 @@ from procutil import Running, clean_env
 from test_interfaces import HAVE_TF2_MSGS
 from test_roslaunch import params, plan_of, summarize
 
+from mlaunch.commands import convert
 from mlaunch.ros import packages
 from mlaunch.ros.search import PackageSearch, searching
-from mlaunch.ros1 import convert
 
 REPO = Path(__file__).resolve().parent.parent
 LAUNCH = REPO / "launches" / "smartcar_display.launch"

@@ -13,14 +13,14 @@ import pytest
 from conftest import requires_rclpy
 from procutil import clean_env, mlaunch, run_mlaunch
 
-from mlaunch.errors import LaunchFileError, UsageError
+from mlaunch.commands.smoke import build_expectations, junit
 from mlaunch.launch.actions import (
     ExecuteProcess,
     LaunchDescription,
     SetLaunchConfiguration,
 )
-from mlaunch.run.resolve import resolve
-from mlaunch.smoke import build_expectations, junit
+from mlaunch.plan.errors import LaunchFileError, UsageError
+from mlaunch.resolve.resolver import resolve
 from mlaunch.smoke.expectations import Expect, _CollectConfigurations, parse_spec, parse_target
 from mlaunch.smoke.settings import Settings, parse_settings, split_arguments
 
@@ -148,7 +148,7 @@ PLAIN = """
 import sys
 from launch import LaunchDescription
 from launch.actions import ExecuteProcess
-from mlaunch.smoke import Expect
+from mlaunch.commands.smoke import Expect
 
 PY = sys.executable
 

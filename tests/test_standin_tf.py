@@ -213,7 +213,7 @@ def test_a_missing_tf2_msgs_is_named_when_static_transform_publisher_cannot_run(
     from test_roslaunch import plan_of
 
     from mlaunch import standins
-    from mlaunch.errors import MlaunchError
+    from mlaunch.plan.errors import MlaunchError
 
     monkeypatch.setattr(standins, "NEEDS", {"stp": "mlaunch_test_no_such_module"})
     launch = tmp_path / "stp.launch.py"

@@ -13,16 +13,16 @@ import time
 
 from test_supervision import Harness, make_spec
 
-from mlaunch.run.plan import ProcessSpec, RespawnPolicy
-from mlaunch.run.records import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
-from mlaunch.run.status import StatusView, attach_status_view
-from mlaunch.run.summary import (
+from mlaunch.engine.records import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
+from mlaunch.parts.status import StatusView, attach_status_view
+from mlaunch.parts.summary import (
     ExitSummary,
     format_bytes,
     format_duration,
     render_summary,
     summary_wanted,
 )
+from mlaunch.plan.steps import ProcessSpec, RespawnPolicy
 
 CSI = re.compile(r"\x1b\[(\d*)([A-Za-z])")
 

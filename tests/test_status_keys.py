@@ -22,9 +22,9 @@ from ptyrun import PtyRun
 from test_status import fake_usage, record
 from test_supervision import Harness
 
-from mlaunch.run.keyboard import Keyboard, decode, guard_line, parse_guard_line
-from mlaunch.run.status import StatusView
-from mlaunch.run.status_keys import NOTICE_SECONDS, PANE_HELP, TABLE_HELP
+from mlaunch.engine.keyboard import Keyboard, decode, guard_line, parse_guard_line
+from mlaunch.parts.status import StatusView
+from mlaunch.parts.status_keys import NOTICE_SECONDS, PANE_HELP, TABLE_HELP
 
 PY = sys.executable
 
@@ -375,7 +375,7 @@ def test_terminal_is_put_back_when_the_program_fails_without_closing(tmp_path: P
     code = textwrap.dedent(
         """
         import selectors
-        from mlaunch.run.keyboard import Keyboard
+        from mlaunch.engine.keyboard import Keyboard
         keyboard = Keyboard(selectors.DefaultSelector(), print)
         assert keyboard.start()
         print("cbreak now", flush=True)

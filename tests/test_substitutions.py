@@ -7,7 +7,6 @@ import sys
 
 import pytest
 
-from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
 from mlaunch.launch.conditions import (
     IfCondition,
     LaunchConfigurationEquals,
@@ -34,6 +33,7 @@ from mlaunch.launch.substitutions import (
     ThisLaunchFileDir,
     perform,
 )
+from mlaunch.plan.errors import InvalidConditionExpressionError, SubstitutionFailure
 
 
 @pytest.fixture

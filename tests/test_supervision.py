@@ -20,22 +20,22 @@ from pathlib import Path
 import pytest
 from procutil import wait_until
 
-from mlaunch.run import proctable
-from mlaunch.run.events import Event, Exited, Output, Started
-from mlaunch.run.logfiles import LogFile
-from mlaunch.run.output import Printer
-from mlaunch.run.plan import Plan, ProcessSpec, RespawnPolicy, Spawn
-from mlaunch.run.process import (
+from mlaunch.engine import proctable
+from mlaunch.engine.logfiles import LogFile
+from mlaunch.engine.output import Printer
+from mlaunch.engine.process import (
     MAX_PARTIAL,
     Process,
     core_dump_hint,
     expand_core_pattern,
     utf8_safe_cut,
 )
-from mlaunch.run.records import FAILED, FINISHED, GAVE_UP
-from mlaunch.run.respawn import STABLE_UPTIME, respawn_delay
-from mlaunch.run.screen import Screen
-from mlaunch.run.supervisor import Supervisor
+from mlaunch.engine.records import FAILED, FINISHED, GAVE_UP
+from mlaunch.engine.respawn import STABLE_UPTIME, respawn_delay
+from mlaunch.engine.screen import Screen
+from mlaunch.engine.supervisor import Supervisor
+from mlaunch.plan.events import Event, Exited, Output, Started
+from mlaunch.plan.steps import Plan, ProcessSpec, RespawnPolicy, Spawn
 
 PY = sys.executable
 
@@ -365,7 +365,7 @@ def write_launch(tmp_path: Path, body: str) -> Path:
 
 def plan_from(path: Path, tmp_path: Path) -> Plan:
     from mlaunch import frontends
-    from mlaunch.run.resolve import ResolveOptions, resolve
+    from mlaunch.resolve.resolver import ResolveOptions, resolve
 
     temp = tmp_path / "temp"
     temp.mkdir(exist_ok=True)

@@ -19,13 +19,13 @@ import pytest
 import xacro
 
 from mlaunch import frontends
-from mlaunch.errors import SubstitutionFailure
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS, Command, perform
+from mlaunch.launch_ros import xacro as in_process
+from mlaunch.plan.errors import SubstitutionFailure
+from mlaunch.plan.steps import Log
+from mlaunch.resolve.resolver import ResolveOptions, resolve
 from mlaunch.ros import packages
-from mlaunch.ros import xacro as in_process
-from mlaunch.run.plan import Log
-from mlaunch.run.resolve import ResolveOptions, resolve
 
 REPO = Path(__file__).resolve().parent.parent
 PROGRAM = Path(sys.executable).parent / "xacro"

@@ -26,8 +26,8 @@ import re
 import shlex
 import shutil
 
-from mlaunch.errors import MlaunchError
-from mlaunch.run.plan import AddHandler, Deferred, Plan, ProcessSpec, Spawn, StartTimer, Step
+from mlaunch.plan.errors import MlaunchError
+from mlaunch.plan.steps import AddHandler, Deferred, Plan, ProcessSpec, Spawn, StartTimer, Step
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import importlib
 import os
 
-from mlaunch.errors import LaunchFileError, is_own_module
 from mlaunch.frontends.limits import allow_deep_trees
+from mlaunch.plan.errors import LaunchFileError, is_own_module
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mlaunch.errors import LaunchFileError
+from mlaunch.plan.errors import LaunchFileError
 
 
 def not_utf8(data: bytes, path: str) -> LaunchFileError | None:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 import sys
 
-from mlaunch.errors import LaunchFileError
+from mlaunch.plan.errors import LaunchFileError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

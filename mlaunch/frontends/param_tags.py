@@ -6,10 +6,10 @@ does not fit its type is an error at load time, with the file and line of the at
 
 from __future__ import annotations
 
-from mlaunch.errors import MlaunchError
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.fields import Value, as_key, required_text
 from mlaunch.launch.substitutions import Substitution, to_bool
+from mlaunch.plan.errors import MlaunchError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

@@ -7,13 +7,13 @@ The launch_ros actions are imported only when such a tag appears.
 from __future__ import annotations
 
 import mlaunch.launch.actions as core
-from mlaunch.errors import MlaunchError
 from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
 from mlaunch.frontends.subst import Part, Parts
 from mlaunch.launch.substitutions import Substitution, to_bool
-from mlaunch.run.plan import OUTPUT_MODES
+from mlaunch.plan.errors import MlaunchError
+from mlaunch.plan.steps import OUTPUT_MODES
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

@@ -6,8 +6,8 @@ import os
 import sys
 import types
 
-from mlaunch.errors import LaunchFileError, MlaunchError
-from mlaunch.origin import user_location
+from mlaunch.plan.errors import LaunchFileError, MlaunchError
+from mlaunch.plan.origin import user_location
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -31,7 +31,7 @@ def set_launch_argv(target: str, second: str | None, arguments: list[str]) -> No
 
 
 def load(path: str) -> LaunchDescription:
-    from mlaunch import compat
+    from mlaunch.app import compat
     from mlaunch.launch.actions import LaunchDescription
 
     compat.install()

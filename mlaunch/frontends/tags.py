@@ -13,7 +13,6 @@ are in ``process_tags``, the machine tags in ``machine_tags``, the ``param`` val
 from __future__ import annotations
 
 import mlaunch.launch.actions as core
-from mlaunch.errors import MlaunchError
 from mlaunch.frontends.composition_tags import COMPOSITION_TAGS
 from mlaunch.frontends.entity import Attr, Entity, did_you_mean
 from mlaunch.frontends.fields import (
@@ -27,6 +26,7 @@ from mlaunch.frontends.fields import (
 from mlaunch.frontends.machine_tags import MACHINE_TAGS
 from mlaunch.frontends.process_tags import PROCESS_TAGS
 from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.plan.errors import MlaunchError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

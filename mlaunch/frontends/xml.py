@@ -11,10 +11,10 @@ import re
 from functools import partial
 from xml.parsers import expat
 
-from mlaunch.errors import LaunchFileError
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
+from mlaunch.plan.errors import LaunchFileError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

@@ -1,4 +1,4 @@
-"""The ``launch`` API of ROS 2, served by mlaunch (see mlaunch.compat).
+"""The ``launch`` API of ROS 2, served by mlaunch (see mlaunch.app.compat).
 
 Launch files import ``launch``, ``launch.actions``, ``launch.substitutions`` ... and get these
 modules. The top-level names load on first use, so importing one submodule stays cheap.
@@ -12,13 +12,13 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.app.launch_service import LaunchService
     from mlaunch.launch.conditions import Condition
     from mlaunch.launch.event_handlers import EventHandler
     from mlaunch.launch.events import Event
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
     from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
-    from mlaunch.launch.launch_service import LaunchService
     from mlaunch.launch.substitutions import (
         SomeSubstitutionsType,
         SomeSubstitutionsType_types_tuple,
@@ -33,7 +33,7 @@ _NAMES: dict[str, tuple[str, str]] = {
     "LaunchDescriptionEntity": ("mlaunch.launch.launch_description", "LaunchDescriptionEntity"),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
     "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
-    "LaunchService": ("mlaunch.launch.launch_service", "LaunchService"),
+    "LaunchService": ("mlaunch.app.launch_service", "LaunchService"),
     "EventHandler": ("mlaunch.launch.event_handlers", "EventHandler"),
     "Event": ("mlaunch.launch.events", "Event"),
     "LaunchDescriptionSource": (
@@ -59,7 +59,6 @@ _SUBMODULES = (
     "launch_context",
     "launch_description",
     "launch_description_sources",
-    "launch_service",
 )
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 
-from mlaunch.errors import LaunchArgumentError, LaunchFileError
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
@@ -20,8 +19,9 @@ from mlaunch.launch.substitutions import (
     perform_substitutions,
     to_bool,
 )
-from mlaunch.origin import caller_origin
-from mlaunch.run.plan import (
+from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError
+from mlaunch.plan.origin import caller_origin
+from mlaunch.plan.steps import (
     AddHandler,
     ArgumentInfo,
     Log,
@@ -29,7 +29,7 @@ from mlaunch.run.plan import (
     RequestShutdown,
     StartTimer,
 )
-from mlaunch.run.plan import EmitEvent as EmitEventStep
+from mlaunch.plan.steps import EmitEvent as EmitEventStep
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 # --- arguments and configurations ------------------------------------------------------------

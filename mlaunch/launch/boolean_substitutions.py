@@ -4,7 +4,6 @@ IfElse) and the two readings of a boolean text: YAML-style for them, strict for 
 
 from __future__ import annotations
 
-from mlaunch.errors import InvalidConditionExpressionError, SubstitutionFailure
 from mlaunch.launch.substitution import (
     SomeSubstitutionsType,
     Substitution,
@@ -13,6 +12,7 @@ from mlaunch.launch.substitution import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.plan.errors import InvalidConditionExpressionError, SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

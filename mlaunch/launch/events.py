@@ -1,7 +1,7 @@
 """Events, with the names of ROS 2 launch, and the matchers handlers use to pick processes.
 
 Plain classes (not dataclasses, whose import and creation cost start-up time) that compare and
-show themselves as dataclasses do, through ``mlaunch.record.Record``.
+show themselves as dataclasses do, through ``mlaunch.plan.record.Record``.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable
 
-from mlaunch.record import Record
+from mlaunch.plan.record import Record
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

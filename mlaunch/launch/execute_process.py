@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 
-from mlaunch.errors import MlaunchError, SubstitutionFailure
 from mlaunch.launch.launch_description import Action
 from mlaunch.launch.substitutions import (
     LaunchConfiguration,
@@ -20,7 +19,8 @@ from mlaunch.launch.substitutions import (
     perform_substitutions,
     to_bool,
 )
-from mlaunch.run.plan import OUTPUT_MODES, Deferred, ProcessSpec, RespawnPolicy
+from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
+from mlaunch.plan.steps import OUTPUT_MODES, Deferred, ProcessSpec, RespawnPolicy
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -29,8 +29,8 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.run.plan import NodeInfo
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.plan.steps import NodeInfo
+    from mlaunch.resolve.resolver import Resolver
 
 # The launch configuration PushMachine (or a default Machine) sets for the rest of its scope
 # (mlaunch.machines); here so that a launch without machines never imports that package.
@@ -52,7 +52,7 @@ class ExecuteProcess(Action):
     """
 
     # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
-    # (mlaunch.launch.launch_service fills it in; launch_testing looks processes up by it).
+    # (mlaunch.app.launch_service fills it in; launch_testing looks processes up by it).
     process_details: dict[str, Any] | None = None
     # The exit status of its last run (negative: killed by that signal); None until it exits.
     return_code: int | None = None

@@ -7,7 +7,7 @@ and may return entities to visit next. Nothing here starts a process or prints.
 
 from __future__ import annotations
 
-from mlaunch.origin import caller_origin
+from mlaunch.plan.origin import caller_origin
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -15,7 +15,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.conditions import Condition
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 class LaunchDescriptionEntity:

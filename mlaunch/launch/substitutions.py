@@ -11,7 +11,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Iterable
 
-from mlaunch.errors import SubstitutionFailure
 from mlaunch.launch.boolean_substitutions import (
     AllSubstitution,
     AndSubstitution,
@@ -37,6 +36,7 @@ from mlaunch.launch.substitution import (
     perform,
     perform_substitutions,
 )
+from mlaunch.plan.errors import SubstitutionFailure
 
 # typing (~4 ms) and subprocess (~3 ms, with selectors and threading) are not imported at start-up:
 # annotations are strings, and only Command() runs a program. mypy treats this name as

@@ -18,9 +18,9 @@ import threading
 
 import pytest
 
+from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import LaunchDescription, RegisterEventHandler
 from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
-from mlaunch.launch.launch_service import LaunchService
 from mlaunch.launch_testing.actions import ReadyToTest
 from mlaunch.launch_testing.io_handler import ActiveIoHandler
 from mlaunch.launch_testing.loader import iter_ready_to_test

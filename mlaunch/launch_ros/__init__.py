@@ -12,19 +12,19 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch_ros.params import evaluate_dict as evaluate_parameter_dict
+    from mlaunch.launch_ros.params import normalize_dict as normalize_parameter_dict
+    from mlaunch.launch_ros.params import normalize_parameters
     from mlaunch.launch_ros.scope import make_namespace_absolute, prefix_namespace
-    from mlaunch.ros.params import evaluate_dict as evaluate_parameter_dict
-    from mlaunch.ros.params import normalize_dict as normalize_parameter_dict
-    from mlaunch.ros.params import normalize_parameters
 
 # launch_ros.utilities names -> (module, attribute): loaded on first use so that importing
 # ``launch_ros.substitutions`` alone does not load the Node machinery.
 _NAMES: dict[str, tuple[str, str]] = {
     "make_namespace_absolute": ("mlaunch.launch_ros.scope", "make_namespace_absolute"),
     "prefix_namespace": ("mlaunch.launch_ros.scope", "prefix_namespace"),
-    "evaluate_parameter_dict": ("mlaunch.ros.params", "evaluate_dict"),
-    "normalize_parameter_dict": ("mlaunch.ros.params", "normalize_dict"),
-    "normalize_parameters": ("mlaunch.ros.params", "normalize_parameters"),
+    "evaluate_parameter_dict": ("mlaunch.launch_ros.params", "evaluate_dict"),
+    "normalize_parameter_dict": ("mlaunch.launch_ros.params", "normalize_dict"),
+    "normalize_parameters": ("mlaunch.launch_ros.params", "normalize_parameters"),
 }
 
 _SUBMODULES = {
@@ -69,7 +69,7 @@ def evaluate_parameters(context: Any, parameters: Any) -> list[Any]:
     from pathlib import Path
 
     from mlaunch.launch_ros.parameter_descriptions import ParameterFile
-    from mlaunch.ros.params import evaluate_dict as evaluate_parameter_dict
+    from mlaunch.launch_ros.params import evaluate_dict as evaluate_parameter_dict
 
     out: list[Any] = []
     for entry in parameters:

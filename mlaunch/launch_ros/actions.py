@@ -10,7 +10,6 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 
-from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.launch.actions import Action, LaunchDescription
 from mlaunch.launch.substitutions import (
     SomeSubstitutionsType,
@@ -18,6 +17,8 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros import params
+from mlaunch.launch_ros import xacro as _xacro
 from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
 from mlaunch.launch_ros.scope import (
@@ -28,15 +29,14 @@ from mlaunch.launch_ros.scope import (
     node_name_problem,
     prefix_namespace,
 )
-from mlaunch.ros import params
-from mlaunch.ros import xacro as _xacro
+from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.actions import LaunchDescriptionEntity
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 _xacro.register()
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from mlaunch.errors import LaunchFileError
 from mlaunch.launch.substitutions import normalize
+from mlaunch.plan.errors import LaunchFileError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -38,7 +38,7 @@ class ComposableNode:
         extra_arguments: Any = None,
         condition: Any = None,
     ) -> None:
-        from mlaunch.ros.params import normalize_parameters
+        from mlaunch.launch_ros.params import normalize_parameters
 
         self.package = normalize(package)
         self.node_plugin = normalize(plugin)

@@ -16,20 +16,20 @@ container's full name, which exists only once the container was visited.
 
 from __future__ import annotations
 
-from mlaunch.errors import LaunchFileError, MlaunchError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import Substitution, describe, normalize, perform_substitutions
 from mlaunch.launch_ros.actions import Node, make_namespace_absolute
 from mlaunch.launch_ros.composable import ComposableNode
 from mlaunch.launch_ros.node import node_name_counts
-from mlaunch.run.plan import Handoff
+from mlaunch.plan.errors import LaunchFileError, MlaunchError
+from mlaunch.plan.steps import Handoff
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch_ros.load_request import LoadRequest
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 # What a load needs attached to the run (Plan.needs): the LoadNode driver.
@@ -42,7 +42,7 @@ class LoadComponents(Handoff):
     ``written`` is the container's name as the launch file gave it (launch_ros's log lines show
     that, ``'box'`` rather than ``'/box'``); empty means the same as ``target``.
     A Handoff: the supervisor emits it on the event stream when it reaches it (in the plan, a
-    timer or an event handler), and the LoadNode driver (mlaunch.ros.components) sends the
+    timer or an event handler), and the LoadNode driver (mlaunch.parts.components) sends the
     requests."""
 
     __slots__ = ("names", "requests", "target", "written")

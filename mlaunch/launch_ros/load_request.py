@@ -19,12 +19,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mlaunch.errors import MlaunchError, SubstitutionFailure
 from mlaunch.launch.substitutions import perform_substitutions
+from mlaunch.launch_ros import params
 from mlaunch.launch_ros.actions import make_namespace_absolute, prefix_namespace
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile
-from mlaunch.record import Record
-from mlaunch.ros import params
+from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
+from mlaunch.plan.record import Record
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -269,7 +269,7 @@ def parameter_type(name: str, value: Any) -> int:
 
 def describe_request(request: LoadRequest, container: str, origin: str) -> list[str]:
     """--print lines of one component load, as a process is shown."""
-    from mlaunch.run.describe import _rel, _shorten, _value_text
+    from mlaunch.resolve.describe import _rel, _shorten, _value_text
 
     lines = [
         f"component {request.full_name}   (loaded into {container})"
@@ -286,8 +286,8 @@ def describe_request(request: LoadRequest, container: str, origin: str) -> list[
 
 
 def request_data(request: LoadRequest) -> dict[str, Any]:
-    """--print --format json: one component load as data (mlaunch.run.plan_json)."""
-    from mlaunch.run.plan_json import json_safe
+    """--print --format json: one component load as data (mlaunch.resolve.plan_json)."""
+    from mlaunch.resolve.plan_json import json_safe
 
     def typed(p: TypedParameter) -> dict[str, Any]:
         return {"name": p.name, "value": json_safe(p.value), "type": TYPE_NAMES[p.type]}

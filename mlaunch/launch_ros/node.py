@@ -19,7 +19,6 @@ import os
 from collections.abc import Iterable
 
 from mlaunch import standins
-from mlaunch.errors import LaunchFileError, MlaunchError, SubstitutionFailure
 from mlaunch.launch.execute_process import ExecuteProcess
 from mlaunch.launch.substitutions import (
     SomeSubstitutionsType,
@@ -28,6 +27,7 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros import params
 from mlaunch.launch_ros.composable import remap_rules as _remap_rules
 from mlaunch.launch_ros.parameter_descriptions import ParameterFile
 from mlaunch.launch_ros.scope import (
@@ -38,17 +38,18 @@ from mlaunch.launch_ros.scope import (
     ros_remaps,
 )
 from mlaunch.launch_ros.substitutions import ExecutableInPackage
-from mlaunch.record import Record
-from mlaunch.ros import packages, params
+from mlaunch.plan.errors import LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.plan.record import Record
+from mlaunch.plan.steps import NodeInfo, ProcessSpec
+from mlaunch.ros import packages
 from mlaunch.ros.packages import PackageNotFoundError
-from mlaunch.run.plan import NodeInfo, ProcessSpec
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 Subs = tuple[Substitution, ...]
 # launch_ros's key for the count of full node names in the context globals.
@@ -272,7 +273,7 @@ class Node(ExecuteProcess):
         package = perform_substitutions(ctx, self.node_package)
         index = packages.for_context(ctx)
         if remote:
-            # Found on that computer (mlaunch.machines.agent looks the package up there); this
+            # Found on that computer (mlaunch.parts.agent looks the package up there); this
             # computer's path is only a hint, and there are no stand-ins on other computers.
             return package, executable, [remote_executable(index, package, executable)], None
         if index.installed(package) is not None:

@@ -19,13 +19,13 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from mlaunch.errors import LaunchFileError, SubstitutionFailure
 from mlaunch.launch.substitutions import (
     Substitution,
     describe,
     normalize,
     perform_substitutions,
 )
+from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

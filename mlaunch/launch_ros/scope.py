@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 # --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
@@ -109,7 +109,7 @@ def add_global_remap(resolver: Resolver, action: Any, rule: tuple[str, str]) -> 
 def _extend_shared(
     resolver: Resolver, action: Any, key: str, entries: tuple[Any, ...], what: str
 ) -> None:
-    from mlaunch.run.binding import SCOPED_PARAMETERS, file_has
+    from mlaunch.resolve.binding import SCOPED_PARAMETERS, file_has
 
     configs = resolver.context.launch_configurations
     current = configs.get(key)

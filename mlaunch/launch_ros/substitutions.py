@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import collections.abc
 
-from mlaunch.errors import SubstitutionFailure
 from mlaunch.launch.substitutions import (
     PathJoinSubstitution,
     SomeSubstitutionsType,
@@ -18,8 +17,9 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch_ros import xacro as _xacro
+from mlaunch.plan.errors import SubstitutionFailure
 from mlaunch.ros import packages
-from mlaunch.ros import xacro as _xacro
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

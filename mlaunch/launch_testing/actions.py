@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 from mlaunch.launch.actions import Action
-from mlaunch.run.plan import StartTimer
+from mlaunch.plan.steps import StartTimer
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 class ReadyToTest(Action):

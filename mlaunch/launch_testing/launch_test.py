@@ -13,7 +13,7 @@ import os
 import re
 import sys
 
-from mlaunch.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERRUPTED, EXIT_OK, EXIT_USAGE
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_description import LaunchDescriptionEntity
 
-# mlaunch.errors' table: a launch test's own errors (its file, its arguments) are bad input.
+# mlaunch.plan.errors' table: a launch test's own errors (its file, its arguments) are bad input.
 EXIT_PASS = EXIT_OK
 EXIT_FAIL = EXIT_FAILURE
 
@@ -73,7 +73,7 @@ def build_parser(prog: str = "launch_test") -> argparse.ArgumentParser:
 
 def load_module(name: str, path: str) -> ModuleType:
     """Import the test file as module ``name``, with the ROS 2 names served by mlaunch."""
-    from mlaunch import compat
+    from mlaunch.app import compat
 
     compat.install()
     spec = importlib.util.spec_from_file_location(name, path)
@@ -109,8 +109,8 @@ def run(args: argparse.Namespace) -> int:
 
 
 def show_arguments(description: LaunchDescriptionEntity, path: str) -> None:
-    from mlaunch.run.describe import format_arguments
-    from mlaunch.run.resolve import collect_arguments
+    from mlaunch.resolve.describe import format_arguments
+    from mlaunch.resolve.resolver import collect_arguments
 
     infos = collect_arguments(description, path=path, arguments={}, environ=os.environ)
     sys.stdout.write(format_arguments(infos))

@@ -12,9 +12,9 @@ import threading
 import time
 import unittest
 
+from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import LaunchDescription, RegisterEventHandler
 from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
-from mlaunch.launch.launch_service import LaunchService
 from mlaunch.launch_testing.io_handler import ActiveIoHandler
 from mlaunch.launch_testing.proc_info_handler import ActiveProcInfoHandler
 

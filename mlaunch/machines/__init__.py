@@ -1,7 +1,6 @@
-"""Several machines: processes of one launch started on other computers over SSH.
+"""Several machines, as a launch file writes them (``Machine``, ``PushMachine``, ``machine=``).
 
-``spec`` is the resolved machine (what ``--print`` shows), ``actions`` the launch-file spelling
-(``Machine``, ``PushMachine``, ``machine=``), ``ssh`` one multiplexed connection per machine,
-``remote`` the process seam the supervisor calls, and ``agent`` the small program that runs on
-the other computer. Nothing here is imported by a launch that declares no machine.
+The resolved machine is ``mlaunch.plan.machine``; the SSH connection, the process seam and the
+agent that runs on the other computer are parts of a run (``mlaunch.parts.ssh``, ``remote``,
+``agent``). Nothing here is imported by a launch that declares no machine.
 """

@@ -10,18 +10,18 @@ launch configuration, so a scoped GroupAction keeps it inside.
 
 from __future__ import annotations
 
-from mlaunch.errors import LaunchFileError
 from mlaunch.launch.execute_process import PUSHED_MACHINE as PUSHED
 from mlaunch.launch.launch_description import Action
 from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
-from mlaunch.machines.spec import DEFAULT_TIMEOUT, MachineSpec, check_name, declared
+from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.machine import DEFAULT_TIMEOUT, MachineSpec, check_name, declared
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 class Machine(Action):
@@ -70,7 +70,7 @@ class Machine(Action):
             resolver.context.launch_configurations[PUSHED] = spec.name
 
     def resolve_spec(self, resolver: Resolver) -> MachineSpec:
-        from mlaunch.machines.spec import is_local
+        from mlaunch.plan.machine import is_local
 
         ctx = resolver.context
         name = perform_substitutions(ctx, self.name)

@@ -1,2 +1,1 @@
-"""ROS-facing helpers: the ament index, package search, node command lines, params files, xacro,
-lifecycle driving and the rclpy bridge (the only place rclpy is imported, lazily)."""
+"""ROS package data on disk, no rclpy: the ament index, the run's package search, params files."""

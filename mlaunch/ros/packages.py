@@ -30,8 +30,8 @@ import os
 import re
 import sys
 
-from mlaunch import errors
-from mlaunch.record import Record
+from mlaunch.plan import errors
+from mlaunch.plan.record import Record
 from mlaunch.ros.search import CONTEXT_KEY, PackageSearch, active
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 
-from mlaunch.record import Record
+from mlaunch.plan.record import Record
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

@@ -38,7 +38,7 @@ from mlaunch.ros1.model import (
 )
 
 if TYPE_CHECKING:
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 
 class MappingWarning(Action):
@@ -235,7 +235,7 @@ def _substitution(part: Part) -> Any:
     if isinstance(part, EvalRef):
         return RoslaunchEval(part.expression)
     if isinstance(part, CommandRef):
-        import mlaunch.ros.xacro  # noqa: F401  (xacro runs in-process for Command)
+        import mlaunch.launch_ros.xacro  # noqa: F401  (xacro runs in-process for Command)
 
         return core.Command(subs(part.command), on_stderr="warn")
     if isinstance(part, FileRef):

@@ -8,9 +8,9 @@ from dataclasses import dataclass, field
 from typing import Any
 from xml.parsers import expat
 
-from mlaunch.errors import LaunchFileError, MlaunchError
 from mlaunch.frontends.encoding import not_utf8
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
+from mlaunch.plan.errors import LaunchFileError, MlaunchError
 from mlaunch.ros1.eval import EvalCutter
 from mlaunch.ros1.model import (
     AnonRef,

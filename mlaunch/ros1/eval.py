@@ -13,8 +13,8 @@ import os
 from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import MlaunchError, SubstitutionFailure
 from mlaunch.launch.substitutions import Substitution
+from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
 from mlaunch.ros1.model import (
     AnonRef,
     ArgRef,

@@ -2,7 +2,7 @@
 
 ``mlaunch.ros1.reading`` maps a ROS 1 file to these ``Item`` objects (arguments, SetParameter,
 groups, includes, nodes, processes, warnings); ``mlaunch.ros1.build`` turns them into mlaunch's
-actions and ``mlaunch.ros1.convert`` writes them out as a ROS 2 file.
+actions and ``mlaunch.commands.convert`` writes them out as a ROS 2 file.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ Reading goes in two steps, and ``mlaunch convert`` shares the first one:
    decision is taken there, once (docs/ros1.md lists them); the nodes of known ROS 1 packages
    are rewritten by the table in ``mlaunch.ros1.mapping``.
 2. ``to_actions(items)`` (``mlaunch.ros1.build``) builds that model into mlaunch's own actions
-   (the ROS 2 classes); ``mlaunch.ros1.convert`` writes the same model out as a ROS 2 launch
+   (the ROS 2 classes); ``mlaunch.commands.convert`` writes the same model out as a ROS 2 launch
    file instead. Running the ROS 1 file and running its conversion therefore resolve to the
    same plan.
 

@@ -11,7 +11,7 @@ from typing import Any
 
 import yaml
 
-from mlaunch.errors import LaunchFileError
+from mlaunch.plan.errors import LaunchFileError
 from mlaunch.ros1.model import DirnameRef, FindRef, Part, Value, merge
 
 _XACRO = re.compile(r"^/xacro(\.py)?(?=\s)")

@@ -1,7 +1,7 @@
 """What ``mlaunch test`` checks: expectations, parsed from the command line or the launch file.
 
 ``Expect`` (Python) and ``mlaunch_expect*`` launch configurations (any format) put them in the
-plan; ``build_expectations`` (mlaunch.smoke) merges them with the defaults.
+plan; ``build_expectations`` (mlaunch.commands.smoke) merges them with the defaults.
 """
 
 from __future__ import annotations
@@ -10,13 +10,13 @@ import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import LaunchFileError, UsageError
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import perform
-from mlaunch.run.plan import Note
+from mlaunch.plan.errors import LaunchFileError, UsageError
+from mlaunch.plan.steps import Note
 
 if TYPE_CHECKING:
-    from mlaunch.run.resolve import Resolver
+    from mlaunch.resolve.resolver import Resolver
 
 CONFIG_PREFIX = "mlaunch_expect"
 KINDS = ("topic", "service", "node", "lifecycle", "output", "clock")

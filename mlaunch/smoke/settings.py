@@ -37,7 +37,7 @@ or from the launch file:
     ``- let: {name: mlaunch_expect_scan, value: "topic /scan:10 within 15"}``, in XML
     ``<let name="mlaunch_expect_scan" value="topic /scan:10"/>`` (it must be set where the
     top level of the launch sees it: at the top level, or in an included file, not in a group);
-  - in Python, ``mlaunch.smoke.Expect(topic="/scan", rate=10.0, within=15)`` (or
+  - in Python, ``mlaunch.commands.smoke.Expect(topic="/scan", rate=10.0, within=15)`` (or
     ``service=``, ``node=``, ``lifecycle=`` with ``state=``, ``output=`` with ``process=``).
 A normal ``mlaunch FILE`` run ignores both.
 
@@ -52,7 +52,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from mlaunch.errors import UsageError
+from mlaunch.plan.errors import UsageError
 from mlaunch.smoke.expectations import KINDS, Expectation, parse_spec, parse_target
 
 _HELP = __doc__ or ""

@@ -10,16 +10,16 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.run.events import Event, Exited, HandedOff, Output, Started
+from mlaunch.plan.events import Event, Exited, HandedOff, Output, Started
 from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
 if TYPE_CHECKING:
-    from mlaunch.ros.handoff import SharedGraph
-    from mlaunch.ros.lifecycle import LifecycleManager, Outcome
-    from mlaunch.run.plan import Plan, ProcessSpec
-    from mlaunch.run.process import Process
-    from mlaunch.run.supervisor import Supervisor
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.handoff import SharedGraph
+    from mlaunch.parts.lifecycle import LifecycleManager, Outcome
+    from mlaunch.plan.steps import Plan, ProcessSpec
 
 # At the end, the youngest process is given up to this long since its start before the stop
 # signals: SIGINT during a Python node's imports leaves a traceback in a passing run.
@@ -53,7 +53,7 @@ class SmokeRun:
         *,
         lifecycle: LifecycleManager | None = None,
     ) -> None:
-        from mlaunch.ros.handoff import LoopCall, SharedGraph
+        from mlaunch.parts.handoff import LoopCall, SharedGraph
 
         self.supervisor = supervisor
         self.expectations = expectations
@@ -84,7 +84,7 @@ class SmokeRun:
 
     def _on_event(self, event: Event) -> None:
         """The subscription: output, starts and exits, and the lifecycle manager's results."""
-        from mlaunch.ros.lifecycle import Outcome
+        from mlaunch.parts.lifecycle import Outcome
 
         if isinstance(event, Output):
             self._on_output(event.process.label, event.data)
@@ -163,7 +163,7 @@ class SmokeRun:
         self._checker.start()
 
     def _exited(self, e: Expectation, process: Process) -> None:
-        from mlaunch.run.process import describe_status
+        from mlaunch.engine.process import describe_status
 
         code = process.returncode if process.returncode is not None else 0
         uptime = max(0.0, process.ended_at - process.started_at)
@@ -274,7 +274,7 @@ class SmokeRun:
     # --- checker thread ---------------------------------------------------------------------------
 
     def _check_graph(self) -> None:
-        from mlaunch.ros.graph_types import GraphNotRunning, RosBridgeError
+        from mlaunch.parts.graph_types import GraphNotRunning, RosBridgeError
 
         try:
             graph = self.graph.get()
@@ -389,7 +389,7 @@ class GraphProbe:
         return False, f"not in the graph (nodes seen: {shown or 'none'})"
 
     def _lifecycle(self, e: Expectation, *, nodes: set[str], **_: Any) -> tuple[bool, str]:
-        from mlaunch.ros.graph_types import RosTimeout
+        from mlaunch.parts.graph_types import RosTimeout
 
         if e.target not in nodes:
             return False, "the node is not in the graph"

@@ -12,7 +12,7 @@ import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 
 # Plugin file names, with and without the lib prefix / .so suffix (gz accepts both spellings).
 CLASSIC_DIFF_DRIVE = "gazebo_ros_diff_drive"

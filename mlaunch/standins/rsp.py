@@ -17,7 +17,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 from mlaunch.standins import transforms
 from mlaunch.standins.common import EXIT_FAILURE, init_ros, spin_until_shutdown
 from mlaunch.standins.urdf import Robot, UrdfError, joint_transform, parse_urdf

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NoReturn
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag, latched
 from mlaunch.standins.diffdrive import Pose2D, describe_model
 from mlaunch.standins.plugins import ModelError

@@ -16,7 +16,7 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 from mlaunch.standins import transforms
 from mlaunch.standins.common import EXIT_FAILURE, EXIT_OK, init_ros, spin_until_shutdown
 

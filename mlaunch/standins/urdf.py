@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 GEOMETRY_KINDS = ("box", "cylinder", "sphere", "mesh")

@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 
 PORT_ENV = "MLAUNCH_VIEWER_PORT"
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from xml.parsers import expat
 
-from mlaunch.errors import StandinError
+from mlaunch.plan.errors import StandinError
 
 # Re-exported: the simulator, its tests and its callers know these from here.
 from mlaunch.standins.raycast import GaussianNoise as GaussianNoise

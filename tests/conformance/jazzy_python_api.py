@@ -1,8 +1,8 @@
 """Write down the Python names and keyword arguments of the reference launch (run under its python).
 
-    bash -c 'source ~/.cache/ros2-launch-jazzy/env.sh && python tests/conformance/jazzy_python_api.py' > mlaunch/jazzy_python.json
+    bash -c 'source ~/.cache/ros2-launch-jazzy/env.sh && python tests/conformance/jazzy_python_api.py' > mlaunch/check/jazzy_python.json
 
-The output (mlaunch/jazzy_python.json) is data the portability check holds .launch.py files to (which
+The output (mlaunch/check/jazzy_python.json) is data the portability check holds .launch.py files to (which
 ``launch``/``launch_ros`` modules exist, what names they export, which keyword arguments their
 classes take). test_portability checks that the file still says what the reference has.
 """

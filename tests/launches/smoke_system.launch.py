@@ -20,8 +20,8 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch_ros.actions import LifecycleNode, Node
 
-from mlaunch.ros.lifecycle import LifecycleSequence
-from mlaunch.smoke import Expect
+from mlaunch.commands.smoke import Expect
+from mlaunch.parts.lifecycle import LifecycleSequence
 
 NODES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "nodes")
 VARIANTS = ("ok", "crash", "die_later", "ghost", "silent", "fail_configure")

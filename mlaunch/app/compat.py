@@ -1,0 +1,114 @@
+"""The module names unmodified ROS 2 launch files import, served by mlaunch while it loads them.
+
+``install()`` puts a finder first on ``sys.meta_path`` that answers ``launch``, ``launch.actions``,
+``launch_ros.actions``, ``ament_index_python.packages`` ... with mlaunch's own modules. Nothing is
+installed on disk, so a real ROS installation on the same machine is never shadowed outside
+mlaunch, and inside mlaunch every description is built from classes mlaunch can resolve.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from importlib.machinery import ModuleSpec
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from types import ModuleType
+    from typing import Any
+
+# The ROS 2 top-level packages and the mlaunch package serving each: ``launch.X.Y`` is
+# ``mlaunch.launch.X.Y``, and so on (a prefix rule: a new module needs no entry here).
+ROOTS: dict[str, str] = {
+    "launch": "mlaunch.launch",
+    "launch_ros": "mlaunch.launch_ros",
+    "launch_xml": "mlaunch.launch.launch_description_sources",
+    "launch_yaml": "mlaunch.launch.launch_description_sources",
+    "ament_index_python": "mlaunch.ros.ament_index",
+    "launch_testing": "mlaunch.launch_testing",
+    "launch_testing_ros": "mlaunch.launch_testing_ros",
+    "launch_pytest": "mlaunch.launch_pytest",
+}
+
+# Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per
+# module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.launch_description``).
+SYNONYMS: dict[str, str] = {
+    "launch.action": "mlaunch.launch.launch_description",
+    "launch.launch_description_entity": "mlaunch.launch.launch_description",
+    "launch.some_substitutions_type": "mlaunch.launch.substitution",
+    "launch.condition": "mlaunch.launch.conditions",
+    "launch.event_handler": "mlaunch.launch.event_handlers",
+    "launch.event": "mlaunch.launch.events",
+    "launch.events.process": "mlaunch.launch.events",
+    "launch.utilities": "mlaunch.launch",
+    "launch.launch_service": "mlaunch.app.launch_service",
+    "launch.frontend": "mlaunch.launch",
+    "launch_xml.launch_description_sources": "mlaunch.launch.launch_description_sources",
+    "launch_yaml.launch_description_sources": "mlaunch.launch.launch_description_sources",
+    "launch_ros.event_handlers": "mlaunch.launch_ros.events",
+    "launch_ros.events.lifecycle": "mlaunch.launch_ros.events",
+    "launch_ros.utilities": "mlaunch.launch_ros",
+    "ament_index_python.packages": "mlaunch.ros.ament_index",
+    "launch_testing.tools.text": "mlaunch.launch_testing.text",
+    "launch_testing.tools.output": "mlaunch.launch_testing.tools",
+    "launch_testing.tools.process": "mlaunch.launch_testing.tools",
+    "launch_testing.decorator": "mlaunch.launch_testing.markers",
+    "launch_testing.parametrize": "mlaunch.launch_testing.markers",
+    "launch_testing.ready_to_test_action_timeout": "mlaunch.launch_testing.markers",
+    "launch_testing.test_result": "mlaunch.launch_testing.test_runner",
+    "launch_testing.util.proc_lookup": "mlaunch.launch_testing.util",
+    "launch_pytest.tools.process": "mlaunch.launch_pytest.tools",
+}
+
+
+def target_of(fullname: str) -> str | None:
+    """The mlaunch module that serves the ROS 2 module ``fullname``, or None if none does."""
+    if fullname in SYNONYMS:
+        return SYNONYMS[fullname]
+    root, dot, rest = fullname.partition(".")
+    base = ROOTS.get(root)
+    if base is None:
+        return None
+    return base + dot + rest
+
+
+# Plain classes, not importlib.abc's: importing importlib.abc pulls in importlib.resources and
+# pathlib (~7 ms), and the import system only needs these methods.
+class _AliasLoader:
+    def __init__(self, target: str) -> None:
+        self.target = target
+
+    def create_module(self, spec: ModuleSpec) -> ModuleType:
+        return importlib.import_module(self.target)
+
+    def exec_module(self, module: ModuleType) -> None:
+        return None
+
+
+class AliasFinder:
+    """Answers the ROS 2 module names with mlaunch modules."""
+
+    def find_spec(self, fullname, path=None, target=None):  # type: ignore[no-untyped-def]
+        target_name = target_of(fullname)
+        if target_name is None:
+            return None
+        if importlib.util.find_spec(target_name) is None:
+            return None
+        is_package = fullname in ROOTS or any(s.startswith(fullname + ".") for s in SYNONYMS)
+        loader: Any = _AliasLoader(target_name)
+        return ModuleSpec(fullname, loader, is_package=is_package)
+
+
+_FINDER = AliasFinder()
+
+
+def install() -> None:
+    """Serve the ROS 2 names from now on in this process (idempotent)."""
+    if _FINDER in sys.meta_path:
+        return
+    sys.meta_path.insert(0, _FINDER)
+    # A real launch/launch_ros/ament_index_python imported earlier must not win.
+    for name in list(sys.modules):
+        module = sys.modules[name]
+        if target_of(name) is not None and not module.__name__.startswith("mlaunch"):
+            del sys.modules[name]

@@ -1,0 +1,442 @@
+"""One run of a launch file: load -> resolve -> supervise, with an explicit list of what attaches.
+
+``mlaunch FILE``, ``mlaunch test FILE`` and ``mlaunch export`` go through here; none reaches
+into another. What attaches to a run is a list of functions the caller passes to ``launch`` or
+``supervise``: each is called with the Run (after the supervisor exists, before it starts) and
+returns a part that subscribes to the supervisor's event stream, or None; parts with a
+``close()`` are closed in list order when the run ends. ``standard_parts`` is what every run
+gets: lifecycle driving (when the plan needs it, as resolve noted), the ``--status`` view (when
+asked for) and the exit summary. Nothing here imports rclpy, rich or psutil unless a part that
+needs them is attached.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+
+from mlaunch.app.options import Options
+from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Started
+from mlaunch.plan.steps import Plan
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.engine.lifeline import Lifeline
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.launch.launch_description import LaunchDescription, LaunchDescriptionEntity
+    from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
+    from mlaunch.ros.search import PackageSearch
+
+
+class Run:
+    """What an attached part sees of the run: the command line, the plan and the supervisor.
+
+    ``lifecycle`` is the LifecycleManager once lifecycle driving is attached (the smoke checks
+    share its ROS graph), else None.
+    """
+
+    __slots__ = ("lifecycle", "opts", "plan", "supervisor")
+
+    def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor) -> None:
+        self.opts = opts
+        self.plan = plan
+        self.supervisor = supervisor
+        self.lifecycle: LifecycleManager | None = None
+
+
+Attach = Callable[[Run], object]
+
+
+# --- load and resolve ---------------------------------------------------------------------------
+
+
+def find_launch_file(opts: Options) -> str:
+    """The launch file path: a file, or PKG FILE looked up in the package's share folder."""
+    from mlaunch.plan.errors import LaunchFileError
+
+    if opts.second is None:
+        if not os.path.exists(opts.target):
+            raise LaunchFileError(f"launch file {opts.target!r} does not exist")
+        return os.path.abspath(opts.target)
+    from mlaunch.ros import packages
+
+    return packages.find_launch_file(opts.target, opts.second)
+
+
+def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
+    """Where this run looks for ROS packages: --package-path, the launch file, the environment."""
+    from mlaunch.ros.search import PackageSearch
+
+    return PackageSearch(opts.package_path, launch_file, os.environ)
+
+
+def load_target(opts: Options) -> tuple[str, LaunchDescription]:
+    """The launch file the command line names (a path, or PKG FILE) and its description."""
+    from mlaunch.ros.search import searching
+
+    # `mlaunch PKG FILE` looks the package up with the search settings, before there is a file.
+    given = os.path.abspath(opts.target) if opts.second is None else None
+    with searching(package_search(opts, given if given and os.path.exists(given) else None)):
+        path = find_launch_file(opts)
+    from mlaunch import frontends
+    from mlaunch.frontends.python import set_launch_argv
+
+    set_launch_argv(opts.target, opts.second, opts.launch_argv)
+    # Launch-file code run while loading (get_package_share_directory) sees the same search.
+    with searching(package_search(opts, path)):
+        return path, frontends.load(path)
+
+
+def resolve_for_run(
+    opts: Options,
+    path: str,
+    description: LaunchDescriptionEntity,
+    *,
+    temp_dir: str,
+    log_dir: str,
+) -> tuple[Plan, ResolveOptions, LabelCounter]:
+    """(plan, resolve options, label counter) for a run of ``description`` as opts say."""
+    from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
+
+    options = ResolveOptions(
+        standins=opts.standins,
+        packages=package_search(opts, path),
+        temp_dir=temp_dir,
+        capture=opts.capture,
+        scoped_parameters=opts.scoped_parameters,
+    )
+    if opts.use_sim_time is not None:
+        from mlaunch.launch_ros.actions import with_use_sim_time
+
+        description = with_use_sim_time(description, opts.use_sim_time)
+    labels = LabelCounter()
+    plan = resolve(
+        description,
+        path=path,
+        arguments=opts.arguments,
+        environ=dict(os.environ),
+        log_dir=log_dir,
+        options=options,
+        labels=labels,
+    )
+    return plan, options, labels
+
+
+# --- the whole pipeline --------------------------------------------------------------------------
+
+
+def launch(opts: Options, attach: Sequence[Attach]) -> int:
+    """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it."""
+    from mlaunch.engine.lifeline import Lifeline, write_stdout
+
+    # From here on a launch file's code and substitutions may start processes: signals, the
+    # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
+    with Lifeline() as life:
+        path, description = load_target(opts)
+        if opts.show_args:
+            from mlaunch.resolve.describe import format_arguments
+            from mlaunch.resolve.resolver import collect_arguments
+            from mlaunch.ros.search import searching
+
+            with searching(package_search(opts, path)):
+                infos = collect_arguments(
+                    description, path=path, arguments=opts.arguments, environ=os.environ
+                )
+            if opts.format == "json":
+                from mlaunch.resolve.plan_json import arguments_json
+
+                write_stdout(arguments_json(infos, path, opts.arguments))
+            else:
+                write_stdout(format_arguments(infos))
+            return 0
+        log_dir = ""
+        if not opts.print_plan:
+            from mlaunch.engine.logfiles import make_run_log_dir
+
+            log_dir = make_run_log_dir(os.environ)
+        plan, options, labels = resolve_for_run(
+            opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir
+        )
+        if opts.print_plan:
+            write_stdout(describe(opts, plan, path))
+            return 0
+        return supervise(opts, plan, options, labels, log_dir, life, attach)
+
+
+def describe(opts: Options, plan: Plan, path: str) -> str:
+    """``--print``: the plan as text (resolve.describe) or JSON (resolve.plan_json)."""
+    if opts.format == "json":
+        from mlaunch.resolve.plan_json import plan_json
+
+        return plan_json(plan, path, opts.arguments)
+    from mlaunch.resolve.describe import describe_plan
+
+    return describe_plan(plan, path)
+
+
+def supervise(
+    opts: Options,
+    plan: Plan,
+    options: ResolveOptions,
+    labels: LabelCounter,
+    log_dir: str,
+    life: Lifeline,
+    attach: Sequence[Attach],
+) -> int:
+    """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts."""
+    from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
+    from mlaunch.engine.output import Printer, stdout_is_color_terminal
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.plan.errors import UsageError
+
+    if opts.log_max_bytes is not None and opts.log_max_bytes < 0:
+        raise UsageError(
+            f"--log-max-bytes is {opts.log_max_bytes}; valid: 0 (never rotate) or more"
+        )
+    guard, run_id = life.guard, life.run_id
+    color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
+    rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
+    printer = Printer(
+        color=color,
+        log_dir=log_dir,
+        quiet=opts.quiet,
+        rotate_bytes=rotate,
+        rotate_keep=DEFAULT_ROTATE_KEEP if opts.log_keep is None else opts.log_keep,
+    )
+    printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
+    spawner = _remote_spawner(labels, run_id)
+    supervisor = Supervisor(
+        plan,
+        printer,
+        options=options,
+        labels=labels,
+        guard=guard,
+        run_id=run_id,
+        spawner=Process if spawner is None else spawner,
+    )
+    run = Run(opts, plan, supervisor)
+    parts: list[object] = []
+    try:
+        if spawner is not None:
+            spawner.connect(plan.processes())
+        for part in attach:
+            attached = part(run)
+            if attached is not None:
+                parts.append(attached)
+        life.block()  # until the supervisor's own handlers are in
+        try:
+            code = supervisor.run()
+        finally:
+            life.hand_over()
+    finally:
+        for attached in parts:
+            close = getattr(attached, "close", None)
+            if close is not None:
+                close()
+        if spawner is not None:
+            spawner.close()
+        printer.close()
+        # Everything the run started has ended (run() kills what is left even when it fails).
+        if guard is not None:
+            guard.close()
+    return code
+
+
+def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
+    """The remote-process spawner when the launch declared other machines, else None."""
+    if not getattr(labels, "machines", None):
+        return None  # no Machine in the launch: mlaunch.machines is never imported
+    from mlaunch.plan.machine import remote_machines
+
+    if not remote_machines(labels):
+        return None
+    from mlaunch.engine.proctable import MARKER
+    from mlaunch.parts.remote import Spawner
+
+    return Spawner(os.environ, {MARKER: run_id})
+
+
+# --- what every run attaches ---------------------------------------------------------------------
+
+
+def standard_parts(opts: Options) -> list[Attach]:
+    """Lifecycle driving, composable node loading, the control socket, the ``--status`` view if
+    asked for, then the exit summary.
+
+    Closed in this order at the end: the status view leaves the screen before the summary.
+    """
+    parts: list[Attach] = [lifecycle, components, control_socket]
+    if opts.status:
+        parts.append(status_view)
+    parts.append(exit_summary)
+    return parts
+
+
+def lifecycle(run: Run) -> object:
+    """Lifecycle (managed) node driving: at once when the plan needs it, else on demand.
+
+    Resolve records in ``plan.needs`` whatever the description says about lifecycle nodes;
+    a handler written as a function can still start one nobody could see before it ran, so
+    without that need a watch (a few isinstance checks per record) attaches the manager the
+    moment a lifecycle node starts or a ChangeState is emitted.
+    """
+    from mlaunch.plan.steps import SEQUENCE_ARGUMENT
+
+    plan = run.plan
+    if (
+        "lifecycle" in plan.needs
+        or SEQUENCE_ARGUMENT in plan.arguments
+        or SEQUENCE_ARGUMENT in run.opts.arguments
+    ):
+        from mlaunch.parts.lifecycle import attach
+
+        run.lifecycle = attach(run.opts.arguments, run.supervisor)
+        return run.lifecycle
+    return _LifecycleWatch(run)
+
+
+class _LifecycleWatch:
+    """Attaches lifecycle driving the moment the run turns out to need it.
+
+    Until then it only looks at each record's class: a process of a lifecycle node starting,
+    or a launch event that needs lifecycle (ChangeState). The record that triggered it is
+    handed to the new manager, which sees every later record itself.
+    """
+
+    def __init__(self, run: Run) -> None:
+        self.run = run
+        run.supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if isinstance(event, Started):
+            node = event.process.spec.node
+            if node is None or not node.lifecycle:
+                return
+        elif not (isinstance(event, LaunchEvent) and getattr(event.event, "needs", None)):
+            return
+        from mlaunch.parts.lifecycle import attach
+
+        run = self.run
+        run.supervisor.events.unsubscribe(self._on_event)
+        run.lifecycle = attach(run.opts.arguments, run.supervisor)
+        run.lifecycle.on_event(event)
+
+    def close(self) -> None:
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        if self.run.lifecycle is not None:
+            self.run.lifecycle.close()
+
+
+def components(run: Run) -> object:
+    """Composable node loading (``components_part``)."""
+    return components_part(run.plan, run.supervisor)
+
+
+def components_part(plan: Plan, supervisor: Supervisor) -> object:
+    """The LoadNode driver: at once when the plan needs it, else on demand.
+
+    Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
+    LoadComposableNodes in timers and handlers not yet fired; a handler written as a function
+    (or a description a LaunchService includes later) can still make one, so without that need
+    a watch attaches the driver at the first LoadComponents the supervisor hands over.
+    """
+    if "components" in plan.needs:
+        from mlaunch.parts.components import ComponentDriver
+
+        return ComponentDriver(supervisor)
+    return _ComponentsWatch(supervisor)
+
+
+class _ComponentsWatch:
+    """Attaches the LoadNode driver at the first LoadComponents step handed over.
+
+    Until then it only looks at each record's class; the record that triggered it is handed to
+    the new driver, which sees every later record itself.
+    """
+
+    def __init__(self, supervisor: Supervisor) -> None:
+        self.supervisor = supervisor
+        self.driver: Any = None
+        supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if not isinstance(event, HandedOff) or "components" not in event.step.needs:
+            return
+        from mlaunch.parts.components import ComponentDriver
+
+        self.supervisor.events.unsubscribe(self._on_event)
+        self.driver = ComponentDriver(self.supervisor)
+        self.driver.on_event(event)
+
+    def close(self) -> None:
+        self.supervisor.events.unsubscribe(self._on_event)
+        if self.driver is not None:
+            self.driver.close()
+
+
+def control_socket(run: Run) -> object:
+    """``mlaunch ctl``'s socket in the run's log folder (mlaunch.parts.control_socket)."""
+    log_dir = run.supervisor.printer.log_dir
+    return _ControlSocketPart(run.supervisor, log_dir) if log_dir else None
+
+
+class _ControlSocketPart:
+    """Opens the control socket on the loop's first turn, and removes it at close.
+
+    After the first children have started: ``socket`` and ``json`` cost milliseconds, which
+    opening it at attach time would spend before the first child.
+    """
+
+    def __init__(self, supervisor: Supervisor, log_dir: str) -> None:
+        self.supervisor = supervisor
+        self.log_dir = log_dir
+        self.server: Any = None
+        supervisor.schedule(0.0, self._open, keeps_alive=False)
+
+    def _open(self) -> None:
+        from mlaunch.parts.control_socket import ControlSocket
+        from mlaunch.plan.events import Said
+
+        server = ControlSocket(self.supervisor, self.log_dir)
+        if server.open():
+            self.server = server
+        else:
+            text = f"{server.error}; mlaunch ctl cannot reach this run"
+            self.supervisor.events.emit(Said("WARNING", "launch", text))
+
+    def close(self) -> None:
+        if self.server is not None:
+            self.server.close()
+
+
+def status_view(run: Run) -> object:
+    """``--status``: the live table pinned below the output (rich and psutil, only then)."""
+    from mlaunch.parts.status import attach_status_view
+
+    return attach_status_view(run.supervisor)
+
+
+class _ExitSummary:
+    """Prints mlaunch.parts.summary's exit summary at close, importing it only then.
+
+    Importing it costs start-up time that attaching before the run would spend before the first
+    child starts.
+    """
+
+    def __init__(self, supervisor: Supervisor, *, quiet: bool) -> None:
+        self.supervisor = supervisor
+        self.quiet = quiet
+
+    def close(self) -> None:
+        from mlaunch.parts.summary import ExitSummary
+
+        ExitSummary(self.supervisor, quiet=self.quiet).close()
+
+
+def exit_summary(run: Run) -> object:
+    """The table of every process at the end (more than one process, or any failure)."""
+    return _ExitSummary(run.supervisor, quiet=run.opts.quiet)

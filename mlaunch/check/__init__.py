@@ -1,0 +1,1 @@
+"""``--check``: what ros2 launch (Jazzy) would reject or read differently in a file."""

@@ -1,0 +1,105 @@
+"""The command line: argv -> Options -> load -> resolve -> run. The only place errors are printed.
+
+Exit status (the table is mlaunch.plan.errors'):
+  0    every process ended and nothing required failed (or a Shutdown action ended the launch)
+  1    a required process (on_exit=Shutdown / required=True) exited with a failure
+  2    bad command line or launch file: missing file, syntax error, bad argument, failed
+       substitution, missing package or executable (one line on stderr, no traceback)
+  70   an internal error of mlaunch (a bug: --debug shows the traceback)
+  128+N  mlaunch was stopped by signal N: 130 for Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+from mlaunch.app.options import Options, parse_options
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+# Each subcommand module has command(args); it parses its options (mlaunch.app.options) and runs
+# through mlaunch.app.pipeline itself, so none imports this module back.
+SUBCOMMANDS = {
+    "test": "mlaunch.commands.smoke",
+    "convert": "mlaunch.commands.convert",
+    "export": "mlaunch.commands.export",
+    "ctl": "mlaunch.commands.ctl",
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``mlaunch ...`` and its subcommands: the one place errors are caught and printed."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    debug = "--debug" in args or "-d" in args
+    try:
+        if args and args[0] in SUBCOMMANDS and not os.path.isfile(args[0]):
+            import importlib
+
+            return int(importlib.import_module(SUBCOMMANDS[args[0]]).command(args[1:]))
+        return run_cli(args)
+    except BrokenPipeError:
+        from mlaunch.engine.lifeline import stdout_gone
+
+        return stdout_gone()
+    except (Exception, KeyboardInterrupt) as e:  # KeyboardInterrupt: Ctrl-C, lifeline.Stopped
+        return report_error(e, debug)
+
+
+def report_error(error: BaseException, debug: bool) -> int:
+    """The error printed once (see mlaunch.plan.errors.report); its exit status."""
+    from mlaunch.plan.errors import report
+
+    return report(error, debug=debug)
+
+
+def run_cli(argv: Sequence[str]) -> int:
+    """``mlaunch FILE ...``: the pipeline with what every run attaches (or ``--check``)."""
+    from mlaunch.app import pipeline
+
+    opts = parse_options(argv)
+    if opts.check:
+        return check_target(opts)
+    return pipeline.launch(opts, pipeline.standard_parts(opts))
+
+
+def check_target(opts: Options) -> int:
+    """``--check``: the portability report of the launch file, without loading or running it."""
+    from mlaunch.app.pipeline import find_launch_file, package_search
+    from mlaunch.check.portability import report
+    from mlaunch.ros.search import searching
+
+    with searching(package_search(opts, None)):
+        return report(find_launch_file(opts), sys.stdout)
+
+
+def program() -> None:
+    """The ``mlaunch`` program: main(), then exit without interpreter teardown.
+
+    By the time main() returns, the printer is closed, the guard reaped and the temp dir gone;
+    only stdio buffers remain, so flushing them and calling os._exit skips ~8 ms of teardown
+    between the last child's death and mlaunch's. Tests call main() instead.
+    """
+    from mlaunch.engine.lifeline import ensure_std_streams
+
+    ensure_std_streams()  # a closed stdout (mlaunch FILE >&-) must not lend its number to a file
+    if "_ARGCOMPLETE" in os.environ:  # the shell asks for completions: answered, then exit
+        from mlaunch.cli.completion import complete
+
+        complete()
+    try:
+        code = main()
+    except SystemExit as e:  # argparse's usage errors and --help
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe (mlaunch ... | head)
+            pass
+    os._exit(code)
+
+
+if __name__ == "__main__":
+    program()

@@ -1,0 +1,1 @@
+"""The subcommands of the mlaunch CLI: ``test`` (smoke), ``convert``, ``export``, ``ctl``."""

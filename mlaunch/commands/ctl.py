@@ -1,0 +1,353 @@
+"""``mlaunch ctl [RUN] list|stop|start|restart|mute|unmute|logs [LABEL]``: control a running launch.
+
+Another shell talks to a running mlaunch through its control socket (mlaunch.parts.control_socket,
+in the run's log folder, private to the user). RUN picks the run: by default the newest one that
+is still running; else a log folder (a path, or a folder name or part of one under the log
+base), mlaunch's pid, or the run id (``MLAUNCH_RUN_ID`` of its processes). What each operation
+does is mlaunch.parts.control's; this module finds the run, sends the request and says the answer.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import socket
+import sys
+
+from mlaunch.engine.logfiles import log_base_dir
+from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
+from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, Address, find_socket
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
+if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+
+# How long the run may take to take a request (its loop answers between two turns).
+ANSWER_TIMEOUT = 5.0
+RUN_ID = re.compile(r"(\d+)-[0-9a-f]{8}")
+
+DESCRIPTION = """\
+Control a running launch from another shell: list its processes, stop, start or restart one,
+keep one's output off mlaunch's screen (mute) or show it again (unmute), or print its last lines.
+"""
+
+EPILOG = """\
+operations:
+  list            every process: state, pid, restarts, uptime, muted, how it last ended
+  stop LABEL      stop it with its stop ladder (SIGINT, SIGTERM, SIGKILL); it stays down,
+                  respawn included, and is reported as stopped by the user
+  start LABEL     start a process that is not running again (same label, argv, parameters)
+  restart LABEL   stop it, then start it at once (no respawn delay); restarts + 1
+  mute LABEL      keep its output off mlaunch's screen; its log file still gets every line
+  unmute LABEL    show its output again
+  logs LABEL      its last lines (-n)
+
+LABEL: a process's label (talker-1, as mlaunch prints it), or its name without the counter
+(talker) or its node's name, when only one process has it.
+
+RUN (default: the newest run still running, under the ROS log folder):
+  a run's log folder, or its name (latest too) or part of it; mlaunch's pid; or the run id
+  (MLAUNCH_RUN_ID in its processes' environment)
+
+exit status:
+  0  done
+  1  the run or the process cannot do it now: no running launch, the launch ended (a stale
+     control socket), the process is not running or already running, the launch is
+     shutting down
+  2  bad input: an unknown operation or label, a RUN that names nothing or several runs
+
+A launch whose processes were all stopped this way keeps running (they can be started again);
+Ctrl-C ends it. The launch file's exit handlers see each stop as they would see ros2 launch's
+ShutdownProcess: a process with on_exit=Shutdown() (XML on_exit="shutdown") ends the launch
+when it is stopped or restarted, with exit status 0.
+"""
+
+
+class CtlError(MlaunchError):
+    """``mlaunch ctl`` cannot reach the run or the run refused; ``exit_code`` from the table."""
+
+    def __init__(self, message: str, exit_code: int = EXIT_FAILURE) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+def parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="mlaunch ctl",
+        usage="mlaunch ctl [-h] [-n LINES] [--json] [RUN] OPERATION [LABEL]",
+        description=DESCRIPTION,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("words", nargs="+", metavar="[RUN] OPERATION [LABEL]", help="see below")
+    p.add_argument(
+        "-n",
+        "--lines",
+        type=int,
+        default=DEFAULT_LINES,
+        help=f"logs: how many of the last lines (default: {DEFAULT_LINES})",
+    )
+    p.add_argument("--json", action="store_true", help="print the answer as JSON (one object)")
+    p.add_argument("-d", "--debug", action="store_true", help="show tracebacks of errors")
+    return p
+
+
+def split_words(words: Sequence[str]) -> tuple[str | None, str, str | None]:
+    """(RUN, operation, LABEL) from ``[RUN] OPERATION [LABEL]``."""
+    if words[0] in OPERATIONS:
+        run, rest = None, list(words)
+    elif len(words) > 1 and words[1] in OPERATIONS:
+        run, rest = words[0], list(words[1:])
+    else:
+        raise CtlError(
+            f"no operation in {' '.join(words)!r}; valid: {', '.join(OPERATIONS)}", EXIT_USAGE
+        )
+    op, args = rest[0], rest[1:]
+    if op == "list":
+        if args:
+            raise CtlError(f"list takes no label (got {args[0]!r})", EXIT_USAGE)
+        return run, op, None
+    if len(args) != 1:
+        what = "one process label" if not args else f"one label, not {len(args)}"
+        raise CtlError(f"{op} needs {what}: mlaunch ctl [RUN] {op} LABEL", EXIT_USAGE)
+    return run, op, args[0]
+
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch ctl ...``: find the run, send the request, say the answer; raises on failure."""
+    ns = parser().parse_args(list(args))
+    run, op, label = split_words(ns.words)
+    request: dict[str, object] = {"version": PROTOCOL, "op": op}
+    if label is not None:
+        request["label"] = label
+    if op == "logs":
+        request["lines"] = ns.lines
+    try:
+        target = find_run(run, os.environ)
+        answer = ask(target, request)
+        expected_id = _run_id(run)
+        about = answer.get("run")
+        if expected_id and (not isinstance(about, dict) or about.get("run_id") != expected_id):
+            raise CtlError(f"the run in {target.folder} is not run {expected_id}", EXIT_USAGE)
+    except CtlError as e:
+        if ns.json:  # machine output for every failure, not only the run's answers
+            failed = {"ok": False, "error": str(e), "status": e.exit_code}
+            sys.stdout.write(json.dumps(failed, indent=2) + "\n")
+        raise
+    if ns.json:
+        sys.stdout.write(json.dumps(answer, indent=2) + "\n")
+    if not answer.get("ok"):
+        status = answer.get("status")
+        raise CtlError(str(answer.get("error")), status if isinstance(status, int) else 1)
+    if not ns.json:
+        sys.stdout.write(say(op, answer))
+    return EXIT_OK
+
+
+# --- finding the run ------------------------------------------------------------------------------
+
+
+class Target:
+    """A run's control socket: ``folder`` is the run's log folder."""
+
+    __slots__ = ("folder", "path")
+
+    def __init__(self, folder: str, path: str) -> None:
+        self.folder = folder
+        self.path = path
+
+
+def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
+    """The run RUN names (None: the newest still running) under the ROS log folder."""
+    base = log_base_dir(environ)
+    if run is None:
+        return _newest_live(base)
+    under_base = os.path.join(base, run)  # a folder's name, or "latest"
+    if os.path.exists(run) or (os.sep not in run and os.path.isdir(under_base)):
+        path = os.path.realpath(run if os.path.exists(run) else under_base)
+        if os.path.isdir(path):
+            return _with_socket(path)
+        return Target(os.path.dirname(os.path.dirname(path)), path)
+    pid = run if run.isdigit() else None
+    match = RUN_ID.fullmatch(run)
+    if match:
+        pid = match.group(1)
+    folders = _run_folders(base)
+    if pid is not None:
+        named = [f for f in folders if f.endswith(f"-{pid}")]
+        what = f"pid {pid}"
+    else:
+        named = [f for f in folders if f == run] or [f for f in folders if run in f]
+        what = repr(run)
+    if not named:
+        recent = ", ".join(folders[:5]) or "none"
+        raise CtlError(f"no run {what} under {base} (newest runs: {recent})", EXIT_USAGE)
+    live = [f for f in named if find_socket(os.path.join(base, f))]
+    if len(named) > 1 and len(live) != 1:
+        shown = ", ".join(named[:10]) + (f" and {len(named) - 10} more" if len(named) > 10 else "")
+        raise CtlError(f"{what} names {len(named)} runs: {shown}; give one folder", EXIT_USAGE)
+    return _with_socket(os.path.join(base, (live or named)[0]))
+
+
+def _with_socket(folder: str) -> Target:
+    path = find_socket(folder)
+    if path is None:
+        raise CtlError(
+            f"the run in {folder} is not running (its control socket {FOLDER}/{NAME} is gone)"
+        )
+    return Target(folder, path)
+
+
+def _run_folders(base: str) -> list[str]:
+    """Run log folders under ``base``, newest first (their names start with the time)."""
+    try:
+        names = [e.name for e in os.scandir(base) if e.is_dir(follow_symlinks=False)]
+    except OSError:
+        return []
+    return sorted(names, reverse=True)
+
+
+def _newest_live(base: str) -> Target:
+    """The newest run that answers; stale sockets are skipped, and named if nothing answers."""
+    candidates = []
+    latest = os.path.join(base, "latest")
+    if os.path.isdir(latest):
+        candidates.append(os.path.realpath(latest))
+    candidates += [os.path.join(base, name) for name in _run_folders(base)]
+    stale = []
+    seen = set()
+    for folder in candidates:
+        path = find_socket(folder) if folder not in seen else None
+        if path is None:
+            continue
+        seen.add(folder)
+        if _answers(path):
+            return Target(folder, path)
+        stale.append(folder)
+    if stale:
+        raise CtlError(
+            f"no running launch under {base}: the newest with a control socket, {stale[0]},"
+            " has ended (its socket is stale: nothing accepts on it)"
+        )
+    raise CtlError(f"no running launch under {base} (no run's log folder has a control socket)")
+
+
+def _answers(path: str) -> bool:
+    """Whether something accepts on the socket (a dead run's socket refuses at once)."""
+    try:
+        with _connect(path, ANSWER_TIMEOUT):
+            return True
+    except OSError:
+        return False
+
+
+def _run_id(run: str | None) -> str | None:
+    return run if run is not None and RUN_ID.fullmatch(run) else None
+
+
+# --- talking to it ----------------------------------------------------------------------------
+
+
+def _connect(path: str, timeout: float) -> socket.socket:
+    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    sock.settimeout(timeout)
+    try:
+        with Address(path) as address:
+            sock.connect(address)
+    except BaseException:
+        sock.close()
+        raise
+    return sock
+
+
+def ask(target: Target, request: dict[str, object]) -> dict[str, object]:
+    """Send ``request``, return the final answer (after ``accepted``, if the run sends one)."""
+    try:
+        sock = _connect(target.path, ANSWER_TIMEOUT)
+    except (ConnectionRefusedError, FileNotFoundError):
+        raise CtlError(
+            f"the run in {target.folder} has ended (its control socket is stale)"
+        ) from None
+    except TimeoutError:
+        raise CtlError(f"the run in {target.folder} does not answer (stopped?)") from None
+    except OSError as e:
+        raise CtlError(f"cannot reach the run in {target.folder}: {e.strerror or e}") from None
+    with sock:
+        sock.sendall(json.dumps(request).encode() + b"\n")
+        reader = sock.makefile("rb")
+        while True:
+            try:
+                line = reader.readline()
+            except TimeoutError:
+                raise CtlError(f"the run in {target.folder} did not answer in time") from None
+            if not line:
+                raise CtlError(f"the run in {target.folder} ended before it answered")
+            message = json.loads(line)
+            if message.get("accepted"):
+                sock.settimeout(float(message.get("wait", 60.0)))
+                continue
+            return dict(message)
+
+
+# --- saying the answer --------------------------------------------------------------------------
+
+
+def say(op: str, answer: dict[str, object]) -> str:
+    """The answer in words (without --json)."""
+    if op == "list":
+        return _table(answer.get("processes") or [])  # type: ignore[arg-type]
+    if op == "logs":
+        lines = answer.get("lines") or []
+        return "".join(f"{line}\n" for line in lines)  # type: ignore[attr-defined]
+    info: dict[str, object] = answer.get("process") or {}  # type: ignore[assignment]
+    label, state = info.get("label"), info.get("state")
+    if op in ("mute", "unmute"):
+        return f"{label}: {'muted' if info.get('muted') else 'unmuted'}\n"
+    if state in ("running", "stopping"):
+        return f"{label}: running [pid {info.get('pid')}], restarts: {info.get('restarts')}\n"
+    return f"{label}: {info.get('outcome') or state}\n"
+
+
+def _table(rows: list[dict[str, object]]) -> str:
+    head = ("process", "state", "pid", "restarts", "uptime", "muted", "last ended")
+    cells = [
+        (
+            str(r["label"]),
+            str(r["state"]),
+            str(r["pid"] or "-"),
+            str(r["restarts"]),
+            _uptime(r["uptime"], r.get("restart_in")),
+            "yes" if r["muted"] else "",
+            str(r["outcome"] or ""),
+        )
+        for r in rows
+    ]
+    widths = [max(len(row[i]) for row in [head, *cells]) for i in range(len(head))]
+    return "".join(
+        "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() + "\n"
+        for row in [head, *cells]
+    )
+
+
+def _uptime(value: object, restart_in: object = None) -> str:
+    if isinstance(restart_in, (int, float)):
+        return f"restart in {restart_in:.1f} s"
+    if not isinstance(value, (int, float)):
+        return "-"
+    from mlaunch.parts.summary import format_duration
+
+    return format_duration(float(value))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m mlaunch.commands.ctl``: ``mlaunch ctl``, errors printed by mlaunch's main."""
+    from mlaunch.cli import main as cli_main
+
+    return cli_main(["ctl", *(sys.argv[1:] if argv is None else argv)])
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,165 @@
+"""``mlaunch export FILE [name:=value ...] --to systemd DIR``: hand a launch to the system's init.
+
+The launch is resolved exactly as ``mlaunch FILE`` would resolve it (same arguments, options and
+environment), then written out by a format's writer (systemd: mlaunch.export.systemd). Nothing
+is started.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+
+from mlaunch.plan.errors import MlaunchError, UsageError
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.app.options import Options
+    from mlaunch.export.systemd import Export, Unit
+    from mlaunch.plan.steps import Deferred, Plan
+
+FORMATS = ("systemd",)
+USAGE = "mlaunch export FILE [name:=value ...] --to systemd DIR [--name NAME] [--user USER]"
+
+
+def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
+    """(export settings, the rest: the launch target, its arguments and mlaunch's options)."""
+    return build_parser().parse_known_args(args)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """``mlaunch export``'s own options (the rest are mlaunch FILE's)."""
+    parser = argparse.ArgumentParser(prog="mlaunch export", usage=USAGE, add_help=True)
+    parser.add_argument(
+        "--to",
+        nargs=2,
+        metavar=("FORMAT", "DIR"),
+        required=True,
+        help="what to write and where: 'systemd DIR' writes units, params files and a README",
+    )
+    parser.add_argument("--name", help="the target's name and the units' prefix (default: FILE)")
+    parser.add_argument("--user", help="the user the services run as (User=; default: root)")
+    parser.add_argument(
+        "--install-dir",
+        help="where DIR will be on the robot (the units name their files there; default: DIR)",
+    )
+    parser.add_argument("--force", action="store_true", help="write into a non-empty DIR")
+    return parser
+
+
+def main(args: Sequence[str]) -> int:
+    """``mlaunch export ARGS``: through mlaunch's main, which prints errors and gives the status."""
+    # Through the one main that prints errors and gives the status: this runs the subcommand
+    # on its own (tests, a script), so it calls back up to the command line on purpose.
+    from mlaunch import cli
+
+    return cli.main(["export", *args])
+
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch export``'s work; errors go up to mlaunch.cli.main."""
+    from mlaunch.app.options import parse_options
+
+    try:
+        settings, rest = parse(list(args))
+    except SystemExit as e:  # argparse: --help (0) or a usage error (2), already printed
+        return int(e.code or 0)
+    fmt, out_dir = settings.to
+    if fmt not in FORMATS:
+        raise UsageError(f"--to {fmt!r} is not a format; valid: {', '.join(FORMATS)}")
+    if not rest:
+        raise UsageError(f"a launch file is needed: {USAGE}")
+    try:
+        opts = parse_options(rest)
+    except SystemExit as e:
+        return int(e.code or 0)
+    return export_systemd(opts, settings, out_dir)
+
+
+def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) -> int:
+    from mlaunch.app import pipeline
+    from mlaunch.engine.lifeline import private_temp_dir, remove_private_dir
+    from mlaunch.export import systemd
+    from mlaunch.resolve.resolver import resolve_deferred
+
+    if os.path.isdir(out_dir) and os.listdir(out_dir) and not settings.force:
+        raise UsageError(f"{out_dir!r} is not empty; choose an empty directory or pass --force")
+    path, description = pipeline.load_target(opts)
+    prefix = systemd.unit_name(settings.name or _stem(path))
+    temp_dir = private_temp_dir()
+    try:
+        plan, options, labels = pipeline.resolve_for_run(
+            opts, path, description, temp_dir=temp_dir, log_dir=""
+        )
+
+        def expand(body: Deferred) -> Plan | None:
+            try:
+                return resolve_deferred(body, labels=labels, options=options)
+            except Exception as e:  # a handler's Python code, called here with no event
+                export.warnings.append(
+                    f"{getattr(body, 'origin', '') or '?'}: not exported ({type(e).__name__}: {e})"
+                )
+                return None
+
+        export = systemd.Export(plan, prefix=prefix, expand=expand)
+        units = export.build()
+        if not units:
+            raise MlaunchError(f"{path}: the launch starts no process; nothing to export")
+        write_units(export, units, out_dir, settings, path, prefix)
+    finally:
+        remove_private_dir(temp_dir)
+    for warning in export.warnings:
+        print(f"mlaunch export: warning: {warning}", file=sys.stderr)
+    print(f"wrote {len(units)} services and {prefix}.target to {out_dir} (see its README.md)")
+    return 0
+
+
+def write_units(
+    export: Export,
+    units: list[Unit],
+    out_dir: str,
+    settings: argparse.Namespace,
+    source: str,
+    prefix: str,
+) -> None:
+    from mlaunch.export import systemd
+
+    os.makedirs(out_dir, exist_ok=True)
+    install_dir = os.path.abspath(settings.install_dir or out_dir)
+    systemd.install_params(units, out_dir, install_dir)
+    env_file = os.path.join(install_dir, f"{prefix}.env")
+    # The environment the launch was resolved in; what it changed is in each unit.
+    _write(os.path.join(out_dir, f"{prefix}.env"), systemd.environment_file(os.environ))
+    cwd = os.getcwd()
+    for unit in units:
+        text = systemd.service_text(
+            unit,
+            target=f"{prefix}.target",
+            env_file=env_file,
+            cwd=cwd,
+            user=settings.user,
+        )
+        _write(os.path.join(out_dir, unit.name), text)
+    _write(
+        os.path.join(out_dir, f"{prefix}.target"),
+        systemd.target_text(units, os.path.basename(source)),
+    )
+    _write(
+        os.path.join(out_dir, "README.md"),
+        systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings),
+    )
+
+
+def _write(path: str, text: str) -> None:
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+def _stem(path: str) -> str:
+    name = os.path.basename(path)
+    for suffix in (".launch.py", ".launch.yaml", ".launch.xml", ".launch", ".py", ".yaml", ".xml"):
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return name

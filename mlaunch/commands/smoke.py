@@ -1,0 +1,251 @@
+"""``mlaunch test FILE``: a CI smoke run of a launch file (the options: mlaunch.smoke.settings).
+
+It starts the launch exactly as ``mlaunch FILE`` would (the same pipeline, the same parts
+attached), plus the checks: the expectations (mlaunch.smoke.expectations) are watched
+(mlaunch.smoke.watch) until the system is ready, held, then the launch is shut down and a
+report (mlaunch.smoke.report) says what was expected and seen.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, UsageError
+from mlaunch.smoke import junit
+from mlaunch.smoke.expectations import (
+    Expect,
+    Expectation,
+    ExpectStep,
+    _CollectConfigurations,
+    _true,
+    expectation_data,
+    parse_spec,
+    parse_target,
+)
+from mlaunch.smoke.report import Report
+from mlaunch.smoke.settings import Settings, parse_settings, split_arguments
+from mlaunch.smoke.watch import SmokeRun
+
+if TYPE_CHECKING:
+    from mlaunch.engine.lifeline import Lifeline
+    from mlaunch.plan.steps import Plan, ProcessSpec
+
+
+def main(args: Sequence[str]) -> int:
+    """``mlaunch test ARGS``: through mlaunch's main, which prints errors and gives the status."""
+    # Through the one main that prints errors and gives the status: this runs the subcommand
+    # on its own (tests, a script), so it calls back up to the command line on purpose.
+    from mlaunch import cli
+
+    return cli.main(["test", *args])
+
+
+def command(args: Sequence[str]) -> int:
+    """``mlaunch test``'s work; errors go up to mlaunch.cli.main."""
+    from mlaunch.app import pipeline
+    from mlaunch.app.options import parse_options
+
+    args = list(args)
+    from mlaunch.launch_testing.launch_test import is_launch_test_file
+
+    if any(is_launch_test_file(a) for a in args if not a.startswith("-")):
+        # A launch_testing file (it defines generate_test_description): launch_test runs it.
+        from mlaunch.launch_testing.launch_test import main as launch_test_main
+
+        return launch_test_main(args, prog="mlaunch test")
+    mine, rest = split_arguments(args)
+    try:
+        settings = parse_settings(mine)
+        opts = parse_options(rest) if rest else None
+    except SystemExit as e:  # argparse: --help (0) or a usage error (2), already printed
+        return int(e.code or 0)
+    if opts is None:
+        raise UsageError("a launch file is needed: mlaunch test FILE [name:=value ...]")
+    if opts.print_plan and opts.format == "json":
+        return print_plan(opts, settings)
+    if opts.show_args or opts.print_plan:
+        return pipeline.launch(opts, pipeline.standard_parts(opts))
+    return run(opts, settings)
+
+
+# --- running --------------------------------------------------------------------------------------
+
+
+def run(opts: Any, settings: Settings) -> int:
+    """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
+    from mlaunch.engine.lifeline import Lifeline
+    from mlaunch.engine.logfiles import make_run_log_dir
+
+    with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
+        log_dir = make_run_log_dir(os.environ)
+        path, plan, options, labels, expectations = prepare(opts, settings, life, log_dir)
+        return supervise(opts, settings, plan, options, labels, log_dir, path, expectations, life)
+
+
+def print_plan(opts: Any, settings: Settings) -> int:
+    """``mlaunch test FILE --print --format json``: the plan, plus what the run would check."""
+    from mlaunch.engine.lifeline import Lifeline, write_stdout
+    from mlaunch.resolve.plan_json import plan_json
+
+    with Lifeline() as life:  # a launch file's code and Command substitutions may run
+        path, plan, _options, _labels, expectations = prepare(opts, settings, life, "")
+        test = {
+            "timeout": settings.timeout,
+            "hold": settings.hold,
+            "allow_exit": list(settings.allow_exit),
+            "expectations": [expectation_data(e) for e in expectations],
+        }
+        write_stdout(plan_json(plan, path, opts.arguments, test=test))
+    return EXIT_OK
+
+
+def prepare(
+    opts: Any, settings: Settings, life: Lifeline, log_dir: str
+) -> tuple[str, Plan, Any, Any, list[Expectation]]:
+    """Load and resolve as ``mlaunch FILE`` does, with the launch configurations collected;
+    (path, plan, resolve options, labels, the expectations of the run)."""
+    from mlaunch.app import pipeline
+    from mlaunch.launch.actions import LaunchDescription
+
+    path, description = pipeline.load_target(opts)
+    collector = _CollectConfigurations()
+    plan, options, labels = pipeline.resolve_for_run(
+        opts,
+        path,
+        LaunchDescription([description, collector]),
+        temp_dir=life.temp_dir,
+        log_dir=log_dir,
+    )
+    # use_sim_time:=true is an ordinary launch argument; a file that declares it is
+    # expected to run on simulated time, as --use-sim-time is.
+    sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
+    expectations = build_expectations(plan, settings, collector, sim_time)
+    return path, plan, options, labels, expectations
+
+
+def build_expectations(
+    plan: Plan, settings: Settings, collector: _CollectConfigurations, use_sim_time: bool
+) -> list[Expectation]:
+    """Defaults from the plan, then the launch file's, then the command line's (later wins)."""
+    specs = plan.processes()
+    explicit = [s.expectation for s in plan.steps if isinstance(s, ExpectStep) and s.expectation]
+    explicit += collector.found + settings.expectations
+    out: dict[tuple[str, str], Expectation] = {}
+    for spec in specs:
+        out[("process", spec.label)] = Expectation("process", spec.label, labels=[spec.label])
+    for spec in specs:
+        fqn = spec.node.fully_qualified_name if spec.node is not None else None
+        if spec.node is None or fqn is None:
+            continue
+        out.setdefault(("node", fqn), Expectation("node", fqn))
+        if spec.node.lifecycle:
+            out.setdefault(("lifecycle", fqn), Expectation("lifecycle", fqn))
+    components: dict[str, str] = {}  # composable node -> its container (LoadComponents steps)
+    for step in plan.steps:
+        for name in getattr(step, "component_names", list)():
+            components[name] = step.target  # type: ignore[attr-defined]
+            out.setdefault(("node", name), Expectation("node", name))
+    if use_sim_time or collector.use_sim_time or any(_sim_time_argv(s.argv) for s in specs):
+        out[("clock", "/clock")] = Expectation("clock", "/clock")
+    for expectation in explicit:
+        out[expectation.key()] = expectation
+    for expectation in out.values():
+        _involve(expectation, specs)
+        if expectation.kind == "node" and expectation.target in components:
+            container = components[expectation.target]
+            expectation.labels = [
+                s.label for s in specs if s.node and s.node.fully_qualified_name == container
+            ]
+    found = list(out.values())
+    found.append(Expectation("shutdown", "", status="pending", seen="the launch was not stopped"))
+    return found
+
+
+def _sim_time_argv(argv: Sequence[str]) -> bool:
+    return any(a.lower() in ("use_sim_time:=true", "use_sim_time:=1") for a in argv)
+
+
+def _involve(expectation: Expectation, specs: list[ProcessSpec]) -> None:
+    """Which processes' output explains this expectation; compile an output regex."""
+    if expectation.kind in ("node", "lifecycle"):
+        expectation.labels = [
+            s.label
+            for s in specs
+            if s.node is not None and s.node.fully_qualified_name == expectation.target
+        ]
+    elif expectation.kind == "output":
+        names = {s.label for s in specs} | {s.base_name for s in specs}
+        head, sep, tail = expectation.target.partition(":")
+        if sep and head in names:
+            expectation.process, expectation.target = head, tail
+        if expectation.process:
+            expectation.labels = [
+                s.label for s in specs if expectation.process in (s.label, s.base_name)
+            ]
+        try:
+            expectation.regex = re.compile(expectation.target)
+        except re.error as e:
+            raise UsageError(
+                f"output expectation ({expectation.origin}): {expectation.target!r} is not a"
+                f" regular expression: {e}"
+            )
+
+
+def supervise(
+    opts: Any,
+    settings: Settings,
+    plan: Plan,
+    options: Any,
+    labels: Any,
+    log_dir: str,
+    path: str,
+    expectations: list[Expectation],
+    life: Lifeline,
+) -> int:
+    """Run the plan as ``mlaunch FILE`` would (the same parts attached), plus the smoke checks.
+
+    The checks attach last, so lifecycle driving, if the plan needs it, already exists and its
+    ROS graph is shared.
+    """
+    from mlaunch.app import pipeline
+
+    runs: list[SmokeRun] = []
+
+    def attach(run: pipeline.Run) -> SmokeRun:
+        smoke = SmokeRun(run.supervisor, expectations, settings, lifecycle=run.lifecycle)
+        runs.append(smoke)
+        return smoke
+
+    parts = [*pipeline.standard_parts(opts), attach]
+    code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
+    if not runs:
+        return code
+    smoke = runs[0]
+    smoke.conclude()
+    report = Report(path, expectations, smoke.rings, smoke.elapsed())
+    sys.stdout.write(report.table())
+    sys.stdout.flush()
+    if settings.junit:
+        report.write_junit(settings.junit)
+    if code >= 128:
+        return code  # interrupted: say so, whatever was seen
+    return EXIT_OK if report.passed else EXIT_FAILURE
+
+
+__all__ = [
+    "Expect",
+    "Expectation",
+    "Settings",
+    "_CollectConfigurations",
+    "build_expectations",
+    "junit",
+    "parse_settings",
+    "parse_spec",
+    "parse_target",
+    "run",
+    "split_arguments",
+]

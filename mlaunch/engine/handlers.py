@@ -1,0 +1,216 @@
+"""The launch file's event handlers (RegisterEventHandler, on_exit, OnProcessIO) while it runs.
+
+LaunchHandlers subscribes to the supervisor's EventStream: each record of a process starting,
+printing or exiting, of the launch shutting down, or of a managed node's transition becomes
+the launch event launch_ros's handlers expect (mlaunch.launch.events), and every matching
+handler fires. The events a launch file emits (EmitEvent: Shutdown, ShutdownProcess,
+SignalProcess) are acted on here too. A handler's body is resolved when it fires, with the
+same resolve code as the launch file (``Supervisor.fire``), and what it gives is carried out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from mlaunch.engine.process import Process
+from mlaunch.launch import events as ev
+from mlaunch.launch.event_handlers import returned_entities
+from mlaunch.plan.events import (
+    Completed,
+    Event,
+    Exited,
+    LaunchEvent,
+    Output,
+    ShutdownBegun,
+    Started,
+    Transition,
+    Unclaimed,
+)
+from mlaunch.plan.steps import AddHandler, Deferred
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.engine.supervisor import Supervisor
+
+
+class LaunchHandlers:
+    """The registered handlers of one run, newest first (as ROS 2), and their dispatch."""
+
+    def __init__(self, supervisor: Supervisor) -> None:
+        self.supervisor = supervisor
+        self.handlers: list[AddHandler] = []
+
+    def add(self, step: AddHandler) -> None:
+        self.handlers.insert(0, step)  # newest first, as ROS 2
+
+    def remove(self, handler: object) -> None:
+        self.handlers[:] = [h for h in self.handlers if h.handler is not handler]
+
+    def __call__(self, event: Event) -> None:
+        """The subscription: the records launch has events for."""
+        if isinstance(event, Output):
+            if self.handlers:
+                self.output(event.process, event.stream, event.data)
+        elif isinstance(event, Started):
+            self._started(event.process)
+        elif isinstance(event, Exited):
+            self._exited(event.process, event.code)
+        elif isinstance(event, ShutdownBegun):
+            sigint = event.due_to_signal == 2  # SIGINT, without importing signal for it
+            self.dispatch("shutdown", None, ev.Shutdown(reason=event.reason, due_to_sigint=sigint))
+        elif isinstance(event, Transition):
+            self._transition(event)
+        elif isinstance(event, LaunchEvent):
+            self._launch_event(event)
+        elif isinstance(event, Completed):
+            self._completed(event.action)
+
+    def wants_completion(self, action: object) -> bool:
+        """Whether a handler registered now waits for ``action`` to complete.
+
+        launch asks this as it visits an action: ExecutionComplete is emitted for it (when it
+        completes) only if so, and then every matching handler of that moment handles it.
+        """
+        return any(_completes(h, action) for h in self.handlers)
+
+    def _completed(self, action: object) -> None:
+        event = ev.ExecutionComplete(action=action)
+        for handler in list(self.handlers):
+            if not _completes(handler, action):
+                continue
+            if handler.once:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, event)
+
+    def _launch_event(self, record: LaunchEvent) -> None:
+        """launch's own events: Shutdown, ShutdownProcess, SignalProcess.
+
+        Others are for later subscribers (lifecycle takes ChangeState); the Unclaimed that
+        follows is said by the printer if none did.
+        """
+        event, supervisor = record.event, self.supervisor
+        if isinstance(event, ev.Shutdown):
+            supervisor.begin_shutdown(event.reason)
+        elif isinstance(event, ev.ShutdownProcess):
+            for p in self._running(event.process_matcher):
+                supervisor.stop(p)
+        elif isinstance(event, ev.SignalProcess):
+            for p in self._running(event.process_matcher):
+                p.signal_group(int(event.signal_number))
+        else:
+            supervisor.events.emit(Unclaimed(record))
+            return
+        record.taken = True
+
+    def _running(self, matcher: Callable[[Any], bool] | None) -> list[Process]:
+        processes = self.supervisor.processes
+        return [p for p in processes if p.running and (matcher is None or matcher(p))]
+
+    def _started(self, process: Process) -> None:
+        self.dispatch("process_start", process, ev.ProcessStarted(**_details(process)))
+
+    def _exited(self, process: Process, code: int) -> None:
+        event = ev.ProcessExited(**_details(process), returncode=code)
+        self.dispatch("process_exit", process, event)
+        if process.spec.on_exit is not None:
+            self.supervisor.fire(process.spec.on_exit, event)
+
+    def _transition(self, record: Transition) -> None:
+        """OnStateTransition handlers: their own matcher on the event, else on the node's spec."""
+        for handler in list(self.handlers):
+            if handler.kind != "state_transition":
+                continue
+            matches = getattr(handler.handler, "matches", None)
+            if matches is not None:
+                if not matches(record.event):
+                    continue
+            elif handler.matcher is not None and not handler.matcher(record.spec):
+                continue
+            if handler.once and handler in self.handlers:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, record.event)
+
+    def dispatch(self, kind: str, process: Process | None, event: Any) -> None:
+        """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec."""
+        for handler in list(self.handlers):
+            if handler.kind != kind:
+                continue
+            if (
+                process is not None
+                and handler.matcher is not None
+                and not handler.matcher(process.spec)
+            ):
+                continue
+            if handler.once:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, event)
+
+    def output(self, process: Process, stream: str, data: bytes) -> None:
+        """Complete lines of a child to the OnProcessIO handlers that want its ``stream``."""
+        event_type = ev.ProcessStdout if stream == "stdout" else ev.ProcessStderr
+        for handler in list(self.handlers):
+            if handler.kind != "process_io":
+                continue
+            if handler.matcher is not None and not handler.matcher(process.spec):
+                continue
+            callback = handler.io_callbacks.get(stream)
+            if callback is None:
+                continue
+            if handler.once:
+                self.handlers.remove(handler)
+            event = event_type(
+                action=process.spec.action,
+                name=process.label,
+                cmd=list(process.argv),
+                pid=process.pid,
+                text=data,
+                fd=1 if stream == "stdout" else 2,
+            )
+            try:
+                result = callback(event)
+            except Exception as e:  # launch-file code: report it where it was written
+                from mlaunch.plan.origin import user_location
+
+                where = user_location(e.__traceback__) or handler.origin
+                self.supervisor.handler_failed(
+                    f"{where}: OnProcessIO callback failed: {type(e).__name__}: {e}"
+                )
+                return
+            entities = returned_entities(result)
+            if entities and handler.body is not None:
+                body = handler.body
+                deferred = Deferred(entities, body.context, body.origin, captured=body.captured)
+                self.supervisor.fire(deferred, event)
+
+
+class _Target:
+    """An action in the place of a ProcessSpec, for handler matchers (they read ``.action``)."""
+
+    __slots__ = ("action",)
+
+    def __init__(self, action: object) -> None:
+        self.action = action
+
+
+def _completes(handler: AddHandler, action: object) -> bool:
+    if handler.kind != "execution_complete":
+        return False
+    return handler.matcher is None or bool(handler.matcher(_Target(action)))
+
+
+def _details(process: Process) -> dict[str, Any]:
+    """What launch's process events carry about the process (ExecuteProcess.process_details)."""
+    spec = process.spec
+    return {
+        "action": spec.action,
+        "name": spec.label,
+        "cmd": list(spec.argv),
+        "cwd": spec.cwd,
+        "env": spec.env,
+        "pid": process.pid,
+    }

@@ -1,0 +1,335 @@
+"""The one printer: what mlaunch says about a run, and each process's lines, to screen and logs.
+
+Child output is data, never markup: bytes in, invalid UTF-8 replaced, each line prefixed with its
+process label, written with one call per chunk. A chunk is prefixed with a single
+``bytes.replace`` instead of a per-line Python loop, which is what lets mlaunch pass hundreds of
+thousands of lines a second while the children keep running. Where the bytes go is not decided
+here: the terminal is a Screen (mlaunch.engine.screen: non-blocking, bounded, flow-controlled by the
+supervisor's loop) and the files are LogFiles (mlaunch.engine.logfiles). rich is used only by the
+status view, and imported only when it is shown.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from collections.abc import Callable, Mapping
+
+from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile, tail_lines
+from mlaunch.engine.sayings import SAYINGS, VIEWER_ADDRESS, Sayings
+from mlaunch.engine.screen import Screen
+from mlaunch.plan.events import Event, Output
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.engine.process import Process
+
+# Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
+# which mlaunch always writes so every process has its log).
+SCREEN_STREAMS: dict[str, frozenset[str]] = {
+    "log": frozenset({"stderr"}),
+    "screen": frozenset({"stdout", "stderr"}),
+    "both": frozenset({"stdout", "stderr"}),
+    "own_log": frozenset(),
+    "full": frozenset({"stdout", "stderr"}),
+}
+LAUNCH_LOG_MODES = frozenset({"log", "both", "full"})
+
+LEVEL_COLORS = {"INFO": b"", "WARNING": b"\x1b[33m", "ERROR": b"\x1b[31m", "DEBUG": b"\x1b[2m"}
+LABEL_COLORS = [b"\x1b[32m", b"\x1b[36m", b"\x1b[35m", b"\x1b[34m", b"\x1b[33m", b"\x1b[92m",
+                b"\x1b[96m", b"\x1b[95m", b"\x1b[94m", b"\x1b[93m"]  # fmt: skip
+RESET = b"\x1b[0m"
+
+
+def clean(data: bytes) -> bytes:
+    """Valid UTF-8, with U+FFFD for whatever was not."""
+    if data.isascii():
+        return data  # the common case, checked without building a str
+    try:
+        data.decode("utf-8")
+        return data
+    except UnicodeDecodeError:
+        return data.decode("utf-8", "replace").encode("utf-8")
+
+
+def prefix_lines(prefix: bytes, data: bytes) -> bytes:
+    """Each line of ``data`` (complete lines, ending in newline) with ``prefix`` before it."""
+    return prefix + data[:-1].replace(b"\n", b"\n" + prefix) + b"\n"
+
+
+class Printer(Sayings):
+    """Owns the terminal and the log files of a run, and every word mlaunch says about it.
+
+    A Printer is a subscriber of the supervisor's EventStream (``__call__``): each record
+    becomes its line (``_SAYS`` at the end of this module lists which).
+
+    ``out`` receives every byte meant for the screen; None means the real terminal through a
+    Screen (non-blocking, bounded), whose flow control the supervisor drives (``waiting_fd``,
+    ``holding``, ``flush_screen``). Tests pass a callable that collects bytes, or a Screen.
+    """
+
+    def __init__(
+        self,
+        out: Callable[[bytes], object] | None = None,
+        color: bool = False,
+        log_dir: str | None = None,
+        rotate_bytes: int = DEFAULT_ROTATE_BYTES,
+        rotate_keep: int = DEFAULT_ROTATE_KEEP,
+        quiet: bool = False,
+        clock: Callable[[], float] = time.time,
+    ) -> None:
+        self.out = out
+        self.color = color
+        self.log_dir = log_dir
+        self.rotate_bytes = rotate_bytes
+        self.rotate_keep = rotate_keep
+        self.quiet = quiet
+        self.clock = clock
+        # The Screen under whatever the screen output goes through (a status view wraps it).
+        self._screen: Screen | None
+        self._write: Callable[[bytes], object]
+        if out is None:
+            self._screen = self._write = Screen()
+        else:
+            self._screen = out if isinstance(out, Screen) else None
+            self._write = out
+        self._launch_log: LogFile | None = None
+        # launch.log stops copying process lines past rotate_bytes (they stay in <label>.log);
+        # mlaunch's own messages always go in, so launch.log never rotates and loses none.
+        self._launch_log_full = False
+        self._own: dict[str, LogFile] = {}
+        self._prefix: dict[str, bytes] = {}
+        # Labels whose output the user muted (mlaunch.parts.control): kept off the screen only.
+        self.muted: set[str] = set()
+        self._dirty: set[LogFile] = set()
+        self._log_errors: list[str] = []
+        self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
+        self._viewers: set[str] = set()  # labels of viewer stand-ins, whose address is said
+        if self.log_dir:
+            self._launch_log = self._open("launch.log", lazy=False, rotate=False)
+
+    def __repr__(self) -> str:
+        return f"Printer(log_dir={self.log_dir!r}, color={self.color}, quiet={self.quiet})"
+
+    def _open(self, name: str, *, lazy: bool = True, rotate: bool = True) -> LogFile:
+        assert self.log_dir is not None
+        return LogFile(
+            os.path.join(self.log_dir, name),
+            rotate_bytes=self.rotate_bytes if rotate else 0,
+            keep=self.rotate_keep,
+            lazy=lazy,
+            on_error=self._log_failed,
+        )
+
+    def _log_failed(self, path: str, error: OSError) -> None:
+        # Said on screen only (the log is what failed), and only once per file.
+        text = (
+            f"[ERROR] [launch]: cannot write {path}: {error.strerror or error}; not logging to it"
+        )
+        self._write(text.encode("utf-8", "replace") + b"\n")
+
+    # --- where screen output goes -------------------------------------------------------------
+
+    @property
+    def screen(self) -> Callable[[bytes], object]:
+        return self._write
+
+    def set_screen(self, out: Callable[[bytes], object]) -> Callable[[bytes], object]:
+        """Send screen output to ``out`` from now on (the status view); returns the previous one."""
+        previous, self._write = self._write, out
+        return previous
+
+    def blocked(self) -> bool:
+        """The screen has output waiting for the terminal (the supervisor then polls)."""
+        return bool(getattr(self._write, "blocked", False))
+
+    # --- flow control, driven by the supervisor's loop ------------------------------------------
+
+    def waiting_fd(self) -> int | None:
+        """The terminal's fd while output waits for it (to select for writability), else None."""
+        screen = self._screen
+        if screen is None or not screen.waiting:
+            return None
+        return screen.fd
+
+    def holding(self, label: str | None = None) -> bool:
+        """The terminal is far behind (everyone's output, or ``label``'s own): stop reading the
+        children (that one) until it catches up."""
+        screen = self._screen
+        return screen is not None and screen.holding(label)
+
+    def flush_screen(self) -> None:
+        """Hand the terminal what it takes now (its fd was reported writable)."""
+        if self._screen is not None:
+            self._screen.flush()
+
+    # --- launch's own messages ----------------------------------------------------------------
+
+    def message(self, level: str, source: str, text: str, *, always: bool = False) -> None:
+        """``[LEVEL] [source]: text`` on screen and in launch.log (``always``: under -q too)."""
+        line = f"[{level}] [{source}]: {text}\n".encode("utf-8", "replace")
+        if always or not self.quiet or level in ("WARNING", "ERROR"):
+            write = getattr(self._write, "urgent", self._write)
+            if self.color and LEVEL_COLORS.get(level):
+                write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")
+            else:
+                write(line)
+        if self._launch_log is not None:
+            self._launch_log.write(b"%.7f " % self.clock() + line)
+            self._dirty.add(self._launch_log)
+
+    def block(self, text: str) -> None:
+        """Lines of launch's own (the exit summary) as they are, on screen and in launch.log."""
+        data = text.encode("utf-8", "replace")
+        if not data.endswith(b"\n"):
+            data += b"\n"
+        self._write(data)
+        if self._launch_log is not None:
+            self._launch_log.write(data)
+            self._dirty.add(self._launch_log)
+
+    # --- process output ------------------------------------------------------------------------
+
+    def register(self, label: str, index: int) -> None:
+        """Prepare a process's prefix and log file (once; respawns reuse them)."""
+        if label in self._prefix:
+            return
+        plain = f"[{label}] ".encode()
+        if self.color:
+            color = LABEL_COLORS[index % len(LABEL_COLORS)]
+            self._prefix[label] = color + plain[:-1] + RESET + b" "
+        else:
+            self._prefix[label] = plain
+        if self.log_dir:
+            self._own[label] = self._open(f"{label}.log")
+
+    def output(self, label: str, stream: str, mode: str, data: bytes) -> None:
+        """Complete lines from a process (bytes ending in newline)."""
+        data = clean(data)
+        # -q quiets mlaunch's own messages and children's stdout; their stderr stays visible.
+        if (
+            stream in SCREEN_STREAMS.get(mode, ())
+            and (not self.quiet or stream == "stderr")
+            and label not in self.muted
+        ):
+            if self._write is self._screen:
+                # Counted per process, for per-process flow control (Screen.holding).
+                self._screen.write(prefix_lines(self._prefix[label], data), source=label)
+            else:
+                self._write(prefix_lines(self._prefix[label], data))
+        own = self._own.get(label)
+        if own is not None:
+            own.write(data)
+            self._dirty.add(own)
+        if self._launch_log is not None and mode in LAUNCH_LOG_MODES:
+            self._copy_to_launch_log(label, data)
+
+    def _copy_to_launch_log(self, label: str, data: bytes) -> None:
+        """A process's lines into launch.log too, until it has ``rotate_bytes`` (then said once)."""
+        log = self._launch_log
+        assert log is not None
+        if self._launch_log_full:
+            return
+        lines = prefix_lines(b"%.7f [%s] " % (self.clock(), label.encode()), data)
+        room = self.rotate_bytes - log.size
+        if not self.rotate_bytes or len(lines) <= room:
+            log.write(lines)
+        else:
+            log.write(lines[: lines.rfind(b"\n", 0, max(0, room)) + 1])  # whole lines that fit
+            self._launch_log_full = True
+            note = (
+                f"[INFO] [launch]: launch.log has reached {self.rotate_bytes} bytes: from here on"
+                " it keeps mlaunch's own messages only; each process's lines stay in its"
+                " <label>.log\n"
+            )
+            log.write(b"%.7f " % self.clock() + note.encode())
+        self._dirty.add(log)
+
+    def log_tail(self, label: str, count: int) -> list[bytes] | None:
+        """The last ``count`` lines ``label`` wrote (from its log file); None without log files."""
+        own = self._own.get(label)
+        if own is None:
+            if not self.log_dir:
+                return None
+            return tail_lines(os.path.join(self.log_dir, f"{label}.log"), count)
+        own.flush()
+        return tail_lines(own.path, count)
+
+    def flush(self) -> None:
+        """Push buffered lines to disk and screen (called when the supervisor is about to wait)."""
+        if self._dirty:
+            for f in self._dirty:
+                f.flush()
+            self._dirty.clear()
+        flush = getattr(self._write, "flush", None)
+        if flush is not None:
+            flush()
+
+    def close(self) -> None:
+        self.flush()
+        if self._launch_log is not None:
+            self._launch_log.close()
+        for f in self._own.values():
+            f.close()
+        close = getattr(self._write, "close", None)
+        if close is not None:
+            close()
+
+    # --- the run's events, in words -------------------------------------------------------------
+
+    def __call__(self, event: Event) -> None:
+        """The printer's subscription to the supervisor's EventStream: each record in words."""
+        method = _SAYS.get(type(event))
+        if method is not None:
+            method(self, event)
+
+    def _output(self, event: Output) -> None:
+        process = event.process
+        if (
+            self._viewers
+            and process.label in self._viewers
+            and event.stream == "stdout"
+            and VIEWER_ADDRESS in event.data
+        ):
+            self._viewer_output(process, event.data)
+        else:
+            self.output(process.label, event.stream, process.spec.output, event.data)
+
+    def _viewer_output(self, process: Process, data: bytes) -> None:
+        """A viewer stand-in's stdout with its address line, which mlaunch says itself.
+
+        The address must be seen whatever the viewer's output mode (``log`` hides its stdout)
+        and under -q, and only once: the child's copy goes to its own log file only.
+        """
+        label, mode = process.label, process.spec.output
+        rest = b""
+        for line in data.splitlines(keepends=True):
+            if not line.startswith(VIEWER_ADDRESS):
+                rest += line
+                continue
+            if rest:
+                self.output(label, "stdout", mode, rest)
+                rest = b""
+            self.message("INFO", label, clean(line).decode().rstrip(), always=True)
+            own = self._own.get(label)
+            if own is not None:
+                own.write(line)
+                self._dirty.add(own)
+        if rest:
+            self.output(label, "stdout", mode, rest)
+
+
+def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
+    if environ.get("NO_COLOR"):
+        return False
+    if environ.get("FORCE_COLOR") or environ.get("RCUTILS_COLORIZED_OUTPUT") == "1":
+        return True
+    return sys.stdout.isatty() and environ.get("TERM") != "dumb"
+
+
+# Which words each record of the event stream becomes (records not listed are not said): a
+# process's output here, everything else mlaunch.engine.sayings'.
+_SAYS: dict[type, Callable[[Printer, Any], None]] = {Output: Printer._output, **SAYINGS}

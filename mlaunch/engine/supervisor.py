@@ -1,0 +1,526 @@
+"""run(plan) -> exit code: start processes, stream their output, fire triggers, stop everything.
+
+One thread, one ``selectors`` loop. Signal handlers only record the signal (and wake the loop
+through ``signal.set_wakeup_fd``); the loop acts on them. Every child runs in its own session, so
+the stop ladder (mlaunch.engine.ladder) reaches its whole process group.
+
+The supervisor writes no words. It emits a record of everything that happens on its
+EventStream (mlaunch.plan.events) and acts on policy: this module is where a process's exit
+becomes, in order, an ``Exited`` record (the printer turns it into the log line, the launch
+file's handlers fire on it, lifecycle driving and smoke checks see it), the required-process
+shutdown, and the respawn decision (``_exited``). Its own reaction to the stream is starting the
+stop ladder (``_react``); launch's own events (ShutdownProcess ...) are mlaunch.engine.handlers'.
+
+Nothing is left behind: descendants that leave their group are found and ended at shutdown
+(mlaunch.engine.strays); a guard process (mlaunch.engine.guard, a constructor seam) ends the run if
+mlaunch itself is killed; if the loop itself fails, every group is killed before the error
+propagates.
+
+The children's pipes and the terminal share the loop's selector (mlaunch.engine.pipes): a slow
+terminal holds the children's pipes unread instead of losing lines. The per-label ProcessRecord
+(mlaunch.engine.records) is what the status view and the exit summary read. Signals are recorded
+by mlaunch.engine.signals, timers are mlaunch.engine.timers, the respawn policy is
+mlaunch.engine.respawn, the launch file's event handlers are mlaunch.engine.handlers, and the
+shutdown and signal handling is the Stopping base (mlaunch.engine.stopping).
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+import selectors
+import time
+from collections.abc import Callable
+
+from mlaunch.engine import guard as guards
+from mlaunch.engine import proctable
+from mlaunch.engine.handlers import LaunchHandlers
+from mlaunch.engine.ladder import StopLadder
+from mlaunch.engine.output import Printer
+from mlaunch.engine.pipes import Pipes
+from mlaunch.engine.process import Process, describe_status
+from mlaunch.engine.records import GAVE_UP, RESTARTING, RUNNING, STOPPED, ProcessRecord
+from mlaunch.engine.respawn import GIVE_UP, NO_RESTART, next_restart
+from mlaunch.engine.signals import SignalWatch
+from mlaunch.engine.stopping import Stopping
+from mlaunch.engine.strays import STRAY_GRACE, Strays
+from mlaunch.engine.timers import Timer, Timers
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
+from mlaunch.plan.events import (
+    Completed,
+    Event,
+    EventStream,
+    Exited,
+    FailedToStart,
+    GaveUp,
+    HandedOff,
+    LaunchEvent,
+    NotStarted,
+    Output,
+    RespawnScheduled,
+    Said,
+    Started,
+    StartsSkipped,
+    StoppingAll,
+    StrayEnded,
+    Unclaimed,
+)
+from mlaunch.plan.steps import (
+    AddHandler,
+    Deferred,
+    EmitEvent,
+    Handoff,
+    Log,
+    Note,
+    Plan,
+    ProcessSpec,
+    RemoveHandler,
+    RequestShutdown,
+    Spawn,
+    StartTimer,
+    Step,
+)
+from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve_deferred
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.engine.cgroup import RunCgroup
+    from mlaunch.parts.control import Control
+
+# How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
+POLL = 0.05
+
+
+class Supervisor(Stopping):
+    """Runs a Plan. Seams (printer, clock, guard, run id) are constructor arguments.
+
+    The printer is subscribed to ``events`` first (after the supervisor's own reactions), then
+    the launch file's handlers; whatever else attaches to the run subscribes after them. The
+    printer is also the terminal whose flow control the loop drives.
+
+    ``adopt``: become the subreaper and end every descendant at shutdown; an embedder with
+    children of its own passes False (the run's processes are still found by their marker).
+    ``stray_grace``: seconds between SIGTERM and SIGKILL for a stray descendant.
+    ``spawner(spec, index, restarts)``: makes the Process for a spec (``Process`` by default).
+    """
+
+    def __init__(
+        self,
+        plan: Plan,
+        printer: Printer,
+        *,
+        options: ResolveOptions | None = None,
+        labels: LabelCounter | None = None,
+        clock: Callable[[], float] = time.monotonic,
+        install_signals: bool = True,
+        guard: guards.Guard | None = None,
+        run_id: str | None = None,
+        adopt: bool = True,
+        stray_grace: float = STRAY_GRACE,
+        spawner: Callable[[ProcessSpec, int, int], Process] = Process,
+        cgroup: RunCgroup | None = None,
+    ) -> None:
+        self.plan = plan
+        self.printer = printer
+        self.options = options or ResolveOptions()
+        self.labels = labels or LabelCounter()
+        self.clock = clock
+        self.guard = guard
+        self.run_id = run_id or guards.new_run_id()
+        # Makes the Process for a spec: remote machines plug in here (mlaunch.parts.remote).
+        self.spawner = spawner
+        self.selector = selectors.DefaultSelector()
+        self.by_pid: dict[int, Process] = {}
+        self.processes: list[Process] = []
+        self.lingering: list[Process] = []
+        self.records: dict[str, ProcessRecord] = {}
+        self.timers = Timers(clock)
+        # Pending respawns by label: a user's stop or start cancels the one waiting.
+        self.respawn_timers: dict[str, Timer] = {}
+        self._control: Control | None = None
+        self.signals = SignalWatch(install=install_signals)
+        self.strays = Strays(
+            self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
+        )
+        self.pipes = Pipes(self.selector, printer, self._deliver)
+        self.launch_handlers = LaunchHandlers(self)
+        self.events = EventStream()
+        # Its steps outlive the shutdown's cancellation of timers.
+        self.ladder = StopLadder(
+            lambda delay, step: self.schedule(delay, step, cancel_on_shutdown=False),
+            self.events.emit,
+            self.records,
+        )
+        self.events.subscribe(self._react)
+        self.events.subscribe(printer)
+        self.events.subscribe(self.launch_handlers)
+        self._index = itertools.count()
+        self.shutting_down = False
+        self._held: set[Process] = set()
+        self.shutdown_reason = ""
+        self.exit_code = EXIT_OK
+        self._stop_presses = 0
+        self._skipped = 0  # starts a description asked for while shutting down
+        self._kill_now = False
+        self._marker_env = {proctable.MARKER: self.run_id}
+        # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
+        self._awaited: set[int] = set()
+        # Work attached parts do outside the loop (composable node loads): keeps the run alive.
+        self._work: set[object] = set()
+
+    @property
+    def control(self) -> Control:
+        """Runtime control of this run (mlaunch.parts.control), made on first use; loop thread only.
+
+        Stop, start, restart, mute, unmute a process by label, list them, read their last lines.
+        """
+        if self._control is None:
+            from mlaunch.parts.control import Control
+
+            self._control = Control(self)
+        return self._control
+
+    @property
+    def handlers(self) -> list[AddHandler]:
+        """The launch file's registered event handlers, newest first."""
+        return self.launch_handlers.handlers
+
+    # --- the loop ------------------------------------------------------------------------------
+
+    def run(self) -> int:
+        self.signals.start(self.selector)
+        try:
+            self.execute(self.plan.steps, self.plan.warnings)
+            if self.guard is not None:
+                self.guard.flush()  # the first spawns' groups, in one write
+            # After the first spawns, not before: ctypes costs milliseconds and the first child
+            # should not wait for it. An orphan from that window is still found by its marker.
+            self.strays.adopt_orphans()
+            while not self._finished():
+                self._loop_once()
+            if self.guard is not None:
+                # Everything of the run has ended: the guard may leave while we tidy up.
+                self.guard.dismiss()
+        except BaseException:
+            self._emergency_stop()
+            raise
+        finally:
+            self.strays.release()
+            self.signals.stop()
+            self.selector.close()
+            self.pipes.forget_terminal()
+            self.printer.flush()
+        return self.exit_code
+
+    def _loop_once(self) -> None:
+        timeout = self._next_timeout()
+        if timeout is None or timeout > 0:
+            self.printer.flush()
+        if self.guard is not None and self.guard.pending:
+            self.guard.flush()  # this turn's +pgid/-pgid lines, in one write
+        if self.pipes.before_wait() or self.signals.polling:
+            timeout = POLL if timeout is None else min(timeout, POLL)
+        ready = self.selector.select(timeout)
+        for key, _ in ready:
+            key.data(key.fd)
+        self._handle_signals()
+        self.timers.run_due()
+
+    def _finished(self) -> bool:
+        if any(p.running for p in self.processes):
+            return False
+        if not self.shutting_down:
+            if self.timers.keep_alive() or self._work:
+                return False
+            if any(r.state == STOPPED for r in self.records.values()):
+                return False  # stopped by the user, who may start it again: not idle
+            # Idle: nothing runs and nothing is pending, as ROS 2's idle shutdown.
+            self.begin_shutdown("idle")
+        if self._lingering_pending():
+            return False
+        if self._strays_pending():
+            return False
+        for process in self.processes:
+            self.pipes.close_all(process)
+        return True
+
+    def busy(self, work: object) -> None:
+        """``work`` (a hashable token) of an attached part, such as a composable node load
+        waiting for its container, keeps an otherwise idle launch running until
+        ``done(work)``, as launch's completion futures do; a shutdown does not wait for it."""
+        self._work.add(work)
+
+    def done(self, work: object) -> None:
+        self._work.discard(work)
+
+    def _lingering_pending(self) -> bool:
+        """Groups whose leader is gone but a member lives on (a grandchild in the same group)."""
+        for process in list(self.lingering):
+            if not process.check_group():
+                self.lingering.remove(process)
+                if self.guard is not None:
+                    self.guard.forget(process.pid)
+        return bool(self.lingering)
+
+    def _strays_pending(self) -> bool:
+        """Processes of the run outside every group we watch: end them; True while any lives."""
+        skip = self.guard.pid if self.guard is not None else None
+        alive, sent = self.strays.sweep(self.by_pid, skip, now_kill=self._kill_now)
+        for name, pid, sig in sent:
+            self.events.emit(StrayEnded(name, pid, sig))
+        return alive
+
+    def _next_timeout(self) -> float | None:
+        polling = self.shutting_down and bool(self.lingering or self.strays.seen)
+        delay = self.timers.next_delay()
+        if delay is None:
+            return POLL if polling else None
+        return min(delay, POLL) if polling else delay
+
+    def schedule(
+        self,
+        delay: float,
+        callback: Callable[[], None],
+        *,
+        keeps_alive: bool = True,
+        cancel_on_shutdown: bool = True,
+    ) -> Timer:
+        """Call ``callback`` from the loop after ``delay`` seconds.
+
+        ``keeps_alive`` False: the timer alone does not keep an idle launch running (a status
+        refresh); ``cancel_on_shutdown`` False: it still fires while shutting down (the ladder).
+        """
+        return self.timers.add(delay, callback, keeps_alive, cancel_on_shutdown)
+
+    # --- plan steps ------------------------------------------------------------------------------
+
+    def execute(self, steps: list[Step], warnings: list[str] | tuple[str, ...] = ()) -> None:
+        """Carry out a visited description's steps.
+
+        What they cause is queued on the event stream until every step has been carried out,
+        as launch handles events only after the description was visited: a handler
+        registered after a process in the same description still sees it start.
+        """
+        self.events.hold()
+        try:
+            for warning in warnings:
+                self.events.say_now(Said("WARNING", "launch", warning))
+            for step in steps:
+                if self.signals.pending:
+                    # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
+                    # after the last one started. Exits wait for the loop, as in ROS 2.
+                    self._handle_stop_signals()
+                self._step(step)
+            if self._skipped:
+                self.events.emit(StartsSkipped(self._skipped))  # once, not once per process
+                self._skipped = 0
+        finally:
+            self.events.release()
+
+    def _step(self, step: Step) -> None:
+        if isinstance(step, Spawn):
+            if step.spec is not None and self.shutting_down:
+                self._skipped += 1
+            elif step.spec is not None:
+                if self.launch_handlers.wants_completion(step.spec.action):
+                    self._awaited.add(id(step.spec))  # ExecutionComplete once it exits for good
+                self.start(step.spec)
+        elif isinstance(step, Log):
+            # LogInfo is no event in launch: it is said as it is visited.
+            self.events.say_now(Said(step.level, step.source, step.message))
+        elif isinstance(step, StartTimer):
+            self._start_timer(step)
+        elif isinstance(step, AddHandler):
+            self.launch_handlers.add(step)
+        elif isinstance(step, RemoveHandler):
+            self.launch_handlers.remove(step.handler)
+        elif isinstance(step, RequestShutdown):
+            self.begin_shutdown(step.reason)
+        elif isinstance(step, EmitEvent):
+            self.events.emit(LaunchEvent(step.event))
+        elif isinstance(step, Handoff):
+            # For the part that carries it out (the LoadNode driver): from the plan, a timer
+            # or a handler alike, in the order the steps are reached.
+            handed = HandedOff(step)
+            self.events.emit(handed)
+            self.events.emit(Unclaimed(handed))
+        elif not isinstance(step, Note):
+            raise TypeError(
+                f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"
+                " whatever adds this kind of step must also handle it"
+            )
+
+    def _start_timer(self, step: StartTimer) -> None:
+        body, action = step.body, step.action
+        awaited = action is not None and self.launch_handlers.wants_completion(action)
+        if body is None and not awaited:
+            return
+
+        def expire() -> None:
+            if body is not None:
+                self.fire(body, None)
+            if awaited:
+                self.events.emit(Completed(action))
+
+        self.schedule(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
+
+    def fire(self, body: Deferred, event: Any) -> None:
+        """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
+        try:
+            plan = resolve_deferred(body, labels=self.labels, options=self.options, event=event)
+        except MlaunchError as e:
+            self.handler_failed(str(e))
+            return
+        self.execute(plan.steps, plan.warnings)
+
+    def handler_failed(self, message: str) -> None:
+        """A handler of the launch file failed: say where, then shut down (exit status 2)."""
+        self.events.emit(Said("ERROR", "launch", message))
+        self.exit_code = max(self.exit_code, EXIT_USAGE)
+        self.begin_shutdown("an event handler failed")
+
+    def _react(self, event: Event) -> None:
+        """The supervisor's own subscription: the stop ladder begins at StoppingAll."""
+        if isinstance(event, StoppingAll) and not event.kill:
+            self._stop_all()
+
+    # --- processes ---------------------------------------------------------------------------
+
+    def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
+        if self.shutting_down:
+            self.events.emit(NotStarted(spec))
+            return None
+        process = self.spawner(spec, next(self._index), restarts)
+        record = self.records.get(spec.label)
+        if record is None:
+            record = self.records[spec.label] = ProcessRecord(spec.label, spec)
+        record.restarts, record.restart_at = restarts, None
+        try:
+            process.spawn(self.clock, self._marker_env)
+        except OSError as e:
+            reason = e.strerror or str(e)
+            process.returncode = 127
+            self.processes.append(process)
+            record.failed_to_start(reason)
+            self.events.hold()
+            try:
+                self.events.emit(FailedToStart(process, reason))
+                self._exited(process)
+            finally:
+                self.events.release()
+            return process
+        if self.guard is not None:
+            self.guard.watch(process.pid, spec.sigkill_timeout)
+        self.processes.append(process)
+        self.by_pid[process.pid] = process
+        record.state, record.pid, record.started_at = RUNNING, process.pid, process.started_at
+        self.pipes.watch(process)
+        self.events.emit(Started(process))
+        return process
+
+    def _deliver(self, process: Process, stream: str, data: bytes) -> None:
+        """Complete lines of a child, onto the stream (the printer, then OnProcessIO handlers)."""
+        self.events.emit(Output(process, stream, data))
+
+    def _reap(self) -> None:
+        while True:
+            try:
+                pid, status, rusage = os.wait4(-1, os.WNOHANG)
+            except ChildProcessError:
+                return
+            if pid == 0:
+                return
+            process = self.by_pid.pop(pid, None)
+            if process is None:
+                continue  # an orphaned grandchild we adopted as subreaper, or the guard
+            process.reaped(status, self.clock, rusage)
+            # One record after another, handled once all are queued: its last words first
+            # (what is still in the pipes, then the partial last line), then its exit.
+            self.events.hold()
+            try:
+                self.pipes.drain(process)
+                if process.check_group():
+                    self.lingering.append(process)
+                elif self.guard is not None:
+                    self.guard.forget(process.pid)
+                self.records[process.label].ended(process)
+                self._exited(process)
+            finally:
+                self.events.release()
+
+    def _exited(self, process: Process) -> None:
+        """Where a process's exit becomes a log line, handler calls, a shutdown, a respawn.
+
+        Called with the stream held, so every subscriber sees ``Exited`` before what follows
+        from it: the printer says it, the launch file's OnProcessExit and on_exit handlers
+        fire (mlaunch.engine.handlers), lifecycle driving and smoke checks take note. A required
+        process decides the run first, so the shutdown names it (its on_exit=Shutdown() then
+        has nothing to do). Then the respawn policy (mlaunch.engine.respawn) decides.
+        """
+        spec = process.spec
+        code = process.returncode if process.returncode is not None else 0
+        self.events.emit(Exited(process, code))
+        if spec.required and not process.stopping:
+            # A required process decides the run: it ends it, and its failure is the run's.
+            if code != 0:
+                self.exit_code = max(self.exit_code, EXIT_FAILURE)
+            self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
+        self._maybe_respawn(process, code)
+        if id(spec) in self._awaited and self.records[spec.label].state != RESTARTING:
+            self._awaited.discard(id(spec))
+            self.events.emit(Completed(spec.action))
+
+    def _maybe_respawn(self, process: Process, code: int) -> None:
+        if process.user_stop == "restart":
+            if self.shutting_down:
+                self.records[process.label].not_restarting()
+            else:
+                self.start_again(process)  # at once: no backoff, the user asked for it
+            return
+        if self.shutting_down or process.stopping:
+            return
+        record = self.records[process.label]
+        uptime = process.ended_at - process.started_at
+        policy = process.spec.respawn
+        delay = next_restart(policy, record, code, uptime)
+        if delay == NO_RESTART:
+            return
+        if delay == GIVE_UP:
+            record.state = GAVE_UP
+            record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
+            self.events.emit(GaveUp(process, code, record.restarts))
+            return
+        attempt = record.restarts + 1
+        self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
+        record.state, record.restart_at = RESTARTING, self.clock() + delay
+        self.respawn_timers[process.label] = self.schedule(
+            delay, lambda: self._respawn(process, attempt)
+        )
+
+    def _respawn(self, old: Process, attempt: int) -> None:
+        """Start the same spec again (same argv, label, temp files); forget the old instance."""
+        self.respawn_timers.pop(old.label, None)
+        self._forget(old)
+        self.start(old.spec, restarts=attempt)
+
+    def start_again(self, old: Process) -> Process | None:
+        """Start ``old``'s spec again now, as the user asked (mlaunch.parts.control).
+
+        It counts as a restart, but not against respawn's ``max_retries``, and respawn's
+        crash-loop backoff starts over: the user ended the last run, not a crash. A respawn
+        still waiting for its delay is cancelled.
+        """
+        timer = self.respawn_timers.pop(old.label, None)
+        if timer is not None:
+            timer.cancelled = True
+        record = self.records[old.label]
+        record.user_starts += 1
+        record.streak = 0
+        self._forget(old)
+        return self.start(old.spec, restarts=record.restarts + 1)
+
+    def _forget(self, old: Process) -> None:
+        if not old.streams and old not in self.lingering and old in self.processes:
+            self.processes.remove(old)  # a crash loop must not grow the list forever

@@ -1,0 +1,386 @@
+"""The run's control socket: ``mlaunch ctl`` requests served on the supervisor's own loop.
+
+An AF_UNIX stream socket at ``<run log folder>/control/ctl.sock``: the folder is 0700 and the
+socket 0600, so only the user who runs mlaunch reaches it. It is opened on the loop's first turn
+(after the first children started: ``socket`` costs milliseconds; ``json`` waits for the first
+request) and registered in the loop's selector, so every request is read and carried out on the
+loop thread, by mlaunch.parts.control, never racing the supervisor. It is removed when the run
+ends; if mlaunch is killed, its guard removes it (mlaunch.engine.guard); a socket left behind
+anyway is found stale by ``mlaunch ctl`` (nobody accepts), never waited on.
+
+The protocol is JSON lines. A request is one line: ``{"op": "stop", "label": "talker"}`` (op:
+one of mlaunch.parts.control.OPERATIONS; ``lines`` for logs). The answer is one line with ``ok``;
+a stop or restart first sends ``{"accepted": true, "wait": SECONDS}`` (how long its stop ladder
+may take), then the answer once the process has exited (or started again). Every answer carries
+``run`` (pid, run id, log folder). A failed request answers ``ok: false`` with ``error`` (one
+line), ``status`` (errors' exit-status table) and, for an unknown label, ``labels`` and
+``close``.
+"""
+
+from __future__ import annotations
+
+import os
+import selectors
+import socket
+import stat
+from collections.abc import Mapping
+
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.control import Control, ProcessInfo
+
+FOLDER = "control"
+NAME = "ctl.sock"
+# In FOLDER when the socket is elsewhere (the log folder takes no socket): its path.
+WHERE = "where"
+PROTOCOL = 1
+# A request line longer than this is refused (a request is a few dozen bytes).
+MAX_REQUEST = 64 * 1024
+# Beyond a stop ladder's own timeouts, what an answer to a stop or restart may take.
+WAIT_MARGIN = 5.0
+# AF_UNIX paths longer than this (108 bytes on Linux, with the NUL) are reached through the folder.
+MAX_PATH = 100
+
+
+def socket_path(log_dir: str) -> str:
+    """Where the control socket of the run logging to ``log_dir`` is."""
+    return os.path.join(log_dir, FOLDER, NAME)
+
+
+class Address:
+    """An AF_UNIX address for ``path`` that fits, however long the path (a context manager).
+
+    A long path is reached as ``/proc/self/fd/N/ctl.sock`` through an open descriptor of its
+    folder (a log folder under a deep home or a test's temporary folder exceeds the limit).
+    """
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+        self._fd = -1
+
+    def __enter__(self) -> str:
+        if len(os.fsencode(self.path)) <= MAX_PATH:
+            return self.path
+        folder, name = os.path.split(self.path)
+        self._fd = os.open(folder, os.O_PATH | os.O_DIRECTORY)
+        return f"/proc/self/fd/{self._fd}/{name}"
+
+    def __exit__(self, *_: object) -> None:
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1
+
+
+def find_socket(log_dir: str) -> str | None:
+    """The control socket of the run logging to ``log_dir`` (None when it has none)."""
+    path = socket_path(log_dir)
+    if _is_socket(path):
+        return path
+    try:
+        with open(os.path.join(log_dir, FOLDER, WHERE), encoding="utf-8") as f:
+            elsewhere = f.read().strip()
+    except (OSError, ValueError):
+        return None
+    return elsewhere if _is_socket(elsewhere) else None
+
+
+def runtime_socket_path(log_dir: str, environ: Mapping[str, str]) -> str | None:
+    """Where the socket goes when the log folder takes none: ``$XDG_RUNTIME_DIR/mlaunch/``."""
+    runtime = environ.get("XDG_RUNTIME_DIR")
+    if not runtime or not os.path.isdir(runtime):
+        return None
+    return os.path.join(runtime, "mlaunch", os.path.basename(log_dir.rstrip("/")) + ".sock")
+
+
+def _is_socket(path: str) -> bool:
+    try:
+        return stat.S_ISSOCK(os.stat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _listen(path: str) -> socket.socket:
+    """A listening socket at ``path`` (0600) in a folder of its own made 0700."""
+    folder = os.path.dirname(path)
+    os.makedirs(folder, mode=0o700, exist_ok=True)
+    os.chmod(folder, 0o700)  # made earlier with another mode: private all the same
+    try:
+        os.unlink(path)  # a run's socket path is its own: what is there is stale
+    except FileNotFoundError:
+        pass
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    try:
+        with Address(path) as address:
+            listener.bind(address)
+        os.chmod(path, 0o600)
+        listener.listen(8)
+        listener.setblocking(False)
+    except BaseException:
+        listener.close()
+        raise
+    return listener
+
+
+class ControlSocket:
+    """The listening socket and its clients, in ``supervisor.selector``; ``close`` removes it.
+
+    In the run's log folder; where that takes no socket (a file system without them), in
+    ``$XDG_RUNTIME_DIR/mlaunch/``, named in the log folder's ``control/where``.
+    """
+
+    def __init__(
+        self, supervisor: Supervisor, log_dir: str, environ: Mapping[str, str] = os.environ
+    ) -> None:
+        self.supervisor = supervisor
+        self.path = socket_path(log_dir)
+        self.log_dir = log_dir
+        self.environ = environ
+        self.error = ""  # why it could not be opened
+        self._listener: socket.socket | None = None
+        self._clients: list[_Client] = []
+
+    def open(self) -> bool:
+        """Bind and listen (False, with ``error``, when no folder takes the socket)."""
+        listener: socket.socket | None
+        try:
+            listener = _listen(self.path)
+        except OSError as e:
+            self.error = f"cannot open the control socket {self.path}: {e.strerror or e}"
+            listener = self._elsewhere()
+            if listener is None:
+                return False
+        self._listener = listener
+        self.supervisor.selector.register(listener, selectors.EVENT_READ, self._accept)
+        guard = self.supervisor.guard
+        if guard is not None:
+            guard.remove_on_death(self.path)
+        return True
+
+    def _elsewhere(self) -> socket.socket | None:
+        """The socket in the runtime folder, named in the log folder (None: no luck there)."""
+        path = runtime_socket_path(self.log_dir, self.environ)
+        if path is None:
+            return None
+        try:
+            listener = _listen(path)
+        except OSError as e:
+            self.error += f"; nor {path}: {e.strerror or e}"
+            return None
+        where = os.path.join(self.log_dir, FOLDER, WHERE)
+        try:
+            os.makedirs(os.path.dirname(where), mode=0o700, exist_ok=True)
+            fd = os.open(where, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            with open(fd, "w", encoding="utf-8") as f:
+                f.write(path + "\n")
+        except OSError as e:
+            listener.close()
+            os.unlink(path)
+            self.error += f"; nor can {where} name {path}: {e.strerror or e}"
+            return None
+        self.path = path
+        return listener
+
+    def _accept(self, fd: int) -> None:
+        assert self._listener is not None
+        try:
+            conn, _ = self._listener.accept()
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            return  # the client gave up before we took it
+        conn.setblocking(False)
+        client = _Client(self, conn)
+        self._clients.append(client)
+        self.supervisor.selector.register(conn, selectors.EVENT_READ, client.on_ready)
+
+    def run_info(self) -> dict[str, object]:
+        return {"pid": os.getpid(), "run_id": self.supervisor.run_id, "log_dir": self.log_dir}
+
+    def forget(self, client: _Client) -> None:
+        if client in self._clients:
+            self._clients.remove(client)
+        _unregister(self.supervisor.selector, client.conn)
+        client.conn.close()
+
+    def close(self) -> None:
+        """Answer who still waits (the launch ended), close, and remove the socket file."""
+        for client in list(self._clients):
+            client.ended()
+        if self._listener is not None:
+            _unregister(self.supervisor.selector, self._listener)
+            self._listener.close()
+            self._listener = None
+            for leftover in (self.path, os.path.join(self.log_dir, FOLDER, WHERE)):
+                try:
+                    os.unlink(leftover)
+                except OSError:
+                    pass
+            try:
+                os.rmdir(os.path.join(self.log_dir, FOLDER))
+            except OSError:
+                pass
+
+
+def _unregister(selector: selectors.BaseSelector, sock: socket.socket) -> None:
+    try:
+        selector.unregister(sock)
+    except (KeyError, ValueError, RuntimeError, OSError):
+        pass  # never registered, or the loop's selector is closed already
+
+
+class _Client:
+    """One connection: a request line in, JSON lines out, then closed."""
+
+    def __init__(self, server: ControlSocket, conn: socket.socket) -> None:
+        self.server = server
+        self.conn = conn
+        self.received = b""
+        self.out = b""
+        self.answered = False  # the final answer is queued: close once it is sent
+        self.asked = False
+
+    # --- the loop's callbacks --------------------------------------------------------------
+
+    def on_ready(self, fd: int) -> None:
+        """Readable before the request is whole; writable while an answer waits."""
+        if self.out:
+            self._send()
+            return
+        data = self._recv()
+        if data is None:
+            return
+        if not data:
+            self.server.forget(self)  # the client left (while its stop was under way, too)
+            return
+        if self.asked:
+            return  # past the request: its answer comes when it is done
+        self.received += data
+        if b"\n" in self.received:
+            self.asked = True
+            self.handle(self.received.split(b"\n", 1)[0])
+        elif len(self.received) > MAX_REQUEST:
+            self.asked = True
+            self.fail("the request is too long", EXIT_USAGE)
+
+    def _recv(self) -> bytes | None:
+        """What the client sent (b"" when it left), None if nothing yet."""
+        try:
+            return self.conn.recv(4096)
+        except (BlockingIOError, InterruptedError):
+            return None
+        except OSError:
+            return b""
+
+    # --- the request -----------------------------------------------------------------------
+
+    def handle(self, line: bytes) -> None:
+        from mlaunch.parts.control import AmbiguousLabel, ControlError, UnknownLabel
+
+        try:
+            import json  # at the first request, not when the socket opens
+
+            request = json.loads(line)
+            if not isinstance(request, dict):
+                raise ValueError("not an object")
+        except ValueError as e:
+            self.fail(f"the request is not a JSON object: {e}", EXIT_USAGE)
+            return
+        try:
+            self.carry_out(request)
+        except UnknownLabel as e:
+            self.fail(str(e), e.exit_code, labels=e.labels, close=e.close)
+        except AmbiguousLabel as e:
+            self.fail(str(e), e.exit_code, labels=e.labels)
+        except ControlError as e:
+            self.fail(str(e), e.exit_code)
+
+    def carry_out(self, request: dict[str, object]) -> None:
+        from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS, ControlError
+
+        control = self.server.supervisor.control
+        op, label = request.get("op"), request.get("label")
+        if op not in OPERATIONS:
+            raise ControlError(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
+        if op == "list":
+            rows = [info.as_dict() for info in control.processes()]
+            self.answer({"processes": rows})
+            return
+        if not isinstance(label, str):
+            raise ControlError(f"{op} needs a process label")
+        if op == "logs":
+            lines = request.get("lines", DEFAULT_LINES)
+            if not isinstance(lines, int):
+                raise ControlError(f"lines must be a number, not {lines!r}")
+            self.answer({"label": label, "lines": control.logs(label, lines)})
+        elif op in ("mute", "unmute"):
+            info = (
+                control.mute(label, by="ctl") if op == "mute" else control.unmute(label, by="ctl")
+            )
+            self.answer({"process": info.as_dict()})
+        elif op == "start":
+            control.start(label, by="ctl", done=self.done)
+        else:
+            self.accepted(control, label)
+            if op == "stop":
+                control.stop(label, by="ctl", done=self.done)
+            else:
+                control.restart(label, by="ctl", done=self.done)
+
+    def accepted(self, control: Control, label: str) -> None:
+        spec = control.record(label).spec  # raises before anything is said for a bad label
+        wait = spec.sigterm_timeout + spec.sigkill_timeout + WAIT_MARGIN
+        self.queue({"accepted": True, "wait": wait})
+
+    def done(self, info: ProcessInfo) -> None:
+        self.answer({"process": info.as_dict()})
+
+    # --- answers ---------------------------------------------------------------------------
+
+    def answer(self, payload: dict[str, object]) -> None:
+        self.answered = True
+        self.queue({"ok": True, **payload, "run": self.server.run_info()})
+
+    def fail(self, error: str, status: int = EXIT_FAILURE, **more: object) -> None:
+        self.answered = True
+        self.queue(
+            {"ok": False, "error": error, "status": status, **more, "run": self.server.run_info()}
+        )
+
+    def ended(self) -> None:
+        """The run ended with this request unanswered: say so, as far as the socket takes it."""
+        if not self.answered and self.asked:
+            self.fail("the launch ended before the request was carried out")
+        if self.out:
+            try:
+                self.conn.setblocking(True)
+                self.conn.settimeout(0.5)
+                self.conn.sendall(self.out)
+            except OSError:
+                pass
+            self.out = b""
+        self.server.forget(self)
+
+    def queue(self, message: dict[str, object]) -> None:
+        import json
+
+        self.out += json.dumps(message).encode() + b"\n"
+        self._send()
+
+    def _send(self) -> None:
+        try:
+            sent = self.conn.send(self.out)
+        except (BlockingIOError, InterruptedError):
+            sent = 0
+        except OSError:
+            self.server.forget(self)  # the client went away
+            return
+        self.out = self.out[sent:]
+        if self.out:
+            self.server.supervisor.selector.modify(self.conn, selectors.EVENT_WRITE, self.on_ready)
+        elif self.answered:
+            self.server.forget(self)
+        else:
+            self.server.supervisor.selector.modify(self.conn, selectors.EVENT_READ, self.on_ready)

@@ -1,0 +1,148 @@
+"""MachineSpec: a machine as resolved for one run, and the run-wide table of declared machines."""
+
+from __future__ import annotations
+
+import itertools
+import os
+
+from mlaunch.plan.record import Record
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+# ROS 1's default for <machine timeout>: seconds to wait for the connection.
+DEFAULT_TIMEOUT = 10.0
+
+
+class MachineSpec(Record):
+    """Where a process runs: ``address`` over ssh, or this computer when ``local``.
+
+    ``user`` and ``ssh_port`` None leave the choice to the ssh configuration; ``env_loader`` is a
+    program on the remote that sets the environment and runs its arguments (ROS 1's env-loader);
+    ``timeout`` bounds the connection. ``local``: the address is this computer and the user is
+    ours (ROS 1's rule), so processes start here without ssh.
+    """
+
+    _fields = ("name", "address", "user", "ssh_port", "env_loader", "timeout", "local", "origin")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        name: str,
+        address: str,
+        user: str | None = None,
+        ssh_port: int | None = None,
+        env_loader: str | None = None,
+        timeout: float = DEFAULT_TIMEOUT,
+        local: bool = False,
+        origin: str = "",
+    ) -> None:
+        self.name = name
+        self.address = address
+        self.user = user
+        self.ssh_port = ssh_port
+        self.env_loader = env_loader
+        self.timeout = timeout
+        self.local = local
+        self.origin = origin
+
+    def __hash__(self) -> int:
+        return hash(self._values())
+
+    @property
+    def destination(self) -> str:
+        """``user@address:port`` as far as the launch file says (for messages)."""
+        text = f"{self.user}@{self.address}" if self.user else self.address
+        return f"{text}:{self.ssh_port}" if self.ssh_port else text
+
+    def describe(self) -> str:
+        if self.local:
+            return f"{self.name} (this computer: {self.destination})"
+        extra = f", env-loader {self.env_loader}" if self.env_loader else ""
+        return f"{self.name} (ssh {self.destination}{extra})"
+
+
+def is_local(address: str, user: str | None) -> bool:
+    """ROS 1's rule: the address resolves to this computer and the user is ours (or not given).
+
+    A name that does not resolve (an ssh ``Host`` alias) is remote: ssh resolves it.
+    """
+    import socket
+
+    if user:
+        import getpass
+
+        if user != getpass.getuser():
+            return False
+    if address == "localhost":
+        return True
+    try:
+        infos = socket.getaddrinfo(address, None, 0, 0, socket.IPPROTO_TCP)
+    except (OSError, UnicodeError):
+        return False
+    ips = {str(info[4][0]) for info in infos}
+    if any(ip.startswith("127.") or ip == "::1" for ip in ips):
+        return True
+    return bool(ips & local_addresses())
+
+
+def local_addresses() -> set[str]:
+    """This computer's addresses (its host name's, and what the kernel lists for IPv4/IPv6)."""
+    import socket
+
+    found: set[str] = set()
+    try:
+        found.update(str(i[4][0]) for i in socket.getaddrinfo(socket.gethostname(), None))
+    except OSError:
+        pass
+    try:
+        with open("/proc/net/if_inet6") as f:
+            for line in f:
+                raw = line.split()[0]
+                found.add(socket.inet_ntop(socket.AF_INET6, bytes.fromhex(raw)))
+    except OSError:
+        pass
+    found.update(_ipv4_addresses())
+    return found
+
+
+def _ipv4_addresses() -> set[str]:
+    """IPv4 addresses of this computer's interfaces, from /proc/net/fib_trie's local entries."""
+    out: set[str] = set()
+    try:
+        with open("/proc/net/fib_trie") as f:
+            lines = f.read().splitlines()
+    except OSError:
+        return out
+    for previous, line in itertools.pairwise(lines):
+        if "/32 host LOCAL" in line:
+            out.add(previous.split()[-1])
+    return out
+
+
+def declared(holder: Any) -> dict[str, MachineSpec]:
+    """The machines declared so far in this run, by name.
+
+    Kept on the run's label counter, the one object every resolution of a run shares (timers
+    and handlers resolved later see the machines declared before them), as ROS 1's machine
+    names are global to a launch.
+    """
+    table: dict[str, MachineSpec] | None = getattr(holder, "machines", None)
+    if table is None:
+        table = {}
+        holder.machines = table
+    return table
+
+
+def remote_machines(holder: Any) -> list[MachineSpec]:
+    """The declared machines reached over ssh (empty for a launch without machines)."""
+    table = getattr(holder, "machines", None) or {}
+    return [m for m in table.values() if not m.local]
+
+
+def check_name(name: str) -> str | None:
+    """Why ``name`` cannot name a machine, or None."""
+    if not name or any(c.isspace() for c in name) or os.sep in name:
+        return "a machine name is a non-empty word without spaces or '/'"
+    return None

@@ -1,0 +1,423 @@
+"""The Plan: what resolving a launch description produces, and the only thing the supervisor runs.
+
+A Plan is an ordered list of steps (start this process, print this line, arm this timer, listen
+for this event, shut down). Anything that depends on run time is a step carrying a ``Deferred``:
+entities plus the context captured where they were written, resolved by the same resolver when
+the trigger fires.
+
+The classes are plain classes with ``__slots__``, not dataclasses: importing dataclasses costs
+~8 ms (it imports inspect, ast, dis and tokenize) and creating each dataclass ~0.4 ms, all before
+the first child starts. ``Record`` (mlaunch.plan.record) gives them a dataclass's equality and repr.
+"""
+
+from __future__ import annotations
+
+from mlaunch.plan.record import Record
+
+# typing is imported by type checkers only (~4 ms at start-up); mypy treats this name as
+# typing.TYPE_CHECKING.
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.plan.machine import MachineSpec
+
+OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
+RESPAWN_MODES = ("never", "always", "on-failure")
+
+
+class RespawnPolicy(Record):
+    """When and how a process is started again after it exits (immutable and hashable).
+
+    ``mode`` is ``never``, ``always`` (ROS 2's respawn=True: any exit) or ``on-failure``
+    (non-zero status or a signal). The delay doubles after each quick failure up to
+    ``max_delay`` (crash-loop backoff); ``max_retries`` -1 means no limit.
+    """
+
+    _fields = ("mode", "delay", "max_retries", "backoff", "max_delay")
+    __slots__ = _fields
+    # What the slots hold, for type checkers: __init__ sets them without ``self.x = ...``.
+    mode: str
+    delay: float
+    max_retries: int
+    backoff: float
+    max_delay: float
+
+    def __init__(
+        self,
+        mode: str = "never",
+        delay: float = 0.0,
+        max_retries: int = -1,
+        backoff: float = 1.0,
+        max_delay: float = 30.0,
+    ) -> None:
+        # Frozen: the supervisor and every respawn share one policy object.
+        init = object.__setattr__
+        init(self, "mode", mode)
+        init(self, "delay", delay)
+        init(self, "max_retries", max_retries)
+        init(self, "backoff", backoff)
+        init(self, "max_delay", max_delay)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"cannot assign to field {name!r} of a RespawnPolicy (it is frozen)")
+
+    def __delattr__(self, name: str) -> None:
+        raise AttributeError(f"cannot delete field {name!r} of a RespawnPolicy (it is frozen)")
+
+    def __hash__(self) -> int:
+        return hash(self._values())
+
+    def describe(self) -> str:
+        if self.mode == "never":
+            return "no"
+        retries = "unlimited" if self.max_retries < 0 else f"at most {self.max_retries}"
+        text = f"{self.mode}, delay {self.delay:g} s, {retries} restarts"
+        if self.backoff > 1.0:
+            text += f", backoff x{self.backoff:g} up to {self.max_delay:g} s"
+        return text
+
+
+class NodeInfo(Record):
+    """What the ROS layer knows about a process that is a ROS node."""
+
+    _fields = ("name", "namespace", "package", "executable", "lifecycle", "autostart")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        name: str | None,
+        namespace: str,
+        package: str | None,
+        executable: str,
+        lifecycle: bool = False,
+        autostart: bool = False,
+    ) -> None:
+        self.name = name
+        self.namespace = namespace
+        self.package = package
+        self.executable = executable
+        self.lifecycle = lifecycle
+        self.autostart = autostart
+
+    @property
+    def fully_qualified_name(self) -> str | None:
+        if not self.name:
+            return None
+        ns = self.namespace.rstrip("/")
+        return f"{ns}/{self.name}"
+
+
+class ProcessSpec(Record):
+    """Everything needed to start, watch and stop one process. Respawns reuse it unchanged."""
+
+    _fields = (
+        "label",
+        "argv",
+        "env",
+        "env_changes",
+        "cwd",
+        "shell",
+        "emulate_tty",
+        "output",
+        "respawn",
+        "sigterm_timeout",
+        "sigkill_timeout",
+        "required",
+        "on_exit",
+        "origin",
+        "action",
+        "node",
+        "standin",
+        "temp_files",
+        "machine",
+        "launch_prefix",
+    )
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        label: str,
+        argv: tuple[str, ...],
+        env: dict[str, str],
+        env_changes: dict[str, str | None],
+        cwd: str | None = None,
+        shell: bool = False,
+        emulate_tty: bool = False,
+        output: str = "log",
+        respawn: RespawnPolicy | None = None,
+        sigterm_timeout: float = 5.0,
+        sigkill_timeout: float = 5.0,
+        required: bool = False,
+        on_exit: Deferred | None = None,
+        origin: str = "",
+        action: Any = None,
+        node: NodeInfo | None = None,
+        standin: str | None = None,
+        temp_files: tuple[str, ...] = (),
+        machine: MachineSpec | None = None,
+        launch_prefix: tuple[str, ...] = (),
+    ) -> None:
+        self.label = label
+        self.argv = argv
+        self.env = env
+        self.env_changes = env_changes
+        self.cwd = cwd
+        self.shell = shell
+        self.emulate_tty = emulate_tty  # stdout and stderr are pseudo-terminals (launch's pty)
+        self.output = output
+        self.respawn: RespawnPolicy = RespawnPolicy() if respawn is None else respawn
+        self.sigterm_timeout = sigterm_timeout
+        self.sigkill_timeout = sigkill_timeout
+        self.required = required
+        self.on_exit = on_exit
+        self.origin = origin
+        self.action = action
+        self.node = node
+        self.standin = standin
+        self.temp_files = temp_files
+        # Where it runs: None for this computer, else a declared machine (mlaunch.machines).
+        self.machine = machine
+        # The launch prefix's words at the head of argv (--launch-prefix, prefix=), for --print.
+        self.launch_prefix = launch_prefix
+
+    @property
+    def base_name(self) -> str:
+        return self.label.rsplit("-", 1)[0]
+
+
+class Deferred(Record):
+    """Entities to resolve later: with the run's live context when they fire (launch's rule;
+    ``captured`` then holds the values where they were written, to warn where those differ),
+    or with a ``context`` frozen where they were written (``captured`` None;
+    mlaunch.resolve.binding).
+    """
+
+    _fields = ("entities", "context", "origin", "callback", "captured")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        entities: list[Any],
+        context: LaunchContext,
+        origin: str = "",
+        callback: Any = None,  # callable(event, context) -> entities, as ROS 2 handlers accept
+        captured: LaunchContext | None = None,
+    ) -> None:
+        self.entities = entities
+        self.context = context
+        self.origin = origin
+        self.callback = callback
+        self.captured = captured
+
+    def describe(self) -> str:
+        if self.callback is not None:
+            name = getattr(self.callback, "__qualname__", repr(self.callback))
+            return f"call {name}()"
+        return ", ".join(_entity_name(e) for e in self.entities) or "nothing"
+
+
+def _entity_name(entity: Any) -> str:
+    describe = getattr(entity, "describe_short", None)
+    return describe() if describe else type(entity).__name__
+
+
+class Step(Record):
+    """One thing the supervisor does, in plan order."""
+
+    _fields: tuple[str, ...] = ("origin",)
+    __slots__ = _fields
+
+    def __init__(self, origin: str = "") -> None:
+        self.origin = origin
+
+
+class Spawn(Step):
+    __slots__ = ("spec",)
+    _fields = (*Step._fields, "spec")
+
+    def __init__(self, origin: str = "", spec: ProcessSpec | None = None) -> None:
+        self.origin = origin
+        self.spec = spec
+
+
+class Log(Step):
+    __slots__ = ("level", "message", "source")
+    _fields = (*Step._fields, "level", "source", "message")
+
+    def __init__(
+        self,
+        origin: str = "",
+        level: str = "INFO",
+        source: str = "launch.user",
+        message: str = "",
+    ) -> None:
+        self.origin = origin
+        self.level = level
+        self.source = source
+        self.message = message
+
+
+class StartTimer(Step):
+    __slots__ = ("action", "body", "cancel_on_shutdown", "period")
+    _fields = (*Step._fields, "period", "body", "cancel_on_shutdown", "action")
+
+    def __init__(
+        self,
+        origin: str = "",
+        period: float = 0.0,
+        body: Deferred | None = None,
+        cancel_on_shutdown: bool = True,
+        action: Any = None,
+    ) -> None:
+        self.origin = origin
+        self.period = period
+        self.body = body
+        self.cancel_on_shutdown = cancel_on_shutdown
+        self.action = action  # the TimerAction (OnExecutionComplete targets it)
+
+
+class AddHandler(Step):
+    """Listen for an event: ``kind`` is process_start, process_exit, process_io, shutdown, ..."""
+
+    __slots__ = ("body", "handler", "io_callbacks", "kind", "matcher", "once")
+    _fields = (*Step._fields, "kind", "matcher", "body", "io_callbacks", "once", "handler")
+
+    def __init__(
+        self,
+        origin: str = "",
+        kind: str = "",
+        matcher: Any = None,  # callable(ProcessSpec) -> bool, or None for every process
+        body: Deferred | None = None,
+        io_callbacks: dict[str, Any] | None = None,
+        once: bool = False,
+        handler: Any = None,  # the user's handler object (for UnregisterEventHandler)
+    ) -> None:
+        self.origin = origin
+        self.kind = kind
+        self.matcher = matcher
+        self.body = body
+        self.io_callbacks: dict[str, Any] = {} if io_callbacks is None else io_callbacks
+        self.once = once
+        self.handler = handler
+
+
+class RemoveHandler(Step):
+    __slots__ = ("handler",)
+    _fields = (*Step._fields, "handler")
+
+    def __init__(self, origin: str = "", handler: Any = None) -> None:
+        self.origin = origin
+        self.handler = handler
+
+
+class RequestShutdown(Step):
+    __slots__ = ("reason",)
+    _fields = (*Step._fields, "reason")
+
+    def __init__(self, origin: str = "", reason: str = "reason not given") -> None:
+        self.origin = origin
+        self.reason = reason
+
+
+class EmitEvent(Step):
+    """An event other than Shutdown (ShutdownProcess, SignalProcess, lifecycle ChangeState...)."""
+
+    __slots__ = ("event",)
+    _fields = (*Step._fields, "event")
+
+    def __init__(self, origin: str = "", event: Any = None) -> None:
+        self.origin = origin
+        self.event = event
+
+
+class Note(Step):
+    """A step the supervisor carries nothing out for, read from the plan by what attaches to it.
+
+    A lifecycle sequence, a smoke-test expectation. Any other step kind the supervisor does not
+    know is an error, not skipped.
+    """
+
+
+class Handoff(Step):
+    """A step carried out by a part attached to the run, whenever it is reached.
+
+    The supervisor emits it on the event stream (``HandedOff``) as it carries out the plan, a
+    timer's or a handler's steps alike, so the part acting on it (``needs`` names it: the
+    LoadNode driver for LoadComponents) sees every such step once, in order. A handoff no part
+    takes is said, never dropped in silence.
+    """
+
+    needs: frozenset[str] = frozenset()
+
+
+# What a run may need attached besides the supervisor (Plan.needs): "lifecycle" driving.
+NO_NEEDS: frozenset[str] = frozenset()
+# The YAML/XML form of a LifecycleSequence: a launch argument listing the nodes.
+SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
+
+
+def step_needs(step: Step) -> frozenset[str]:
+    """What a step needs attached to the run: a lifecycle node's spawn, a ChangeState, an
+    OnStateTransition handler and a LifecycleSequence need lifecycle driving."""
+    if isinstance(step, Spawn):
+        node = step.spec.node if step.spec is not None else None
+        return frozenset({"lifecycle"}) if node is not None and node.lifecycle else NO_NEEDS
+    if isinstance(step, AddHandler):
+        return frozenset(getattr(step.handler, "needs", NO_NEEDS))
+    if isinstance(step, EmitEvent):
+        return frozenset(getattr(step.event, "needs", NO_NEEDS))
+    return frozenset(getattr(step, "needs", NO_NEEDS))
+
+
+class ArgumentInfo(Record):
+    """A declared launch argument, for --show-args and CLI checks."""
+
+    _fields = ("name", "default", "description", "choices", "origin", "conditional", "value")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        name: str,
+        default: str | None,
+        description: str,
+        choices: tuple[str, ...] | None,
+        origin: str,
+        conditional: bool = False,
+        value: str | None = None,
+    ) -> None:
+        self.name = name
+        self.default = default
+        self.description = description
+        self.choices = choices
+        self.origin = origin
+        self.conditional = conditional
+        # The value the run gave it where it was first declared (resolve sets it; --show-args
+        # does not resolve, so None there).
+        self.value = value
+
+
+class Plan(Record):
+    """The resolved launch: its steps in order, its arguments, warnings, and ``needs``: what
+    must attach to the run (``"lifecycle"``), noted by resolve as it adds and defers steps."""
+
+    _fields = ("steps", "arguments", "warnings", "temp_dir", "needs")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        steps: list[Step] | None = None,
+        arguments: dict[str, ArgumentInfo] | None = None,
+        warnings: list[str] | None = None,
+        temp_dir: str | None = None,
+        needs: set[str] | None = None,
+    ) -> None:
+        self.steps: list[Step] = [] if steps is None else steps
+        self.arguments: dict[str, ArgumentInfo] = {} if arguments is None else arguments
+        self.warnings: list[str] = [] if warnings is None else warnings
+        self.temp_dir = temp_dir
+        self.needs: set[str] = set() if needs is None else needs
+
+    def processes(self) -> list[ProcessSpec]:
+        return [s.spec for s in self.steps if isinstance(s, Spawn) and s.spec is not None]

@@ -1,0 +1,209 @@
+"""--print and --show-args: the resolved plan and the arguments, as text a person reads."""
+
+from __future__ import annotations
+
+import os
+import shlex
+from collections.abc import Sequence
+
+from mlaunch.plan.steps import (
+    AddHandler,
+    ArgumentInfo,
+    EmitEvent,
+    Log,
+    Plan,
+    ProcessSpec,
+    RemoveHandler,
+    RequestShutdown,
+    Spawn,
+    StartTimer,
+)
+
+LONG_VALUE = 160
+
+HANDLER_WORDS = {
+    "process_start": "when {target} starts",
+    "process_exit": "when {target} exits",
+    "process_io": "on output of {target}",
+    "shutdown": "at shutdown",
+    "state_transition": "on a lifecycle transition of {target}",
+}
+
+
+def describe_plan(plan: Plan, path: str) -> str:
+    processes = plan.processes()
+    out = [f"Plan for {_rel(path)}: {len(processes)} process(es) at start", ""]
+    for warning in plan.warnings:
+        out.append(f"warning: {warning}")
+    if plan.warnings:
+        out.append("")
+    for step in plan.steps:
+        if isinstance(step, Spawn) and step.spec is not None:
+            out.extend(describe_process(step.spec, plan.temp_dir))
+        elif isinstance(step, Log):
+            out.append(f"log [{step.level}] {step.message}")
+        elif isinstance(step, StartTimer) and step.body is not None:
+            out.append(
+                f"timer after {step.period:g} s: {step.body.describe()}   ({_rel(step.origin)})"
+            )
+        elif isinstance(step, AddHandler) and step.body is not None:
+            target = "any process" if step.matcher is None else "its target"
+            target_action = getattr(step.handler, "target_action", None)
+            if target_action is not None and hasattr(target_action, "describe_short"):
+                target = target_action.describe_short()
+            when = HANDLER_WORDS.get(step.kind, step.kind).format(target=target)
+            what = (
+                step.body.describe() if (step.body.entities or step.body.callback) else "callbacks"
+            )
+            out.append(f"handler {when}: {what}   ({_rel(step.origin)})")
+        elif isinstance(step, RemoveHandler):
+            out.append("remove a handler")
+        elif isinstance(step, RequestShutdown):
+            out.append(f"shutdown: {step.reason}")
+        elif isinstance(step, EmitEvent):
+            out.append(f"emit {type(step.event).__name__}")
+        elif hasattr(step, "describe_lines"):
+            # Steps of extensions (composable node loads) describe themselves.
+            out.extend(step.describe_lines())
+            out.append("")
+        out.append("") if isinstance(step, Spawn) else None
+    return "\n".join(out).rstrip() + "\n"
+
+
+def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+    head = spec.label
+    if spec.standin:
+        head += f"   (stand-in for {spec.standin})"
+    lines = [head + (f"   {_rel(spec.origin)}" if spec.origin else "")]
+    argv = " ".join(spec.argv) if spec.shell else shlex.join(spec.argv)
+    lines.append(
+        f"  argv:    {_shorten(argv, 400)}" + ("   [via /bin/sh -c]" if spec.shell else "")
+    )
+    if spec.node is not None and spec.node.fully_qualified_name:
+        kind = "lifecycle node" if spec.node.lifecycle else "node"
+        auto = " (autostart)" if spec.node.autostart else ""
+        lines.append(f"  {kind}:    {spec.node.fully_qualified_name}{auto}")
+    if spec.machine is not None:
+        lines.append(f"  machine: {spec.machine.describe()}")
+    lines.append(f"  cwd:     {spec.cwd or '(inherited)'}")
+    if spec.env_changes:
+        changes = [
+            f"{k}={_shorten(v, 60)}" if v is not None else f"-{k}"
+            for k, v in sorted(spec.env_changes.items())
+        ]
+        lines.append(f"  env:     {' '.join(changes)}")
+    lines.append(f"  output:  {spec.output}")
+    lines.append(f"  respawn: {spec.respawn.describe()}")
+    stop = (
+        f"SIGINT, SIGTERM after {spec.sigterm_timeout:g} s,"
+        f" SIGKILL after {spec.sigkill_timeout:g} s more"
+    )
+    lines.append(f"  stop:    {stop}")
+    if spec.required:
+        lines.append("  exit:    required: its exit shuts the launch down")
+    elif spec.on_exit is not None:
+        lines.append(f"  on exit: {spec.on_exit.describe()}")
+    lines.extend(_params_files(spec, temp_dir))
+    return lines
+
+
+def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+    """The parameters in the params files mlaunch wrote for this process, one per line."""
+    out = []
+    for i, arg in enumerate(spec.argv[:-1]):
+        if arg != "--params-file":
+            continue
+        path = spec.argv[i + 1]
+        if not temp_dir or not path.startswith(temp_dir):
+            continue
+        try:
+            import yaml
+
+            with open(path, encoding="utf-8") as f:
+                data = yaml.safe_load(f)
+        except (OSError, ValueError):
+            continue
+        for node, section in (data or {}).items():
+            params = (section or {}).get("ros__parameters", {})
+            for name, value in _flatten(params):
+                out.append(f"  param:   {name} = {_value_text(value)}   [{node}]")
+    return out
+
+
+def _flatten(params: dict[str, object], prefix: str = "") -> list[tuple[str, object]]:
+    items: list[tuple[str, object]] = []
+    for key, value in params.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            items.extend(_flatten(value, name + "."))
+        else:
+            items.append((name, value))
+    return items
+
+
+def _value_text(value: object) -> str:
+    if isinstance(value, str):
+        if len(value) > 80 or "\n" in value:
+            first = value.strip().splitlines()[0] if value.strip() else ""
+            return f"<string, {len(value)} chars: {_shorten(first, 50)}>"
+        return repr(value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return repr(value)
+
+
+def _shorten(text: str, limit: int) -> str:
+    text = text.replace("\n", "\\n")
+    if len(text) <= limit:
+        return text
+    return f"{text[: limit - 20]}... <{len(text)} chars>"
+
+
+def _rel(path: str) -> str:
+    if not path:
+        return ""
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:
+        return path
+    return rel if not rel.startswith("../../") else path
+
+
+def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
+    """The --show-args table: name, default, description (and choices), conditional marked."""
+    if not infos:
+        return "No arguments.\n"
+    import textwrap
+
+    rows = []
+    any_conditional = False
+    for info in infos:
+        name = info.name + ("*" if info.conditional else "")
+        any_conditional |= info.conditional
+        default = "(required)" if info.default is None else repr(info.default)
+        rows.append((name, default, info.description))
+    w_name = max(len("name"), *(len(r[0]) for r in rows))
+    w_def = min(36, max(len("default"), *(len(r[1]) for r in rows)))
+    width = max(40, _terminal_width() - w_name - w_def - 6)
+    out = ["Arguments (pass arguments as '<name>:=<value>'):", ""]
+    out.append(f"  {'name':<{w_name}}  {'default':<{w_def}}  description")
+    out.append(f"  {'-' * w_name}  {'-' * w_def}  {'-' * min(width, 40)}")
+    for name, default, description in rows:
+        lines = textwrap.wrap(description, width) or [""]
+        # A long default wraps in its column rather than being cut: it is often a path to copy.
+        defaults = [default[i : i + w_def] for i in range(0, len(default), w_def)]
+        for i in range(max(len(lines), len(defaults))):
+            left = name if i == 0 else ""
+            shown = defaults[i] if i < len(defaults) else ""
+            text = lines[i] if i < len(lines) else ""
+            out.append(f"  {left:<{w_name}}  {shown:<{w_def}}  {text}".rstrip())
+    if any_conditional:
+        out += ["", "* argument(s) which are only used if specific conditions occur"]
+    return "\n".join(out) + "\n"
+
+
+def _terminal_width() -> int:
+    try:
+        return os.get_terminal_size(1).columns or 100  # 0 from some pseudo-terminals
+    except OSError:
+        return 100

@@ -1,0 +1,458 @@
+"""Resolve: a launch description + arguments + environment -> a Plan. Nothing is spawned here.
+
+The resolver visits the description depth first, evaluating conditions and substitutions
+against a LaunchContext. Deferred parts (timers, handlers, on_exit) are captured with their
+context and resolved later by ``resolve_deferred``, with the same code.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+
+from mlaunch.frontends.limits import DEPTH_LIMIT, IncludeChain, allow_deep_trees, too_deep
+from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
+from mlaunch.plan.errors import (
+    LaunchFileError,
+    MlaunchError,
+    PackageNotFoundError,
+    SubstitutionFailure,
+)
+from mlaunch.plan.origin import user_location
+from mlaunch.plan.record import Record
+from mlaunch.plan.steps import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step, step_needs
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable, Mapping
+    from typing import Any
+
+    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+    from mlaunch.ros.search import PackageSearch, searching
+
+
+class LabelCounter:
+    """ROS 2's global ``name-N`` counter, shared by everything resolved in one run."""
+
+    def __init__(self) -> None:
+        self._next = itertools.count(1)
+
+    def next(self, base: str) -> str:
+        return f"{base}-{next(self._next)}"
+
+
+class ResolveOptions(Record):
+    """What the caller decides about resolution, besides the description and its arguments.
+
+    ``packages`` is where ROS packages are looked for (a mlaunch.ros.search.PackageSearch,
+    None for the default search); ``temp_dir`` is where params files are written.
+    """
+
+    _fields = ("standins", "packages", "temp_dir", "capture", "scoped_parameters")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        standins: bool = True,
+        packages: PackageSearch | None = None,
+        temp_dir: str | None = None,
+        capture: bool = False,
+        scoped_parameters: bool = False,
+    ) -> None:
+        self.standins = standins
+        self.packages = packages
+        self.temp_dir = temp_dir
+        # Timers and handlers take the values where they were written (mlaunch.resolve.binding).
+        self.capture = capture
+        # SetParameter(s)FromFile stay inside scoped groups (mlaunch.launch_ros.actions).
+        self.scoped_parameters = scoped_parameters
+
+
+class Resolver:
+    """Visits entities against one context, appending steps to one plan."""
+
+    def __init__(
+        self,
+        context: LaunchContext,
+        plan: Plan,
+        *,
+        labels: LabelCounter,
+        options: ResolveOptions,
+    ) -> None:
+        self.context = context
+        self.plan = plan
+        self.labels = labels
+        self.options = options
+        self.includes = IncludeChain()  # include cycles are errors, not a RecursionError
+        self.depth = 0
+        allow_deep_trees()
+
+    # --- visiting -----------------------------------------------------------------------------
+
+    def visit(self, entity: Any) -> None:
+        if self.depth >= DEPTH_LIMIT:
+            origin = getattr(entity, "origin", None)
+            raise too_deep(origin, "launch actions (groups, includes)", includes=self.includes)
+        self.depth += 1
+        try:
+            self._visit(entity)
+        finally:
+            self.depth -= 1
+
+    def _visit(self, entity: Any) -> None:
+        visit = getattr(entity, "visit", None)
+        if visit is None:
+            raise LaunchFileError(
+                f"{type(entity).__name__} ({entity!r:.60}) is not a launch action"
+                " (expected actions such as Node, ExecuteProcess, DeclareLaunchArgument)"
+            )
+        try:
+            more = visit(self)
+        except MlaunchError as e:
+            origin = getattr(entity, "origin", None)
+            if e.where is None and origin:
+                e.where = origin
+            if e.what is None and not isinstance(e, LaunchFileError):
+                e.what = _short(entity)
+            self._name_declaration(e)
+            raise
+        if more:
+            self.visit_all(more)
+
+    def _name_declaration(self, error: MlaunchError) -> None:
+        """Add where the launch argument a bad value came from is declared (once)."""
+        info = self.plan.arguments.get(error.argument or "")
+        if info is None or not info.origin:
+            return
+        error.message += f" (launch argument {error.argument!r}, declared at {info.origin})"
+        error.args = (error.message,)
+        error.argument = None
+
+    def visit_all(self, entities: Iterable[Any]) -> None:
+        for entity in entities:
+            self.visit(entity)
+
+    def call_user(self, function: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        """Call launch-file code (OpaqueFunction), locating any exception in the user's file."""
+        try:
+            return function(*args, **kwargs)
+        except MlaunchError:
+            raise
+        except SystemExit as e:  # sys.exit() in launch-file code must not end mlaunch silently
+            from mlaunch.frontends.python import exit_error
+
+            path = self.context.current_launch_file_path or ""
+            raise exit_error(e, path, "in a function of the launch file") from e
+        except Exception as e:
+            where = user_location(e.__traceback__, self.context.current_launch_file_path)
+            raise MlaunchError(f"{type(e).__name__}: {e}", where=where) from e
+
+    # --- what actions use ---------------------------------------------------------------------
+
+    def add(self, step: Step) -> None:
+        self.plan.steps.append(step)
+        needs = step_needs(step)
+        if needs:
+            self.plan.needs.update(needs)
+
+    def spawn(self, spec: ProcessSpec) -> None:
+        self.add(Spawn(origin=spec.origin, spec=spec))
+
+    def warn(self, message: str) -> None:
+        self.plan.warnings.append(message)
+
+    def new_label(self, base: str) -> str:
+        return self.labels.next(base)
+
+    def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
+        from mlaunch.resolve.binding import file_captures
+
+        entities = list(entities)
+        # Resolved only when they fire: what they may need must be known before the run.
+        _note_needs(entities, self.plan.needs)
+        snapshot = self.context.snapshot()
+        if self.options.capture or (origin and file_captures(origin)):
+            return Deferred(entities, snapshot, origin, callback)
+        return Deferred(entities, self.context, origin, callback, captured=snapshot)
+
+    def float_value(self, value: Any, what: str, origin: str) -> float:
+        text = value if isinstance(value, (int, float)) else perform(self.context, value)
+        try:
+            number = float(text)
+        except (TypeError, ValueError):
+            raise MlaunchError(f"{what} is {text!r}, expected a number", where=origin)
+        if number != number or number in (float("inf"), float("-inf")):
+            raise MlaunchError(f"{what} is {text!r}, expected a finite number", where=origin)
+        return number
+
+    def load_source(self, source: Any, context: LaunchContext, origin: str) -> Any:
+        """The LaunchDescription an include names (built directly, or loaded from its file)."""
+        if source.launch_description is not None:
+            return source.launch_description
+        from mlaunch import frontends
+
+        path = source.get_launch_file_location(context)
+        if not os.path.exists(path):
+            raise LaunchFileError(f"included launch file {path!r} does not exist", where=origin)
+        return frontends.load(path, source.format_hint)
+
+    def locate_program(
+        self, argv: list[str], *, shell: bool, origin: str
+    ) -> tuple[list[str], str | None]:
+        """argv with a stand-in in place of a program that is not installed.
+
+        Returns the argv and the name of what a stand-in replaces (None when the real program
+        runs). A program that is neither installed nor covered by a stand-in is an error here,
+        before anything starts, naming the program.
+        """
+        if shell:
+            return argv, None
+        program = argv[0]
+        env = self.context.environment
+        if os.sep in program:
+            if os.access(program, os.X_OK) and not os.path.isdir(program):
+                return argv, None
+        else:
+            from mlaunch.launch.execute_process import which
+
+            if which(program, env) is not None:
+                return argv, None
+        from mlaunch import standins
+
+        if self.options.standins:
+            replaced = standins.standin_for(argv)
+            if replaced is not None:
+                return replaced, os.path.basename(program)
+        hint = standins.hint_for(argv) if not self.options.standins else ""
+        if os.sep in program:
+            problem = "does not exist" if not os.path.exists(program) else "is not executable"
+            raise PackageNotFoundError(f"program {program!r} {problem}{hint}", where=origin)
+        raise PackageNotFoundError(f"program {program!r} not found on the PATH{hint}", where=origin)
+
+
+def _note_needs(entities: Iterable[Any], needs: set[str]) -> None:
+    """Add what ``entities`` (a timer's or handler's, not yet resolved) and theirs may need.
+
+    An entity says so with a ``needs`` attribute (LifecycleNode, LifecycleSequence), or its
+    event or event handler does (ChangeState, OnStateTransition). A handler written as a
+    function is opaque until it runs; the pipeline watches for what it starts instead.
+    """
+    stack = list(entities)
+    seen: set[int] = set()
+    while stack:
+        entity = stack.pop()
+        if id(entity) in seen:
+            continue  # a handler may list itself among what it registers
+        seen.add(id(entity))
+        handler = getattr(entity, "event_handler", None)
+        for owner in (entity, getattr(entity, "event", None), handler):
+            found = getattr(owner, "needs", None)
+            if found:
+                needs.update(found)
+        get = getattr(entity, "get_sub_entities", None)
+        if get is not None:
+            stack.extend(get())
+        stack.extend(getattr(entity, "entities", None) or ())
+        if handler is not None:
+            stack.extend(getattr(handler, "entities", None) or ())
+
+
+def _short(entity: Any) -> str:
+    describe = getattr(entity, "describe_short", None)
+    return describe() if describe else type(entity).__name__
+
+
+# --- entry points ------------------------------------------------------------------------------
+
+
+def resolve(
+    description: LaunchDescriptionEntity,
+    *,
+    path: str | None,
+    arguments: Mapping[str, str],
+    environ: Mapping[str, str],
+    log_dir: str = "",
+    options: ResolveOptions | None = None,
+    labels: LabelCounter | None = None,
+) -> Plan:
+    """Resolve a whole launch description, as the top-level include of the command line."""
+    options = options or ResolveOptions()
+    plan = Plan(temp_dir=options.temp_dir)
+    context = LaunchContext(
+        environment=environ,
+        argv=tuple(f"{k}:={v}" for k, v in arguments.items()),
+        log_dir=log_dir,
+        warn=plan.warnings.append,
+    )
+    context.launch_configurations.update(arguments)
+    resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
+    with _package_search(options, context):
+        if path is None:
+            resolver.visit(description)
+        else:
+            with context.file_locals(path):
+                resolver.visit(description)
+    plan.warnings.extend(undeclared_argument_warnings(arguments, plan.arguments))
+    return plan
+
+
+def resolve_deferred(
+    deferred: Deferred,
+    *,
+    labels: LabelCounter,
+    options: ResolveOptions,
+    event: Any = None,
+) -> Plan:
+    """Resolve a timer's or handler's entities now, in the context captured when registered."""
+    plan = Plan(temp_dir=options.temp_dir)
+    if deferred.captured is None:
+        context = deferred.context.snapshot()
+    else:
+        # launch's rule: the live state, which the body's own actions change for later ones.
+        context = deferred.context
+        from mlaunch.resolve.binding import differences, warn_once
+
+        diffs = differences(deferred.captured, context, deferred.entities, deferred.callback)
+        message = warn_once(deferred.captured, deferred.origin, diffs)
+        if message:
+            plan.warnings.append(message)
+    saved = context._locals, context._warn  # the live context's locals are the event's only now
+    context._locals, context._warn = dict(saved[0]), plan.warnings.append
+    if event is not None:
+        context.extend_locals({"event": event})
+    resolver = Resolver(context, plan, labels=labels, options=options)
+    try:
+        with _package_search(options, context):
+            entities = deferred.entities
+            if deferred.callback is not None:
+                from mlaunch.launch.event_handlers import returned_entities
+
+                entities = returned_entities(resolver.call_user(deferred.callback, event, context))
+            resolver.visit_all(entities)
+    finally:
+        context._locals, context._warn = saved
+    return plan
+
+
+class _NoSearch:
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc_info: object) -> None:
+        return None
+
+
+def _package_search(options: ResolveOptions, context: LaunchContext) -> _NoSearch | searching:
+    """The run's package search: in the context for Node and the ROS substitutions, and active
+    for ament_index_python calls of the launch-file code that resolving runs (included files
+    being loaded, OpaqueFunctions)."""
+    if options.packages is None:
+        return _NoSearch()
+    from mlaunch.ros.search import CONTEXT_KEY, searching
+
+    context.extend_globals({CONTEXT_KEY: options.packages})
+    return searching(options.packages)
+
+
+# Launch configurations that launch itself reads (ExecuteProcess's prefix, set by
+# --launch-prefix/--launch-prefix-filter or as name:=value): given undeclared on purpose.
+BUILTIN_CONFIGURATIONS = frozenset({"launch-prefix", "launch-prefix-filter"})
+
+
+def undeclared_argument_warnings(
+    given: Mapping[str, str], declared: Mapping[str, ArgumentInfo]
+) -> list[str]:
+    undeclared = [
+        name for name in given if name not in declared and name not in BUILTIN_CONFIGURATIONS
+    ]
+    if not undeclared:  # the common case imports nothing more (start-up budget)
+        return []
+    from mlaunch.frontends.suggest import Suggester
+
+    suggest = Suggester(declared)
+    return [
+        f"argument {name!r} is not declared by the launch file{suggest.hint(name)}"
+        for name in undeclared
+    ]
+
+
+# --- --show-args: a static walk ------------------------------------------------------------------
+
+
+def collect_arguments(
+    description: LaunchDescriptionEntity,
+    *,
+    path: str | None,
+    arguments: Mapping[str, str],
+    environ: Mapping[str, str],
+) -> list[ArgumentInfo]:
+    """Every DeclareLaunchArgument, following includes whose path can be resolved statically.
+
+    Conditional declarations (under a condition, in a timer or handler) are marked; nothing is
+    spawned and no command substitution beyond what an include path needs is run.
+    """
+    from mlaunch.launch.actions import (
+        DeclareLaunchArgument,
+        GroupAction,
+        IncludeLaunchDescription,
+        LaunchDescription,
+        TimerAction,
+    )
+
+    found: dict[str, ArgumentInfo] = {}
+    context = LaunchContext(environment=environ)
+    context.launch_configurations.update(arguments)
+    seen: set[str] = set()
+
+    def walk(entities: Iterable[Any], conditional: bool) -> None:
+        for entity in entities:
+            cond = conditional or getattr(entity, "condition", None) is not None
+            if isinstance(entity, DeclareLaunchArgument):
+                info = entity.argument_info(cond)
+                found.setdefault(info.name, info)
+                if info.name not in context.launch_configurations and entity.default_value:
+                    try:
+                        context.launch_configurations[info.name] = perform_substitutions(
+                            context, entity.default_value
+                        )
+                    except MlaunchError:
+                        pass
+            elif isinstance(entity, LaunchDescription):
+                walk(entity.entities, cond)
+            elif isinstance(entity, (GroupAction, TimerAction)):
+                walk(entity.actions, cond or isinstance(entity, TimerAction))
+            elif isinstance(entity, IncludeLaunchDescription):
+                include(entity, cond)
+
+    def include(entity: Any, conditional: bool) -> None:
+        source = entity.launch_description_source
+        if source.launch_description is not None:
+            walk([source.launch_description], conditional)
+            return
+        try:
+            location = source.get_launch_file_location(context)
+        except (MlaunchError, SubstitutionFailure):
+            return
+        if location in seen or not os.path.exists(location):
+            return
+        seen.add(location)
+        from mlaunch import frontends
+
+        with context.file_locals(location):
+            walk([frontends.load(location, source.format_hint)], conditional)
+
+    if path is None:
+        walk([description], False)
+    else:
+        with context.file_locals(path):
+            walk([description], False)
+    return list(found.values())
+
+
+def substitution_text(value: Any) -> str:
+    """Literal text of a value made only of TextSubstitutions, else its description."""
+    subs = normalize(value)
+    if all(type(s).__name__ == "TextSubstitution" for s in subs):
+        return "".join(s.text for s in subs)  # type: ignore[attr-defined]
+    return " + ".join(s.describe() for s in subs if isinstance(s, Substitution))
