@@ -139,17 +139,18 @@ def test_bad_requests_are_clear_errors(tmp_path: Path) -> None:
         ("back\\slash", '"back\\\\slash"'),
         ("", '""'),
         ("two\nlines", '"two\\nlines"'),
+        ("cr\rhere", '"cr\\rhere"'),
+        ("bell\x07", '"bell\\x07"'),
+        (";", '";"'),
     ],
 )
 def test_exec_words_are_quoted_for_systemd(word: str, quoted: str) -> None:
     assert quote_exec(word) == quoted
 
 
-def test_the_environment_file_leaves_the_login_session_out() -> None:
-    text = environment_file(
-        {"PATH": "/usr/bin", "TERM": "xterm", "SSH_AUTH_SOCK": "/x", "ROS_DOMAIN_ID": "7"}
-    )
-    assert text == 'PATH="/usr/bin"\nROS_DOMAIN_ID="7"\n'
+def test_the_environment_file_holds_what_was_asked_escaped() -> None:
+    text = environment_file({"PATH": "/usr/bin", "ODD": 'a "b" $HOME `x` \\'})
+    assert text.splitlines()[1:] == ['ODD="a \\"b\\" \\$HOME \\`x\\` \\\\"', 'PATH="/usr/bin"']
 
 
 def test_what_systemd_cannot_do_is_a_warning(tmp_path: Path) -> None:

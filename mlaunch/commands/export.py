@@ -21,7 +21,10 @@ if TYPE_CHECKING:
     from mlaunch.plan.steps import Deferred, Plan
 
 FORMATS = ("systemd",)
-USAGE = "mlaunch export FILE [name:=value ...] --to systemd DIR [--name NAME] [--user USER]"
+USAGE = (
+    "mlaunch export FILE [name:=value ...] --to systemd DIR [--name NAME] [--user USER]"
+    " [--env NAME[=VALUE]]..."
+)
 
 
 def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
@@ -44,6 +47,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--install-dir",
         help="where DIR will be on the robot (the units name their files there; default: DIR)",
+    )
+    parser.add_argument(
+        "--env",
+        action="append",
+        default=[],
+        metavar="NAME[=VALUE]",
+        help="put NAME (a shell pattern such as 'ROS_*' picks several) from this environment, or"
+        " NAME=VALUE, into NAME.env for every unit; nothing else of this environment is exported",
     )
     parser.add_argument("--force", action="store_true", help="write into a non-empty DIR")
     return parser
@@ -126,26 +137,36 @@ def write_units(
 ) -> None:
     from mlaunch.export import systemd
 
-    os.makedirs(out_dir, exist_ok=True)
     install_dir = os.path.abspath(settings.install_dir or out_dir)
-    systemd.install_params(units, out_dir, install_dir)
+    copies = systemd.install_params(units, install_dir)
     env_file = os.path.join(install_dir, f"{prefix}.env")
-    # The environment the launch was resolved in; what it changed is in each unit.
-    _write(os.path.join(out_dir, f"{prefix}.env"), systemd.environment_file(os.environ))
-    cwd = os.getcwd()
-    for unit in units:
-        text = systemd.service_text(
-            unit,
-            target=f"{prefix}.target",
-            env_file=env_file,
-            cwd=cwd,
-            user=settings.user,
+    # Only what --env names: the caller's environment holds tokens and keys and paths of the
+    # machine that exported; what the launch changed is in each unit's Environment=.
+    chosen = systemd.chosen_environment(settings.env, os.environ)
+    if not chosen and any(unit.spec.node is not None for unit in units):
+        export.warnings.append(
+            f"{prefix}.env is empty: the nodes get systemd's environment, not this one; add what"
+            " they need with --env (e.g. --env AMENT_PREFIX_PATH --env LD_LIBRARY_PATH"
+            " --env PYTHONPATH --env 'ROS_*')"
         )
-        _write(os.path.join(out_dir, unit.name), text)
-    _write(
-        os.path.join(out_dir, f"{prefix}.target"),
-        systemd.target_text(units, os.path.basename(source)),
-    )
+    cwd = os.getcwd()
+    texts = {
+        unit.name: systemd.service_text(
+            unit, target=f"{prefix}.target", env_file=env_file, cwd=cwd, user=settings.user
+        )
+        for unit in units
+    }  # every unit is checked before any file is written
+    target = systemd.target_text(units, os.path.basename(source))
+    environment = systemd.environment_file(chosen).encode()
+    os.makedirs(out_dir, exist_ok=True)
+    systemd.write_private(os.path.join(out_dir, f"{prefix}.env"), environment)
+    for source_file, name in copies:
+        os.makedirs(os.path.join(out_dir, "params"), mode=0o700, exist_ok=True)
+        with open(source_file, "rb") as f:
+            systemd.write_private(os.path.join(out_dir, "params", name), f.read())
+    for name, text in texts.items():
+        _write(os.path.join(out_dir, name), text)
+    _write(os.path.join(out_dir, f"{prefix}.target"), target)
     _write(
         os.path.join(out_dir, "README.md"),
         systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings),

@@ -21,6 +21,7 @@ is a warning in the README and on stderr, never silently dropped.
 
 from __future__ import annotations
 
+import fnmatch
 import os
 import re
 import shlex
@@ -33,15 +34,6 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
 
-# Variables of a login session that mean nothing to a service.
-SESSION_VARIABLES = frozenset(
-    {"TERM", "SHELL", "PWD", "OLDPWD", "SHLVL", "_", "LS_COLORS", "MAIL", "DISPLAY", "COLORTERM",
-     "WAYLAND_DISPLAY", "DBUS_SESSION_BUS_ADDRESS", "TMUX", "TMUX_PANE", "STY", "WINDOW",
-     "SSH_AUTH_SOCK", "SSH_AGENT_PID", "SSH_CLIENT", "SSH_CONNECTION", "SSH_TTY", "TERM_PROGRAM",
-     "TERM_PROGRAM_VERSION", "VTE_VERSION", "HISTFILE", "PS1", "PROMPT_COMMAND", "EDITOR",
-     "OVERRIDE_LAUNCH_PROCESS_OUTPUT"}
-)  # fmt: skip
-SESSION_PREFIXES = ("XDG_", "SSH_", "GPG_", "MLAUNCH_", "PYTEST_", "KONSOLE_", "GNOME_", "VSCODE_")
 UNIT_CHARS = re.compile(r"[^A-Za-z0-9:_.\-]")
 
 
@@ -107,6 +99,11 @@ class Export:
                 " under systemd (mlaunch does that when it runs the launch)"
             )
         unit = Unit(spec, unit_name(f"{self.prefix}-{spec.label}") + ".service")
+        if len(unit.name) > 255:
+            raise UnsafeValue(
+                f"unit name {unit.name[:40]!r}... is {len(unit.name)} characters long;"
+                " systemd takes at most 255 (a shorter --name or process name)"
+            )
         unit.after, unit.requires, unit.delay = list(after), list(requires), delay
         self.units.append(unit)
 
@@ -142,32 +139,105 @@ def unit_name(text: str) -> str:
     return UNIT_CHARS.sub("_", text)
 
 
+# Characters no unit-file line can hold as they are: a newline or carriage return ends the
+# setting (and starts a directive of the writer's choosing), NUL ends the file's text.
+UNSAFE = re.compile(r"[\x00-\x08\x0a-\x1f\x7f]")
+C_ESCAPES = {"\\": "\\\\", '"': '\\"', "\n": "\\n", "\t": "\\t", "\r": "\\r"}
+
+
+class UnsafeValue(MlaunchError):
+    """A value that systemd would read differently from what the launch says: not exported."""
+
+
+def why_unsafe(value: str) -> str | None:
+    """What makes ``value`` impossible to write as the whole right side of a setting, or None."""
+    bad = UNSAFE.search(value)
+    if bad is not None:
+        names = {"\n": "a newline", "\r": "a carriage return", "\x00": "a NUL byte"}
+        return f"it holds {names.get(bad.group(), f'the control character {bad.group()!r}')}"
+    if value.endswith("\\"):
+        return "it ends with a backslash (systemd would join the next line to it)"
+    if value != value.strip():
+        return "it starts or ends with white space (systemd strips it)"
+    return None
+
+
+def setting(what: str, value: str) -> str:
+    """``value`` as a plain setting (Description=, WorkingDirectory=, ...): specifiers escaped."""
+    why = why_unsafe(value)
+    if why is not None:
+        raise UnsafeValue(f"{what} {value!r} cannot be written in a systemd unit: {why}")
+    return value.replace("%", "%%")
+
+
+def c_escape(text: str) -> str:
+    """``text`` inside systemd's double quotes: backslash, quote and control characters escaped."""
+    out = []
+    for ch in text:
+        if ch in C_ESCAPES:
+            out.append(C_ESCAPES[ch])
+        elif UNSAFE.match(ch):
+            out.append(f"\\x{ord(ch):02x}")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
 def quote_exec(word: str) -> str:
     """One ExecStart argument: specifiers and variables escaped, quoted when needed."""
     word = word.replace("%", "%%").replace("$", "$$")
-    if word and not re.search(r"[\s\"'\\;]", word):
+    if word and not re.search(r"[\s\"'\\;\x00-\x1f\x7f]", word):
         return word
-    escaped = word.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
-    return f'"{escaped.replace(chr(9), chr(92) + "t")}"'
+    return f'"{c_escape(word)}"'
 
 
 def quote_assignment(name: str, value: str) -> str:
     """One ``Environment=`` item, ``"NAME=value"`` with systemd's escapes."""
-    text = f"{name}={value}".replace("%", "%%")
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    check_variable(name, value)
+    return '"' + c_escape(f"{name}={value}".replace("%", "%%")) + '"'
+
+
+def check_variable(name: str, value: str) -> None:
+    """Refuse a variable that an environment file or ``Environment=`` cannot hold as it is."""
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        raise UnsafeValue(
+            f"environment variable name {name!r} cannot be written in a systemd unit:"
+            " a name is letters, digits and '_', not starting with a digit"
+        )
+    bad = UNSAFE.search(value)
+    if bad is not None:
+        raise UnsafeValue(
+            f"environment variable {name}={value!r} cannot be written in a systemd unit:"
+            f" it holds the control character {bad.group()!r}"
+        )
 
 
 def environment_file(env: Mapping[str, str]) -> str:
-    """The shared EnvironmentFile: the resolved environment without the session's variables."""
-    lines = []
+    """An EnvironmentFile of exactly ``env`` (what the export was asked to carry)."""
+    lines = ["# written by mlaunch export: what the launch and --env put in every unit"]
     for name in sorted(env):
-        if name in SESSION_VARIABLES or name.startswith(SESSION_PREFIXES):
-            continue
-        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
-            continue
-        value = env[name].replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+        check_variable(name, env[name])
+        value = re.sub(r'([\\"$`])', r"\\\1", env[name])
         lines.append(f'{name}="{value}"')
     return "\n".join(lines) + "\n"
+
+
+def chosen_environment(patterns: list[str], environ: Mapping[str, str]) -> dict[str, str]:
+    """The variables ``--env`` asks for: ``NAME=VALUE`` as given, ``NAME`` or a pattern from
+    ``environ``; a NAME that is not set is an error (a unit would silently miss it)."""
+    chosen: dict[str, str] = {}
+    for pattern in patterns:
+        name, eq, value = pattern.partition("=")
+        if eq:
+            chosen[name] = value
+            continue
+        found = {k: v for k, v in environ.items() if fnmatch.fnmatchcase(k, name)}
+        if not found:
+            raise UnsafeValue(f"--env {pattern!r}: no such variable in the environment")
+        chosen.update(found)
+    for name, value in chosen.items():
+        check_variable(name, value)
+    return chosen
 
 
 def exec_start(spec: ProcessSpec, path: str) -> list[str]:
@@ -186,12 +256,13 @@ def exec_start(spec: ProcessSpec, path: str) -> list[str]:
 
 
 def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str | None) -> str:
+    """The ``.service`` file of one process; a value systemd would misread is an UnsafeValue."""
     spec = unit.spec
     argv = exec_start(spec, spec.env.get("PATH", os.defpath))
+    source = os.path.basename(spec.origin.split(":")[0]) or "launch"
     lines = [
         "[Unit]",
-        f"Description={spec.label} of {os.path.basename(spec.origin.split(':')[0]) or 'launch'}"
-        " (mlaunch export)",
+        "Description=" + setting("process name", f"{spec.label} of {source} (mlaunch export)"),
         f"PartOf={target}",
     ]
     if unit.after:
@@ -201,21 +272,20 @@ def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str 
     if spec.respawn.mode != "never":
         lines.append("StartLimitIntervalSec=0")
     lines += ["", "[Service]"]
-    if unit.oneshot:
-        lines += ["Type=oneshot", "RemainAfterExit=yes"]
-    else:
-        lines.append("Type=exec")
+    lines += ["Type=oneshot", "RemainAfterExit=yes"] if unit.oneshot else ["Type=exec"]
     if user:
-        lines.append(f"User={user}")
+        lines.append("User=" + user_setting(user))
     if unit.delay > 0:
         lines.append(f"ExecStartPre=/bin/sleep {unit.delay:g}")
     lines.append("ExecStart=" + " ".join(quote_exec(w) for w in argv))
-    lines.append(f"WorkingDirectory={spec.cwd or cwd}")
-    lines.append(f"EnvironmentFile={env_file}")
+    lines.append("WorkingDirectory=" + setting("working directory", spec.cwd or cwd))
+    lines.append("EnvironmentFile=" + setting("environment file path", env_file))
     changed = {k: v for k, v in sorted(spec.env_changes.items()) if v is not None}
     if changed:
         lines.append("Environment=" + " ".join(quote_assignment(k, v) for k, v in changed.items()))
     unset = sorted(k for k, v in spec.env_changes.items() if v is None)
+    for name in unset:
+        check_variable(name, "")
     if unset:
         lines.append("UnsetEnvironment=" + " ".join(unset))
     lines += restart_lines(spec)
@@ -223,9 +293,19 @@ def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str 
         "KillMode=control-group",
         "KillSignal=SIGINT",
         f"TimeoutStopSec={spec.sigterm_timeout + spec.sigkill_timeout:g}",
-        f"SyslogIdentifier={spec.label}",
+        "SyslogIdentifier=" + setting("process name", spec.label),
     ]
     return "\n".join(lines) + "\n"
+
+
+def user_setting(user: str) -> str:
+    """``User=``'s value: a user name or a numeric id, as systemd accepts them, else refused."""
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.-]{0,30}\$?|[0-9]{1,10}", user):
+        raise UnsafeValue(
+            f"--user {user!r} is not a user name systemd accepts (letters, digits, '_', '-', '.',"
+            " not starting with a digit or '-', at most 31 characters) nor a numeric id"
+        )
+    return user
 
 
 def restart_lines(spec: ProcessSpec) -> list[str]:
@@ -237,7 +317,10 @@ def restart_lines(spec: ProcessSpec) -> list[str]:
 
 
 def target_text(units: list[Unit], description: str) -> str:
-    lines = ["[Unit]", f"Description={description} (mlaunch export)"]
+    lines = [
+        "[Unit]",
+        "Description=" + setting("launch file name", f"{description} (mlaunch export)"),
+    ]
     if units:
         lines.append("Wants=" + " ".join(u.name for u in units))
     required = [u.name for u in units if u.spec.required]
@@ -247,9 +330,12 @@ def target_text(units: list[Unit], description: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def install_params(units: list[Unit], out_dir: str, install_dir: str) -> None:
-    """Copy each process's params files next to the units and point its argv at the copies."""
-    params = os.path.join(out_dir, "params")
+def install_params(units: list[Unit], install_dir: str) -> list[tuple[str, str]]:
+    """Point each process's argv at its params files' copies next to the units.
+
+    Returns the copies to make, (source, name under ``params/``), once every unit is known to
+    be writable."""
+    copies: list[tuple[str, str]] = []
     for unit in units:
         spec = unit.spec
         argv = list(spec.argv)
@@ -257,12 +343,20 @@ def install_params(units: list[Unit], out_dir: str, install_dir: str) -> None:
         for i in range(1, len(argv)):
             if argv[i - 1] != "--params-file" or not os.path.isfile(argv[i]):
                 continue
-            os.makedirs(params, exist_ok=True)
             name = f"{unit.name.removesuffix('.service')}-{count}.yaml"
-            shutil.copyfile(argv[i], os.path.join(params, name))
+            copies.append((argv[i], name))
             argv[i] = os.path.join(install_dir, "params", name)
             count += 1
         spec.argv = tuple(argv)
+    return copies
+
+
+def write_private(path: str, data: bytes) -> None:
+    """Write a file only its owner may read (parameters and environments can hold secrets)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o600)
+    with open(fd, "wb") as f:
+        os.fchmod(f.fileno(), 0o600)  # an older file kept its mode through O_TRUNC (--force)
+        f.write(data)
 
 
 def readme_text(prefix: str, install_dir: str, source: str, warnings: list[str]) -> str:
