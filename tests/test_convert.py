@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 from test_roslaunch import fresh_packages, package, plan_of, summarize, write
 
+from mlaunch.cli import main as mlaunch_main
 from mlaunch.commands import convert
 
 __all__ = ["fresh_packages"]  # the autouse fixture, used here too
@@ -118,7 +119,7 @@ def system(tmp_path: Path) -> Path:
 
 def converted(source: Path, fmt: str, output: Path | None = None) -> Path:
     out = output or source.with_name(source.name + "." + fmt)
-    assert convert.main([str(source), "--to", fmt, "-o", str(out)]) == 0
+    assert mlaunch_main(["convert", str(source), "--to", fmt, "-o", str(out)]) == 0
     return out
 
 
@@ -281,17 +282,17 @@ def test_deep_nesting_converts_to_xml_and_yaml_and_is_refused_for_python(tmp_pat
 
 def test_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = write(tmp_path, "c.launch", '<launch>\n  <arg name="x" default="1"/>\n</launch>\n')
-    assert convert.main([path]) == 0  # Python on standard output by default
+    assert mlaunch_main(["convert", path]) == 0  # Python on standard output by default
     assert "def generate_launch_description() -> LaunchDescription:" in capsys.readouterr().out
     out = tmp_path / "c.launch.xml"
-    assert convert.main([path, "-o", str(out)]) == 0  # the format from the suffix
+    assert mlaunch_main(["convert", path, "-o", str(out)]) == 0  # the format from the suffix
     assert out.read_text().startswith('<?xml version="1.0"?>')
-    assert convert.main([str(tmp_path / "missing.launch")]) == 2
+    assert mlaunch_main(["convert", str(tmp_path / "missing.launch")]) == 2
     assert "mlaunch: error: launch file" in capsys.readouterr().err
-    assert convert.main([path, "-o", str(tmp_path / "no" / "dir.py")]) == 2
+    assert mlaunch_main(["convert", path, "-o", str(tmp_path / "no" / "dir.py")]) == 2
     assert "cannot write" in capsys.readouterr().err
     bad = write(tmp_path, "bad.launch", "<launch>\n  <machine name='m'/>\n</launch>\n")
-    assert convert.main([bad, "--to", "yaml"]) == 2
+    assert mlaunch_main(["convert", bad, "--to", "yaml"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1
     assert "bad.launch:2: <machine>: missing required attribute 'address'" in err

@@ -15,6 +15,7 @@ from procutil import Running, clean_env
 from test_interfaces import HAVE_TF2_MSGS
 from test_roslaunch import params, plan_of, summarize
 
+from mlaunch.cli import main as mlaunch_main
 from mlaunch.commands import convert
 from mlaunch.ros import packages
 from mlaunch.ros.search import PackageSearch, searching
@@ -126,7 +127,7 @@ def test_the_committed_conversion_is_what_convert_writes_today() -> None:
 @pytest.mark.parametrize("fmt", ["yaml", "xml"])
 def test_yaml_and_xml_conversions_resolve_to_the_same_plan(tmp_path: Path, fmt: str) -> None:
     out = tmp_path / f"smartcar_display.launch.{fmt}"
-    assert convert.main([str(LAUNCH), "--to", fmt, "-o", str(out)]) == 0
+    assert mlaunch_main(["convert", str(LAUNCH), "--to", fmt, "-o", str(out)]) == 0
     for gui in ("false", "true"):
         ros1 = summarize(plan_of(str(LAUNCH), {"gui": gui}, temp=tmp_path / f"a{gui}"))
         ros2 = summarize(plan_of(str(out), {"gui": gui}, temp=tmp_path / f"b{gui}"))

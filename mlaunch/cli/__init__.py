@@ -15,19 +15,11 @@ import os
 import sys
 
 from mlaunch.app.options import Options, parse_options
+from mlaunch.commands import subcommands
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Sequence
-
-# Each subcommand module has command(args); it parses its options (mlaunch.app.options) and runs
-# through mlaunch.app.pipeline itself, so none imports this module back.
-SUBCOMMANDS = {
-    "test": "mlaunch.commands.smoke",
-    "convert": "mlaunch.commands.convert",
-    "export": "mlaunch.commands.export",
-    "ctl": "mlaunch.commands.ctl",
-}
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -35,10 +27,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or "-d" in args
     try:
-        if args and args[0] in SUBCOMMANDS and not os.path.isfile(args[0]):
-            import importlib
-
-            return int(importlib.import_module(SUBCOMMANDS[args[0]]).command(args[1:]))
+        sub = subcommands().get(args[0]) if args and not os.path.isfile(args[0]) else None
+        if sub is not None:  # each parses its own options and runs through mlaunch.app
+            return sub.main(args[1:])
         return run_cli(args)
     except BrokenPipeError:
         from mlaunch.engine.lifeline import stdout_gone

@@ -28,7 +28,7 @@ from collections.abc import Callable, Iterable
 from typing import Any
 
 from mlaunch.app.options import build_parser
-from mlaunch.cli import SUBCOMMANDS
+from mlaunch.commands import subcommands
 
 # What a launch file is called (ros2 launch's pattern, and ROS 1's .launch): *launch.py,
 # *launch.xml, *launch.yaml, *launch.yml, *.launch.
@@ -48,7 +48,7 @@ def complete() -> None:
 
 def _words() -> list[str]:
     """The words of the command line before the one being completed, from ``mlaunch`` on."""
-    from argcomplete import split_line
+    from argcomplete.lexers import split_line
 
     line = os.environ.get("COMP_LINE", "")
     point = int(os.environ.get("COMP_POINT", len(line)))
@@ -59,37 +59,29 @@ def _words() -> list[str]:
 
 def parser_for(words: list[str]) -> argparse.ArgumentParser:
     """mlaunch's parser, or a subcommand's when the line starts with one, with completers."""
-    sub = words[1] if len(words) > 1 and words[1] in SUBCOMMANDS else None
-    if sub == "convert":
-        from mlaunch.commands.convert import build_parser as convert_parser
-
-        parser = convert_parser()
-        _positional(parser, "file").completer = ros1_file_completer  # type: ignore[attr-defined]
-        return _nested(sub, parser)
-    if sub == "ctl":
-        from mlaunch.commands.ctl import parser as ctl_parser
-
-        parser = ctl_parser()
-        _positional(parser, "words").completer = ctl_completer  # type: ignore[attr-defined]
-        return _nested(sub, parser)
-    parser = build_parser(prog=f"mlaunch {sub}" if sub else "mlaunch")
-    if sub == "test":
-        from mlaunch.smoke.settings import build_parser as test_parser
-
-        _take_options(parser, test_parser())
-    elif sub == "export":
-        from mlaunch.commands.export import build_parser as export_parser
-
-        _take_options(parser, export_parser())
-    target = target_completer if sub is None else launch_target_completer
-    _positional(parser, "target").completer = target  # type: ignore[attr-defined]
-    _positional(parser, "rest").completer = rest_completer  # type: ignore[attr-defined]
+    sub = subcommands().get(words[1]) if len(words) > 1 else None
+    parser = sub.parser() if sub is not None else build_parser(prog="mlaunch")
+    launch_target = target_completer if sub is None else launch_target_completer
+    # What each positional of a parser holds, whichever subcommand's it is.
+    completers: dict[str, Completer] = {
+        "target": launch_target,
+        "rest": rest_completer,
+        "file": ros1_file_completer,
+        "words": ctl_completer,
+    }
     for action in parser._actions:
-        if "--package-path" in action.option_strings:
+        if not action.option_strings and action.dest in completers:
+            _set_completer(action, completers[action.dest])
+        elif "--package-path" in action.option_strings:
             from argcomplete.completers import DirectoriesCompleter
 
-            action.completer = DirectoriesCompleter()  # type: ignore[attr-defined]
-    return _nested(sub, parser) if sub else parser
+            _set_completer(action, DirectoriesCompleter())
+    return _nested(sub.name, parser) if sub is not None else parser
+
+
+def _set_completer(action: argparse.Action, completer: Callable[..., object]) -> None:
+    """argcomplete reads an action's ``completer`` attribute, which argparse does not declare."""
+    setattr(action, "completer", completer)  # noqa: B010
 
 
 def _nested(name: str, parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -99,18 +91,6 @@ def _nested(name: str, parser: argparse.ArgumentParser) -> argparse.ArgumentPars
     subs._name_parser_map[name] = parser
     subs.choices = {name: parser}
     return top
-
-
-def _positional(parser: argparse.ArgumentParser, dest: str) -> argparse.Action:
-    return next(a for a in parser._actions if a.dest == dest and not a.option_strings)
-
-
-def _take_options(parser: argparse.ArgumentParser, other: argparse.ArgumentParser) -> None:
-    """Add ``other``'s options to ``parser`` (a subcommand takes mlaunch FILE's options too)."""
-    known = set(parser._option_string_actions)
-    for action in other._actions:
-        if action.option_strings and not known.intersection(action.option_strings):
-            parser._add_action(action)
 
 
 # --- completers (argcomplete calls them with prefix=, parsed_args= and more) ---------------
@@ -132,7 +112,7 @@ def quietly(completer: Completer) -> Completer:
 @quietly
 def target_completer(prefix: str, parsed_args: Any) -> list[str]:
     """The first word: subcommands, packages, launch files and folders."""
-    found = [s for s in SUBCOMMANDS if s.startswith(prefix)]
+    found = [s for s in subcommands() if s.startswith(prefix)]
     if "/" not in prefix:
         found += [p for p in package_names(parsed_args) if p.startswith(prefix)]
     return found + launch_paths(prefix)

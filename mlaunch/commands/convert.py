@@ -79,16 +79,6 @@ def _format_for(opts: argparse.Namespace) -> str:
     return "py"
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """``mlaunch convert ...``: 0 written, 2 bad input (one line on stderr), through mlaunch's
-    main, which prints errors and gives the status."""
-    # Through the one main that prints errors and gives the status: this runs the subcommand
-    # on its own (tests, a script), so it calls back up to the command line on purpose.
-    from mlaunch import cli
-
-    return cli.main(["convert", *(sys.argv[1:] if argv is None else argv)])
-
-
 def command(args: Sequence[str]) -> int:
     """``mlaunch convert``'s work; errors go up to mlaunch.cli.main."""
     opts = build_parser().parse_args(list(args))
@@ -111,4 +101,4 @@ def command(args: Sequence[str]) -> int:
     return 0
 
 
-__all__ = ["ConversionError", "command", "convert", "main"]
+__all__ = ["ConversionError", "command", "convert"]

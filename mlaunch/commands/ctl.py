@@ -340,14 +340,3 @@ def _uptime(value: object, restart_in: object = None) -> str:
     from mlaunch.parts.summary import format_duration
 
     return format_duration(float(value))
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m mlaunch.commands.ctl``: ``mlaunch ctl``, errors printed by mlaunch's main."""
-    from mlaunch.cli import main as cli_main
-
-    return cli_main(["ctl", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":
-    sys.exit(main())

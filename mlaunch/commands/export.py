@@ -60,15 +60,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(args: Sequence[str]) -> int:
-    """``mlaunch export ARGS``: through mlaunch's main, which prints errors and gives the status."""
-    # Through the one main that prints errors and gives the status: this runs the subcommand
-    # on its own (tests, a script), so it calls back up to the command line on purpose.
-    from mlaunch import cli
-
-    return cli.main(["export", *args])
-
-
 def command(args: Sequence[str]) -> int:
     """``mlaunch export``'s work; errors go up to mlaunch.cli.main."""
     from mlaunch.app.options import parse_options

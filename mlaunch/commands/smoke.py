@@ -35,15 +35,6 @@ if TYPE_CHECKING:
     from mlaunch.plan.steps import Plan, ProcessSpec
 
 
-def main(args: Sequence[str]) -> int:
-    """``mlaunch test ARGS``: through mlaunch's main, which prints errors and gives the status."""
-    # Through the one main that prints errors and gives the status: this runs the subcommand
-    # on its own (tests, a script), so it calls back up to the command line on purpose.
-    from mlaunch import cli
-
-    return cli.main(["test", *args])
-
-
 def command(args: Sequence[str]) -> int:
     """``mlaunch test``'s work; errors go up to mlaunch.cli.main."""
     from mlaunch.app import pipeline
