@@ -248,11 +248,11 @@ def supervise(
 
 def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
     """The remote-process spawner when the launch declared other machines, else None."""
-    if not getattr(labels, "machines", None):
+    if not labels.run_state.get("machines"):
         return None  # no Machine in the launch: mlaunch.machines is never imported
     from mlaunch.plan.machine import remote_machines
 
-    if not remote_machines(labels):
+    if not remote_machines(labels.run_state):
         return None
     from mlaunch.engine.proctable import MARKER
     from mlaunch.parts.remote import Spawner

@@ -1,7 +1,8 @@
 """Actions: the launch description, as the same classes and keywords as ROS 2 ``launch.actions``.
 
-An action is data plus ``execute(resolver)``, which reads the context, adds steps to the plan
-and may return entities to visit next. Nothing here starts a process or prints. The base
+An action is data plus ``execute(context)`` (upstream's contract): it reads the context, hands
+what must happen at run time to ``context.planner`` as plan steps, and may return entities to
+visit next. Nothing here starts a process or prints. The base
 classes live in mlaunch.launch.launch_description and ExecuteProcess in
 mlaunch.launch.execute_process; both are served from here too, under ROS 2's names.
 """
@@ -38,7 +39,6 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.resolve.resolver import Resolver
 
 
 # --- arguments and configurations ------------------------------------------------------------
@@ -89,10 +89,10 @@ class DeclareLaunchArgument(Action):
             conditional=conditional or self.condition is not None,
         )
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        info = resolver.plan.arguments.setdefault(self.name, self.argument_info(conditional=False))
-        if self.name not in ctx.launch_configurations:
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        info = planner.declare_argument(self.argument_info(conditional=False))
+        if self.name not in context.launch_configurations:
             if self.default_value is None:
                 raise LaunchArgumentError(
                     f"required launch argument {self.name!r} was not provided"
@@ -100,8 +100,10 @@ class DeclareLaunchArgument(Action):
                     + (f"; valid choices: {', '.join(self.choices)}" if self.choices else ""),
                     where=self.origin,
                 )
-            ctx.launch_configurations[self.name] = perform_substitutions(ctx, self.default_value)
-        value = ctx.launch_configurations[self.name]
+            context.launch_configurations[self.name] = perform_substitutions(
+                context, self.default_value
+            )
+        value = context.launch_configurations[self.name]
         if self.choices is not None and value not in self.choices:
             raise LaunchArgumentError(
                 f"argument {self.name!r} got {value!r}, which is not one of its choices:"
@@ -121,10 +123,9 @@ class SetLaunchConfiguration(Action):
         self.name = normalize(name)
         self.value = normalize(value)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        name = perform_substitutions(ctx, self.name)
-        ctx.launch_configurations[name] = perform_substitutions(ctx, self.value)
+    def execute(self, context: LaunchContext) -> None:
+        name = perform_substitutions(context, self.name)
+        context.launch_configurations[name] = perform_substitutions(context, self.value)
 
 
 class UnsetLaunchConfiguration(Action):
@@ -132,19 +133,18 @@ class UnsetLaunchConfiguration(Action):
         super().__init__(**kwargs)
         self.name = normalize(name)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        ctx.launch_configurations.pop(perform_substitutions(ctx, self.name), None)
+    def execute(self, context: LaunchContext) -> None:
+        context.launch_configurations.pop(perform_substitutions(context, self.name), None)
 
 
 class PushLaunchConfigurations(Action):
-    def execute(self, resolver: Resolver) -> None:
-        resolver.context.push_scope()
+    def execute(self, context: LaunchContext) -> None:
+        context.push_scope()
 
 
 class PopLaunchConfigurations(Action):
-    def execute(self, resolver: Resolver) -> None:
-        resolver.context.pop_scope()
+    def execute(self, context: LaunchContext) -> None:
+        context.pop_scope()
 
 
 PushEnvironment = PushLaunchConfigurations
@@ -158,16 +158,16 @@ class ResetLaunchConfigurations(Action):
         super().__init__(**kwargs)
         self.launch_configurations = launch_configurations or {}
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        keep = {perform(ctx, k): perform(ctx, v) for k, v in self.launch_configurations.items()}
-        ctx.launch_configurations = keep
+    def execute(self, context: LaunchContext) -> None:
+        keep = {
+            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
+        }
+        context.launch_configurations = keep
 
 
 class ResetEnvironment(Action):
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        ctx.environment = dict(ctx.initial_environment)
+    def execute(self, context: LaunchContext) -> None:
+        context.environment = dict(context.initial_environment)
 
 
 # --- environment -----------------------------------------------------------------------------
@@ -179,10 +179,9 @@ class SetEnvironmentVariable(Action):
         self.name = normalize(name)
         self.value = normalize(value)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        ctx.environment[perform_substitutions(ctx, self.name)] = perform_substitutions(
-            ctx, self.value
+    def execute(self, context: LaunchContext) -> None:
+        context.environment[perform_substitutions(context, self.name)] = perform_substitutions(
+            context, self.value
         )
 
 
@@ -191,9 +190,8 @@ class UnsetEnvironmentVariable(Action):
         super().__init__(**kwargs)
         self.name = normalize(name)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        ctx.environment.pop(perform_substitutions(ctx, self.name), None)
+    def execute(self, context: LaunchContext) -> None:
+        context.environment.pop(perform_substitutions(context, self.name), None)
 
 
 class AppendEnvironmentVariable(Action):
@@ -211,21 +209,20 @@ class AppendEnvironmentVariable(Action):
         self.prepend = prepend
         self.separator = normalize(separator)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        name = perform_substitutions(ctx, self.name)
-        value = perform_substitutions(ctx, self.value)
+    def execute(self, context: LaunchContext) -> None:
+        name = perform_substitutions(context, self.name)
+        value = perform_substitutions(context, self.value)
         prepend = (
             self.prepend
             if isinstance(self.prepend, bool)
-            else to_bool(perform(ctx, self.prepend), "prepend")
+            else to_bool(perform(context, self.prepend), "prepend")
         )
-        old = ctx.environment.get(name)
-        sep = perform_substitutions(ctx, self.separator)
+        old = context.environment.get(name)
+        sep = perform_substitutions(context, self.separator)
         if not old:
-            ctx.environment[name] = value
+            context.environment[name] = value
         else:
-            ctx.environment[name] = f"{value}{sep}{old}" if prepend else f"{old}{sep}{value}"
+            context.environment[name] = f"{value}{sep}{old}" if prepend else f"{old}{sep}{value}"
 
 
 # --- structure -------------------------------------------------------------------------------
@@ -255,15 +252,19 @@ class GroupAction(Action):
     def _flag(self, ctx: LaunchContext, value: Any, what: str) -> bool:
         return value if isinstance(value, bool) else to_bool(perform(ctx, value), what)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        configs = {perform(ctx, k): perform(ctx, v) for k, v in self.launch_configurations.items()}
-        if not self._flag(ctx, self.scoped, "scoped"):
-            ctx.launch_configurations.update(configs)
-            resolver.visit_all(self.actions)
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        configs = {
+            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
+        }
+        if not self._flag(context, self.scoped, "scoped"):
+            context.launch_configurations.update(configs)
+            planner.visit_all(self.actions)
             return
-        with ctx.scope(forwarding=self._flag(ctx, self.forwarding, "forwarding"), configs=configs):
-            resolver.visit_all(self.actions)
+        with context.scope(
+            forwarding=self._flag(context, self.forwarding, "forwarding"), configs=configs
+        ):
+            planner.visit_all(self.actions)
 
 
 class IncludeLaunchDescription(Action):
@@ -292,25 +293,25 @@ class IncludeLaunchDescription(Action):
         self.launch_arguments = list(launch_arguments or [])
         self.scoped = scoped
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
         source = self.launch_description_source
-        path = source.get_launch_file_location(ctx)
-        args = [(perform(ctx, k), perform(ctx, v)) for k, v in self.launch_arguments]
-        description = resolver.load_source(source, ctx, origin=self.origin)
+        path = source.get_launch_file_location(context)
+        args = [(perform(context, k), perform(context, v)) for k, v in self.launch_arguments]
+        description = planner.load_source(source, origin=self.origin)
         if self.scoped:
-            ctx.push_scope()
+            context.push_scope()
         try:
             for name, value in args:
-                ctx.launch_configurations[name] = value
+                context.launch_configurations[name] = value
             if path is None:
-                resolver.visit(description)
+                planner.visit(description)
             else:
-                with resolver.includes.enter(path, self.origin, ctx), ctx.file_locals(path):
-                    resolver.visit(description)
+                with planner.including(path, self.origin), context.file_locals(path):
+                    planner.visit(description)
         finally:
             if self.scoped:
-                ctx.pop_scope()
+                context.pop_scope()
 
     def describe_short(self) -> str:
         return f"IncludeLaunchDescription({self.launch_description_source.describe()})"
@@ -332,8 +333,9 @@ class OpaqueFunction(Action):
         self.args = list(args or [])
         self.kwargs = dict(kwargs or {})
 
-    def execute(self, resolver: Resolver) -> list[Any] | None:
-        result = resolver.call_user(self.function, resolver.context, *self.args, **self.kwargs)
+    def execute(self, context: LaunchContext) -> list[Any] | None:
+        planner = context.planner
+        result = planner.call_user(self.function, context, *self.args, **self.kwargs)
         return list(result) if result else None
 
     def describe_short(self) -> str:
@@ -370,17 +372,17 @@ class TimerAction(Action):
     def get_sub_entities(self) -> list[Any]:
         return list(self.actions)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        period = resolver.float_value(self.period, "TimerAction period", self.origin)
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        period = planner.float_value(self.period, "TimerAction period", self.origin)
         cancel = self.cancel_on_shutdown
         if not isinstance(cancel, bool):
-            cancel = to_bool(perform(ctx, cancel), "cancel_on_shutdown")
-        resolver.add(
+            cancel = to_bool(perform(context, cancel), "cancel_on_shutdown")
+        planner.add(
             StartTimer(
                 origin=self.origin,
                 period=period,
-                body=resolver.defer(self.actions, self.origin),
+                body=planner.defer(self.actions, self.origin),
                 cancel_on_shutdown=cancel,
                 action=self,
             )
@@ -398,7 +400,8 @@ class RegisterEventHandler(Action):
         super().__init__(**kwargs)
         self.event_handler = event_handler
 
-    def execute(self, resolver: Resolver) -> None:
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
         handler = self.event_handler
         kind = getattr(handler, "kind", "")
         if not kind:
@@ -406,12 +409,12 @@ class RegisterEventHandler(Action):
                 f"event handler {type(handler).__name__} is not supported by mlaunch",
                 where=self.origin,
             )
-        resolver.add(
+        planner.add(
             AddHandler(
                 origin=self.origin,
                 kind=kind,
                 matcher=handler.process_matcher() if hasattr(handler, "process_matcher") else None,
-                body=resolver.defer(handler.entities, self.origin, callback=handler.callback),
+                body=planner.defer(handler.entities, self.origin, callback=handler.callback),
                 io_callbacks=dict(getattr(handler, "io_callbacks", {})),
                 once=handler.handle_once,
                 handler=handler,
@@ -424,8 +427,9 @@ class UnregisterEventHandler(Action):
         super().__init__(**kwargs)
         self.event_handler = event_handler
 
-    def execute(self, resolver: Resolver) -> None:
-        resolver.add(RemoveHandler(origin=self.origin, handler=self.event_handler))
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.add(RemoveHandler(origin=self.origin, handler=self.event_handler))
 
 
 class EmitEvent(Action):
@@ -433,16 +437,17 @@ class EmitEvent(Action):
         super().__init__(**kwargs)
         self.event = event
 
-    def execute(self, resolver: Resolver) -> list[Any] | None:
+    def execute(self, context: LaunchContext) -> list[Any] | None:
+        planner = context.planner
         from mlaunch.launch.events import IncludeLaunchDescription
         from mlaunch.launch.events import Shutdown as ShutdownEvent
 
         if isinstance(self.event, ShutdownEvent):
-            resolver.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
+            planner.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
         elif isinstance(self.event, IncludeLaunchDescription):
             return [self.event.launch_description]
         else:
-            resolver.add(EmitEventStep(origin=self.origin, event=self.event))
+            planner.add(EmitEventStep(origin=self.origin, event=self.event))
         return None
 
 
@@ -453,9 +458,10 @@ class Shutdown(Action):
         super().__init__(**kwargs)
         self.reason = normalize(reason)
 
-    def execute(self, resolver: Resolver) -> None:
-        reason = perform_substitutions(resolver.context, self.reason)
-        resolver.add(RequestShutdown(origin=self.origin, reason=reason))
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        reason = perform_substitutions(context, self.reason)
+        planner.add(RequestShutdown(origin=self.origin, reason=reason))
 
 
 class LogInfo(Action):
@@ -463,10 +469,9 @@ class LogInfo(Action):
         super().__init__(**kwargs)
         self.msg = normalize(msg)
 
-    def execute(self, resolver: Resolver) -> None:
-        resolver.add(
-            Log(origin=self.origin, message=perform_substitutions(resolver.context, self.msg))
-        )
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.add(Log(origin=self.origin, message=perform_substitutions(context, self.msg)))
 
 
 __all__ = [

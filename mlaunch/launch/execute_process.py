@@ -30,15 +30,15 @@ if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
     from mlaunch.plan.steps import NodeInfo
-    from mlaunch.resolve.resolver import Resolver
 
 # The launch configuration PushMachine (or a default Machine) sets for the rest of its scope
 # (mlaunch.machines); here so that a launch without machines never imports that package.
 PUSHED_MACHINE = "mlaunch.machine"
 
 
-def _number(resolver: Resolver, value: Any, what: str, origin: str) -> float:
-    return resolver.float_value(value, what, origin)
+def _number(context: LaunchContext, value: Any, what: str, origin: str) -> float:
+    planner = context.planner
+    return planner.float_value(value, what, origin)
 
 
 class ExecuteProcess(Action):
@@ -120,20 +120,21 @@ class ExecuteProcess(Action):
         # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
         self.machine = None if machine is None else normalize(machine)
 
-    def command(self, resolver: Resolver) -> list[str]:
+    def command(self, context: LaunchContext) -> list[str]:
         """The argv before any prefix: each cmd item performed to one element."""
-        return [perform_substitutions(resolver.context, item) for item in self.cmd]
+        return [perform_substitutions(context, item) for item in self.cmd]
 
-    def execute(self, resolver: Resolver) -> None:
-        resolver.spawn(self.build_spec(resolver))
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.spawn(self.build_spec(context))
 
-    def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        machine = self._machine(resolver)
-        return self.process_spec(resolver, self.command(resolver), machine=machine)
+    def build_spec(self, context: LaunchContext) -> ProcessSpec:
+        machine = self._machine(context)
+        return self.process_spec(context, self.command(context), machine=machine)
 
     def process_spec(
         self,
-        resolver: Resolver,
+        context: LaunchContext,
         argv: list[str],
         *,
         node: NodeInfo | None = None,
@@ -149,37 +150,37 @@ class ExecuteProcess(Action):
         ``standin`` names what it replaces, ``temp_files`` what to remove after it;
         ``machine`` is the MachineSpec it runs on (None: no machine given or pushed).
         """
-        ctx = resolver.context
+        planner = context.planner
         remote = machine is not None and not machine.local
         if not argv or not argv[0]:
             raise SubstitutionFailure("the command is empty", where=self.origin)
         named = argv
         located = None
         if not remote:  # another computer's programs are found there
-            argv, located = resolver.locate_program(argv, shell=self.shell, origin=self.origin)
-        prefix = self._prefix(ctx, named)
+            argv, located = planner.locate_program(argv, shell=self.shell, origin=self.origin)
+        prefix = self._prefix(context, named)
         # The label comes from the program the launch file named, not from its stand-in.
         if self.name is not None:
-            base = perform_substitutions(ctx, self.name)
+            base = perform_substitutions(context, self.name)
         elif replaced_label is not None and not prefix:
             base = replaced_label
         else:
             base = os.path.basename((prefix or named)[0])
-        env = self._environment(ctx)
-        on_exit, required = self._exit_policy(resolver)
+        env = self._environment(context)
+        on_exit, required = self._exit_policy(context)
         spec = ProcessSpec(
-            label=resolver.new_label(base),
+            label=planner.new_label(base),
             argv=tuple(prefix + argv),
             launch_prefix=tuple(prefix),
             env=env,
-            env_changes=_env_changes(ctx.initial_environment, env),
-            cwd=None if self.cwd is None else perform_substitutions(ctx, self.cwd),
+            env_changes=_env_changes(context.initial_environment, env),
+            cwd=None if self.cwd is None else perform_substitutions(context, self.cwd),
             shell=self.shell,
-            emulate_tty=self._emulate_tty(ctx),
-            output=self._output(ctx),
-            respawn=self._respawn(resolver),
-            sigterm_timeout=_number(resolver, self.sigterm_timeout, "sigterm_timeout", self.origin),
-            sigkill_timeout=_number(resolver, self.sigkill_timeout, "sigkill_timeout", self.origin),
+            emulate_tty=self._emulate_tty(context),
+            output=self._output(context),
+            respawn=self._respawn(context),
+            sigterm_timeout=_number(context, self.sigterm_timeout, "sigterm_timeout", self.origin),
+            sigkill_timeout=_number(context, self.sigkill_timeout, "sigkill_timeout", self.origin),
             required=required,
             on_exit=on_exit,
             origin=self.origin,
@@ -196,14 +197,14 @@ class ExecuteProcess(Action):
             )
         return spec
 
-    def _machine(self, resolver: Resolver) -> Any:
+    def _machine(self, context: LaunchContext) -> Any:
         """The MachineSpec this process runs on, or None (no machine given or pushed)."""
-        pushed = resolver.context.launch_configurations.get(PUSHED_MACHINE)
+        pushed = context.launch_configurations.get(PUSHED_MACHINE)
         if self.machine is None and not pushed:
             return None  # the common case: nothing of mlaunch.machines is imported
         from mlaunch.machines.actions import machine_for
 
-        return machine_for(resolver, self.machine, self.origin)
+        return machine_for(context, self.machine, self.origin)
 
     def _prefix(self, ctx: LaunchContext, argv: list[str]) -> list[str]:
         if self.prefix is not None:
@@ -254,13 +255,13 @@ class ExecuteProcess(Action):
             )
         return text
 
-    def _respawn(self, resolver: Resolver) -> RespawnPolicy:
-        ctx = resolver.context
+    def _respawn(self, context: LaunchContext) -> RespawnPolicy:
+        planner = context.planner
         value = self.respawn
         if isinstance(value, bool):
             mode = "always" if value else "never"
         else:
-            text = perform(ctx, value).strip().lower()
+            text = perform(context, value).strip().lower()
             if text in ("always", "on-failure", "on_failure", "never"):
                 mode = text.replace("_", "-")
             else:
@@ -273,12 +274,12 @@ class ExecuteProcess(Action):
                     )
         delay = 0.0
         if self.respawn_delay is not None:
-            delay = resolver.float_value(self.respawn_delay, "respawn_delay", self.origin)
+            delay = planner.float_value(self.respawn_delay, "respawn_delay", self.origin)
         retries = int(
-            resolver.float_value(self.respawn_max_retries, "respawn_max_retries", self.origin)
+            planner.float_value(self.respawn_max_retries, "respawn_max_retries", self.origin)
         )
-        backoff = resolver.float_value(self.respawn_backoff, "respawn_backoff", self.origin)
-        max_delay = resolver.float_value(self.respawn_max_delay, "respawn_max_delay", self.origin)
+        backoff = planner.float_value(self.respawn_backoff, "respawn_backoff", self.origin)
+        max_delay = planner.float_value(self.respawn_max_delay, "respawn_max_delay", self.origin)
         if delay < 0 or backoff < 1.0:
             raise MlaunchError(
                 f"respawn_delay must be >= 0 and respawn_backoff >= 1 (got {delay}, {backoff})",
@@ -288,16 +289,16 @@ class ExecuteProcess(Action):
             mode=mode, delay=delay, max_retries=retries, backoff=backoff, max_delay=max_delay
         )
 
-    def _exit_policy(self, resolver: Resolver) -> tuple[Deferred | None, bool]:
-        ctx = resolver.context
+    def _exit_policy(self, context: LaunchContext) -> tuple[Deferred | None, bool]:
+        planner = context.planner
         required = self.required
         if not isinstance(required, bool):
-            required = to_bool(perform(ctx, required), "required")
+            required = to_bool(perform(context, required), "required")
         on_exit = self.on_exit
         if on_exit is None:
             return None, required
         if callable(on_exit) and not hasattr(on_exit, "visit"):
-            return resolver.defer([], self.origin, callback=on_exit), required
+            return planner.defer([], self.origin, callback=on_exit), required
         entities = list(on_exit) if isinstance(on_exit, (list, tuple)) else [on_exit]
         # launch.actions imports this module (ExecuteProcess is one of its names), so Shutdown
         # is looked up when an on_exit needs it rather than at import.
@@ -305,7 +306,7 @@ class ExecuteProcess(Action):
 
         if any(isinstance(e, Shutdown) for e in entities):
             required = True
-        return resolver.defer(entities, self.origin), required
+        return planner.defer(entities, self.origin), required
 
     def describe_short(self) -> str:
         return "ExecuteProcess(" + " ".join(describe(c) for c in self.cmd) + ")"

@@ -14,6 +14,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Mapping
     from typing import Any
 
+    from mlaunch.plan.planner import Planner
+
 
 class Locals:
     """Attribute access to the context locals (``context.locals.event``), as ROS 2 offers.
@@ -48,22 +50,49 @@ class LaunchContext:
     def __init__(
         self,
         *,
-        environment: Mapping[str, str],
+        environment: Mapping[str, str] | None = None,
         argv: tuple[str, ...] = (),
         log_dir: str = "",
         warn: Callable[[str], None] | None = None,
+        planner: Planner | None = None,
     ) -> None:
         self.launch_configurations: dict[str, Any] = {}
-        self.environment: dict[str, str] = dict(environment)
-        self.initial_environment: dict[str, str] = dict(environment)
+        # A copy of the launcher's environment unless the caller gives one (resolve always does).
+        self.environment: dict[str, str] = dict(
+            environment if environment is not None else os.environ
+        )
+        self.initial_environment: dict[str, str] = dict(self.environment)
         self.argv = argv
         self.log_dir = log_dir
         self._locals: dict[str, Any] = {}
         # One run's globals: shared (not copied) by every snapshot, so what a deferred action
         # adds (launch_ros's count of node names) is seen by the whole run.
         self._globals: dict[str, Any] = {}
+        # One run's own state (the declared machines ...): shared by every snapshot, like the
+        # globals, but not visible to launch-file code through ``locals``.
+        self.run_state: dict[str, Any] = {}
         self._scopes: list[tuple[dict[str, Any], dict[str, str]]] = []
         self._warn = warn
+        self._planner = planner
+
+    # --- the seam to planning (mlaunch.plan.planner) ----------------------------------------
+
+    @property
+    def planner(self) -> Planner:
+        """What turns the actions visited with this context into plan steps.
+
+        Resolve sets its own; a context made without one (an action visited on its own, as unit
+        tests of extensions do) gets a standalone planner that collects the steps.
+        """
+        if self._planner is None:
+            from mlaunch.launch.planning import StandalonePlanner
+
+            self._planner = StandalonePlanner(self)
+        return self._planner
+
+    @planner.setter
+    def planner(self, planner: Planner | None) -> None:
+        self._planner = planner
 
     # --- what ROS 2 launch files use -------------------------------------------------------
 
@@ -135,6 +164,7 @@ class LaunchContext:
         }
         copy._locals = dict(self._locals)
         copy._globals = self._globals
+        copy.run_state = self.run_state
         return copy
 
 

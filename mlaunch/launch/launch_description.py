@@ -1,8 +1,9 @@
 """The description's building blocks: ``LaunchDescriptionEntity``, ``Action`` and
 ``LaunchDescription`` (ROS 2's ``launch.action`` and ``launch.launch_description``).
 
-An action is data plus ``execute(resolver)``, which reads the context, adds steps to the plan
-and may return entities to visit next. Nothing here starts a process or prints.
+An action is data plus ``execute(context)``, upstream's contract: it reads the context, hands
+what must happen at run time to ``context.planner`` as plan steps (mlaunch.plan.planner), and
+may return entities to visit next. Nothing here starts a process or prints.
 """
 
 from __future__ import annotations
@@ -15,13 +16,13 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.conditions import Condition
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 
 class LaunchDescriptionEntity:
     """Anything that can appear in a launch description."""
 
-    def visit(self, resolver: Resolver) -> list[Any] | None:
+    def visit(self, context: LaunchContext) -> list[Any] | None:
         return None
 
     def describe_short(self) -> str:
@@ -35,12 +36,12 @@ class Action(LaunchDescriptionEntity):
         self.condition = condition
         self.origin = caller_origin()
 
-    def visit(self, resolver: Resolver) -> list[Any] | None:
-        if self.condition is not None and not self.condition.evaluate(resolver.context):
+    def visit(self, context: LaunchContext) -> list[Any] | None:
+        if self.condition is not None and not self.condition.evaluate(context):
             return None
-        return self.execute(resolver)
+        return self.execute(context)
 
-    def execute(self, resolver: Resolver) -> list[Any] | None:
+    def execute(self, context: LaunchContext) -> list[Any] | None:
         return None
 
     def get_sub_entities(self) -> list[Any]:
@@ -66,11 +67,10 @@ class LaunchDescription(LaunchDescriptionEntity):
     def describe_sub_entities(self) -> list[Any]:
         return list(self.entities)
 
-    def visit(self, resolver: Resolver) -> list[Any] | None:
+    def visit(self, context: LaunchContext) -> list[Any] | None:
         if self.deprecated_reason:
-            resolver.warn(f"launch description is deprecated: {self.deprecated_reason}")
-        resolver.visit_all(self.entities)
-        return None
+            context.planner.warn(f"launch description is deprecated: {self.deprecated_reason}")
+        return list(self.entities)
 
     def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
         """The DeclareLaunchArgument actions in this description, includes not followed."""

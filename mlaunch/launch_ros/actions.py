@@ -36,7 +36,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.actions import LaunchDescriptionEntity
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 _xacro.register()
 
@@ -60,10 +60,9 @@ class PushROSNamespace(Action):
         super().__init__(**kwargs)
         self.namespace = normalize(namespace)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        pushed = perform_substitutions(ctx, self.namespace)
-        previous = ctx.launch_configurations.get("ros_namespace")
+    def execute(self, context: LaunchContext) -> None:
+        pushed = perform_substitutions(context, self.namespace)
+        previous = context.launch_configurations.get("ros_namespace")
         combined = prefix_namespace(previous, pushed)
         assert combined is not None
         problem = namespace_problem(combined)
@@ -72,7 +71,7 @@ class PushROSNamespace(Action):
                 f"the resulting namespace {combined!r} is invalid: {problem}"
                 f" [previous_namespace={previous!r}, pushed_namespace={pushed!r}]"
             )
-        ctx.launch_configurations["ros_namespace"] = combined
+        context.launch_configurations["ros_namespace"] = combined
 
     def describe_short(self) -> str:
         return f"PushROSNamespace({describe(self.namespace)})"
@@ -91,10 +90,9 @@ class SetParameter(Action):
         super().__init__(**kwargs)
         self.param_dict = params.normalize_dict({normalize(name): value})
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        entries = tuple(params.evaluate_dict(ctx, self.param_dict).items())
-        add_global_params(resolver, self, entries)
+    def execute(self, context: LaunchContext) -> None:
+        entries = tuple(params.evaluate_dict(context, self.param_dict).items())
+        add_global_params(context, self, entries)
 
     def describe_short(self) -> str:
         (name,) = self.param_dict
@@ -108,13 +106,12 @@ class SetParametersFromFile(Action):
         super().__init__(**kwargs)
         self.filename = normalize(filename)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        path = os.path.abspath(perform_substitutions(ctx, self.filename))
+    def execute(self, context: LaunchContext) -> None:
+        path = os.path.abspath(perform_substitutions(context, self.filename))
         if not os.path.isfile(path):
             # launch_ros asserts when a node uses it; failing here names the right line.
             raise LaunchFileError(f"parameters file {path!r} does not exist", where=self.origin)
-        add_global_params(resolver, self, (path,))
+        add_global_params(context, self, (path,))
 
     def describe_short(self) -> str:
         return f"SetParametersFromFile({describe(self.filename)})"
@@ -131,10 +128,9 @@ class SetRemap(Action):
     # mlaunch's: True keeps it inside a scoped group even without --scoped-parameters.
     keep_in_scope = False
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        rule = (perform_substitutions(ctx, self.src), perform_substitutions(ctx, self.dst))
-        add_global_remap(resolver, self, rule)
+    def execute(self, context: LaunchContext) -> None:
+        rule = (perform_substitutions(context, self.src), perform_substitutions(context, self.dst))
+        add_global_remap(context, self, rule)
 
     def describe_short(self) -> str:
         return f"SetRemap({describe(self.src)} -> {describe(self.dst)})"
@@ -152,11 +148,11 @@ class SetUseSimTime(Action):
         super().__init__(**kwargs)
         self.value = normalize_typed(value, bool)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        value = bool(perform_typed(ctx, self.value, bool))
-        ctx.launch_configurations["ros_use_sim_time"] = value
-        resolver.warn(
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        value = bool(perform_typed(context, self.value, bool))
+        context.launch_configurations["ros_use_sim_time"] = value
+        planner.warn(
             f"{self.origin}: SetUseSimTime({value}) sets use_sim_time only for launch's own ROS"
             " clock, not for the nodes (as in ROS 2 Jazzy); use SetParameter('use_sim_time',"
             f" {value}) or mlaunch --use-sim-time for the nodes"
@@ -170,10 +166,9 @@ class SetROSLogDir(Action):
         super().__init__(**kwargs)
         self.log_dir = normalize(new_log_dir)
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        new = perform_substitutions(ctx, self.log_dir)
-        ctx.environment["ROS_LOG_DIR"] = os.path.join(ros_log_dir(ctx.environment), new)
+    def execute(self, context: LaunchContext) -> None:
+        new = perform_substitutions(context, self.log_dir)
+        context.environment["ROS_LOG_DIR"] = os.path.join(ros_log_dir(context.environment), new)
 
 
 SetRosLogDir = SetROSLogDir

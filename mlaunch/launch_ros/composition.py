@@ -28,8 +28,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch_ros.load_request import LoadRequest
-    from mlaunch.resolve.resolver import Resolver
 
 
 # What a load needs attached to the run (Plan.needs): the LoadNode driver.
@@ -120,12 +120,13 @@ class ComposableNodeContainer(Node):
         return COMPONENTS if self._descriptions else frozenset()
 
     # A Node returns nothing; a container also returns the load of its nodes (as launch_ros).
-    def execute(self, resolver: Resolver) -> list[Any] | None:  # type: ignore[override]
-        ctx = resolver.context
+    def execute(self, context: LaunchContext) -> list[Any] | None:  # type: ignore[override]
         valid = [
-            d for d in self._descriptions if d.condition() is None or d.condition().evaluate(ctx)
+            d
+            for d in self._descriptions
+            if d.condition() is None or d.condition().evaluate(context)
         ]
-        super().execute(resolver)
+        super().execute(context)
         if not valid:
             return None
         load = LoadComposableNodes(composable_node_descriptions=valid, target_container=self)
@@ -158,23 +159,24 @@ class LoadComposableNodes(Action):
         self._descriptions = _descriptions(composable_node_descriptions)
         self.final_target_container_name: str | None = None
 
-    def execute(self, resolver: Resolver) -> None:
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
         from mlaunch.launch_ros.load_request import load_request
 
         target = self._target_name()
         if target is None:
-            target = perform_substitutions(resolver.context, self._target)
+            target = perform_substitutions(context, self._target)
         self.final_target_container_name = target
         requests = []
         for description in self._descriptions:
-            request = load_request(description, resolver.context)
+            request = load_request(description, context)
             if request is not None:
                 requests.append(request)
         if requests:
             # A relative name is resolved by launch_ros's own node, whose namespace is '/'.
             full = make_namespace_absolute(target) if target else target
-            names = node_name_counts(resolver.context)
-            resolver.add(LoadComponents(self.origin, full, tuple(requests), target, names))
+            names = node_name_counts(context)
+            planner.add(LoadComponents(self.origin, full, tuple(requests), target, names))
 
     def _target_name(self) -> str | None:
         """The container action's full name (None when the target is given as a name)."""

@@ -17,7 +17,7 @@ from mlaunch.plan.errors import LaunchFileError
 from mlaunch.plan.steps import SEQUENCE_ARGUMENT, Note
 
 if TYPE_CHECKING:
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 # How long a node's lifecycle services may take to appear, and each transition to answer.
 DEFAULT_TIMEOUT = 20.0
@@ -77,18 +77,20 @@ class LifecycleSequence(Action):
         self.shutdown_on_failure = shutdown_on_failure
         self.timeout = timeout
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        namespace = str(ctx.launch_configurations.get("ros_namespace") or "/")
-        names = [qualify(perform_substitutions(ctx, n), namespace, self.origin) for n in self.nodes]
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        namespace = str(context.launch_configurations.get("ros_namespace") or "/")
+        names = [
+            qualify(perform_substitutions(context, n), namespace, self.origin) for n in self.nodes
+        ]
         check_sequence(names, self.origin)
-        timeout = resolver.float_value(self.timeout, "LifecycleSequence timeout", self.origin)
+        timeout = planner.float_value(self.timeout, "LifecycleSequence timeout", self.origin)
         if timeout <= 0:
             raise LaunchFileError(
                 f"LifecycleSequence timeout is {timeout:g}; it must be > 0 seconds",
                 where=self.origin,
             )
-        resolver.add(
+        planner.add(
             SequenceStep(
                 origin=self.origin,
                 nodes=tuple(names),

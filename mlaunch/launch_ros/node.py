@@ -49,7 +49,6 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.resolve.resolver import Resolver
 
 Subs = tuple[Substitution, ...]
 # launch_ros's key for the count of full node names in the context globals.
@@ -189,36 +188,35 @@ class Node(ExecuteProcess):
 
     # --- resolving ------------------------------------------------------------------------------
 
-    def node_command(self, resolver: Resolver, *, remote: bool = False) -> NodeCommand:
-        """The node's names and launch_ros's command line for it, in the resolver's context.
+    def node_command(self, context: LaunchContext, *, remote: bool = False) -> NodeCommand:
+        """The node's names and launch_ros's command line for it, in the context's context.
 
         ``remote``: the node runs on another computer (mlaunch.machines), which finds the
         package's executable itself.
         """
-        ctx = resolver.context
-        names = self._names(ctx)
-        package, executable, exe_argv, standin = self._executable(resolver, remote)
-        argv = [*exe_argv, *(perform_substitutions(ctx, a) for a in self.arguments)]
+        names = self._names(context)
+        package, executable, exe_argv, standin = self._executable(context, remote)
+        argv = [*exe_argv, *(perform_substitutions(context, a) for a in self.arguments)]
         if self.ros_arguments is not None:
-            argv += ["--ros-args", *(perform_substitutions(ctx, a) for a in self.ros_arguments)]
+            argv += ["--ros-args", *(perform_substitutions(context, a) for a in self.ros_arguments)]
         argv.append("--ros-args")
         if names.name is not None:
             argv += ["-r", f"__node:={names.name}"]
         if names.namespace is not None:
             argv += ["-r", f"__ns:={names.namespace}"]
-        argv += self._global_parameter_arguments(ctx)
-        own, temp_files = self._parameter_arguments(resolver, names)
+        argv += self._global_parameter_arguments(context)
+        own, temp_files = self._parameter_arguments(context, names)
         argv += own
-        for src, dst in self._remap_arguments(ctx):
+        for src, dst in self._remap_arguments(context):
             argv += ["-r", f"{src}:={dst}"]
         return NodeCommand(names, package, executable, exe_argv, standin, argv, temp_files)
 
-    def command(self, resolver: Resolver) -> list[str]:
-        return self.node_command(resolver).argv
+    def command(self, context: LaunchContext) -> list[str]:
+        return self.node_command(context).argv
 
-    def build_spec(self, resolver: Resolver) -> ProcessSpec:
-        machine = self._machine(resolver)
-        found = self.node_command(resolver, remote=machine is not None and not machine.local)
+    def build_spec(self, context: LaunchContext) -> ProcessSpec:
+        machine = self._machine(context)
+        found = self.node_command(context, remote=machine is not None and not machine.local)
         info = NodeInfo(
             name=found.names.name,
             namespace=found.names.namespace or "/",
@@ -228,7 +226,7 @@ class Node(ExecuteProcess):
             autostart=bool(getattr(self, "autostart", False)),
         )
         spec = self.process_spec(
-            resolver,
+            context,
             found.argv,
             node=info,
             # A stand-in is labelled as the program it replaces (unless a launch prefix leads).
@@ -237,7 +235,7 @@ class Node(ExecuteProcess):
             temp_files=found.temp_files,
             machine=machine,
         )
-        self._track_name(resolver.context, found.names)
+        self._track_name(context, found.names)
         self.resolved_names = found.names
         return spec
 
@@ -263,26 +261,26 @@ class Node(ExecuteProcess):
         return NodeNames(name, namespace)
 
     def _executable(
-        self, resolver: Resolver, remote: bool
+        self, context: LaunchContext, remote: bool
     ) -> tuple[str | None, str, list[str], str | None]:
         """(package, executable, argv items that run it, what a stand-in replaces)."""
-        ctx = resolver.context
-        executable = perform_substitutions(ctx, self.node_executable)
+        planner = context.planner
+        executable = perform_substitutions(context, self.node_executable)
         if self.node_package is None:
             return None, executable, [executable], None
-        package = perform_substitutions(ctx, self.node_package)
-        index = packages.for_context(ctx)
+        package = perform_substitutions(context, self.node_package)
+        index = packages.for_context(context)
         if remote:
             # Found on that computer (mlaunch.parts.agent looks the package up there); this
             # computer's path is only a hint, and there are no stand-ins on other computers.
             return package, executable, [remote_executable(index, package, executable)], None
         if index.installed(package) is not None:
             return package, executable, [index.executable(package, executable)], None
-        if resolver.options.standins:
+        if planner.options.standins:
             replacement = standins.standin_for_package(package, executable)
             if replacement is not None:
                 return package, executable, list(replacement), f"{package}/{executable}"
-        raise _not_installed(index, package, executable, resolver.options.standins)
+        raise _not_installed(index, package, executable, planner.options.standins)
 
     def _global_parameter_arguments(self, ctx: LaunchContext) -> list[str]:
         out: list[str] = []
@@ -297,12 +295,13 @@ class Node(ExecuteProcess):
         return out
 
     def _parameter_arguments(
-        self, resolver: Resolver, names: NodeNames
+        self, context: LaunchContext, names: NodeNames
     ) -> tuple[list[str], tuple[str, ...]]:
         """The node's own params arguments and the temporary files to remove (if mlaunch must)."""
+        planner = context.planner
         if not self.parameters:
             return [], ()
-        temp_dir = resolver.options.temp_dir
+        temp_dir = planner.options.temp_dir
         private = None
         if temp_dir is None and _writes_files(self.parameters):
             # No run directory to write into: a private one, removed with the process's files.
@@ -311,10 +310,10 @@ class Node(ExecuteProcess):
             temp_dir = private = tempfile.mkdtemp(prefix="mlaunch-params-")
 
         def warn(message: str) -> None:
-            resolver.warn(f"{self.origin}: {message}")
+            planner.warn(f"{self.origin}: {message}")
 
         arguments = params.parameter_arguments(
-            resolver.context,
+            context,
             self.parameters,
             node_key=names.params_key,
             temp_dir=temp_dir,

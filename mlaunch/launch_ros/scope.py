@@ -21,7 +21,6 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.resolve.resolver import Resolver
 
 
 # --- names and namespaces (launch_ros.utilities, rmw's validation rules) -----------------------
@@ -94,32 +93,33 @@ def global_params(context: LaunchContext) -> tuple[Any, ...]:
     return tuple(context.launch_configurations.get("global_params") or ())
 
 
-def add_global_params(resolver: Resolver, action: Any, entries: tuple[Any, ...]) -> None:
+def add_global_params(context: LaunchContext, action: Any, entries: tuple[Any, ...]) -> None:
     """Extend the global parameters as launch_ros does, or within the scope on request (the
     option, the file's comment, or ``keep_in_scope`` on the action: ROS 1 files' params)."""
-    _extend_shared(resolver, action, "global_params", entries, "global parameter")
+    _extend_shared(context, action, "global_params", entries, "global parameter")
 
 
-def add_global_remap(resolver: Resolver, action: Any, rule: tuple[str, str]) -> None:
+def add_global_remap(context: LaunchContext, action: Any, rule: tuple[str, str]) -> None:
     """Add a global remap rule as launch_ros's SetRemap does: its list is extended in place too,
     so inside a scoped group it reaches the nodes after the group (the same opt-in keeps it in)."""
-    _extend_shared(resolver, action, "ros_remaps", (rule,), "global remap")
+    _extend_shared(context, action, "ros_remaps", (rule,), "global remap")
 
 
 def _extend_shared(
-    resolver: Resolver, action: Any, key: str, entries: tuple[Any, ...], what: str
+    context: LaunchContext, action: Any, key: str, entries: tuple[Any, ...], what: str
 ) -> None:
+    planner = context.planner
     from mlaunch.resolve.binding import SCOPED_PARAMETERS, file_has
 
-    configs = resolver.context.launch_configurations
+    configs = context.launch_configurations
     current = configs.get(key)
     origin = action.origin or ""
-    scoped = getattr(action, "keep_in_scope", False) or resolver.options.scoped_parameters
+    scoped = getattr(action, "keep_in_scope", False) or planner.options.scoped_parameters
     if scoped or file_has(origin, SCOPED_PARAMETERS):
         configs[key] = (*(current or ()), *entries)
     elif isinstance(current, list):
-        if resolver.context.shared_with_outer_scope(current):
-            resolver.warn(
+        if context.shared_with_outer_scope(current):
+            planner.warn(
                 f"{origin}: this {what} also applies to the nodes after the enclosing"
                 " group, as in ros2 launch (its list is shared with the outer scope);"
                 " --scoped-parameters, or a comment 'mlaunch: scoped-parameters' in the file,"

@@ -10,7 +10,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 
 class ReadyToTest(Action):
@@ -28,12 +28,13 @@ class ReadyToTest(Action):
     def _add_callback(self, callback: Callable[[], None]) -> None:
         self._callbacks.append(callback)
 
-    def execute(self, resolver: Resolver) -> None:
-        resolver.add(
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.add(
             StartTimer(
                 origin=self.origin,
                 period=0.0,
-                body=resolver.defer([], self.origin, callback=self._fire),
+                body=planner.defer([], self.origin, callback=self._fire),
             )
         )
 

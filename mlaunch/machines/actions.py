@@ -20,8 +20,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
-    from mlaunch.resolve.resolver import Resolver
 
 
 class Machine(Action):
@@ -55,9 +55,9 @@ class Machine(Action):
         self.default = default
         self.timeout = timeout
 
-    def execute(self, resolver: Resolver) -> None:
-        spec = self.resolve_spec(resolver)
-        table = declared(resolver.labels)
+    def execute(self, context: LaunchContext) -> None:
+        spec = self.resolve_spec(context)
+        table = declared(context.run_state)
         known = table.get(spec.name)
         if known is not None and known._values()[:-1] != spec._values()[:-1]:
             raise LaunchFileError(
@@ -66,18 +66,18 @@ class Machine(Action):
                 where=self.origin,
             )
         table.setdefault(spec.name, spec)
-        if _flag(resolver, self.default):
-            resolver.context.launch_configurations[PUSHED] = spec.name
+        if _flag(context, self.default):
+            context.launch_configurations[PUSHED] = spec.name
 
-    def resolve_spec(self, resolver: Resolver) -> MachineSpec:
+    def resolve_spec(self, context: LaunchContext) -> MachineSpec:
+        planner = context.planner
         from mlaunch.plan.machine import is_local
 
-        ctx = resolver.context
-        name = perform_substitutions(ctx, self.name)
+        name = perform_substitutions(context, self.name)
         problem = check_name(name)
         if problem is not None:
             raise LaunchFileError(f"machine name {name!r} is invalid: {problem}", where=self.origin)
-        address = perform_substitutions(ctx, self.address).strip()
+        address = perform_substitutions(context, self.address).strip()
         if not address or address.startswith("-") or any(c.isspace() for c in address):
             # A leading '-' would reach ssh as an option (-oProxyCommand=...), not a host.
             raise LaunchFileError(
@@ -85,10 +85,10 @@ class Machine(Action):
                 " or an ssh Host alias (no spaces, not starting with '-')",
                 where=self.origin,
             )
-        user = None if self.user is None else perform_substitutions(ctx, self.user) or None
+        user = None if self.user is None else perform_substitutions(context, self.user) or None
         port = None
         if self.ssh_port is not None and str(self.ssh_port) != "":
-            number = resolver.float_value(self.ssh_port, "ssh_port", self.origin)
+            number = planner.float_value(self.ssh_port, "ssh_port", self.origin)
             if number != int(number) or not 0 < number < 65536:
                 raise LaunchFileError(
                     f"ssh_port of machine {name!r} is {self.ssh_port!r};"
@@ -98,8 +98,8 @@ class Machine(Action):
             port = int(number)
         loader = None
         if self.env_loader is not None:
-            loader = perform_substitutions(ctx, self.env_loader) or None
-        timeout = resolver.float_value(self.timeout, "timeout", self.origin)
+            loader = perform_substitutions(context, self.env_loader) or None
+        timeout = planner.float_value(self.timeout, "timeout", self.origin)
         if timeout <= 0:
             raise LaunchFileError(
                 f"timeout of machine {name!r} is {timeout:g}; valid: seconds above 0",
@@ -127,18 +127,18 @@ class PushMachine(Action):
         super().__init__(**kwargs)
         self.name = normalize(name)
 
-    def execute(self, resolver: Resolver) -> None:
-        name = perform_substitutions(resolver.context, self.name)
-        lookup(resolver, name, self.origin)
-        resolver.context.launch_configurations[PUSHED] = name
+    def execute(self, context: LaunchContext) -> None:
+        name = perform_substitutions(context, self.name)
+        lookup(context, name, self.origin)
+        context.launch_configurations[PUSHED] = name
 
     def describe_short(self) -> str:
         return f"PushMachine({describe(self.name)})"
 
 
-def lookup(resolver: Resolver, name: str, origin: str) -> MachineSpec:
+def lookup(context: LaunchContext, name: str, origin: str) -> MachineSpec:
     """The declared machine ``name``, or a located error naming the declared ones."""
-    table = declared(resolver.labels)
+    table = declared(context.run_state)
     spec = table.get(name)
     if spec is not None:
         return spec
@@ -154,21 +154,21 @@ def lookup(resolver: Resolver, name: str, origin: str) -> MachineSpec:
     raise LaunchFileError(f"machine {name!r} is not declared{hint}", where=origin)
 
 
-def machine_for(resolver: Resolver, given: Any, origin: str) -> MachineSpec | None:
+def machine_for(context: LaunchContext, given: Any, origin: str) -> MachineSpec | None:
     """The machine a process runs on: its own ``machine=``, else the pushed one, else None."""
     if given is not None:
-        name = perform_substitutions(resolver.context, given)
+        name = perform_substitutions(context, given)
     else:
-        name = str(resolver.context.launch_configurations.get(PUSHED, ""))
+        name = str(context.launch_configurations.get(PUSHED, ""))
     if not name:
         return None
-    return lookup(resolver, name, origin)
+    return lookup(context, name, origin)
 
 
-def _flag(resolver: Resolver, value: Any) -> bool:
+def _flag(context: LaunchContext, value: Any) -> bool:
     if isinstance(value, bool):
         return value
-    text = perform_substitutions(resolver.context, normalize(value)).strip().lower()
+    text = perform_substitutions(context, normalize(value)).strip().lower()
     if text == "never":
         return False
     return to_bool(text, "the machine's default")

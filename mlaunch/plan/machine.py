@@ -121,23 +121,20 @@ def _ipv4_addresses() -> set[str]:
     return out
 
 
-def declared(holder: Any) -> dict[str, MachineSpec]:
+def declared(run_state: dict[str, Any]) -> dict[str, MachineSpec]:
     """The machines declared so far in this run, by name.
 
-    Kept on the run's label counter, the one object every resolution of a run shares (timers
-    and handlers resolved later see the machines declared before them), as ROS 1's machine
-    names are global to a launch.
+    Kept in the run's state (``LaunchContext.run_state``, which every resolution of a run shares:
+    timers and handlers resolved later see the machines declared before them), as ROS 1's
+    machine names are global to a launch.
     """
-    table: dict[str, MachineSpec] | None = getattr(holder, "machines", None)
-    if table is None:
-        table = {}
-        holder.machines = table
+    table: dict[str, MachineSpec] = run_state.setdefault("machines", {})
     return table
 
 
-def remote_machines(holder: Any) -> list[MachineSpec]:
+def remote_machines(run_state: dict[str, Any]) -> list[MachineSpec]:
     """The declared machines reached over ssh (empty for a launch without machines)."""
-    table = getattr(holder, "machines", None) or {}
+    table: dict[str, MachineSpec] = run_state.get("machines") or {}
     return [m for m in table.values() if not m.local]
 
 

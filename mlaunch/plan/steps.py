@@ -20,7 +20,6 @@ TYPE_CHECKING = False
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.plan.machine import MachineSpec
 
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
@@ -200,10 +199,10 @@ class Deferred(Record):
     def __init__(
         self,
         entities: list[Any],
-        context: LaunchContext,
+        context: object,  # the launch API's LaunchContext (live, or a snapshot)
         origin: str = "",
         callback: Any = None,  # callable(event, context) -> entities, as ROS 2 handlers accept
-        captured: LaunchContext | None = None,
+        captured: object | None = None,  # a LaunchContext snapshot, with the live context
     ) -> None:
         self.entities = entities
         self.context = context

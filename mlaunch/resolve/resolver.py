@@ -12,7 +12,8 @@ import os
 
 from mlaunch.frontends.limits import DEPTH_LIMIT, IncludeChain, allow_deep_trees, too_deep
 from mlaunch.launch.launch_context import LaunchContext
-from mlaunch.launch.substitutions import Substitution, normalize, perform, perform_substitutions
+from mlaunch.launch.planning import number
+from mlaunch.launch.substitutions import Substitution, normalize, perform_substitutions
 from mlaunch.plan.errors import (
     LaunchFileError,
     MlaunchError,
@@ -26,6 +27,7 @@ from mlaunch.plan.steps import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn,
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Mapping
+    from contextlib import AbstractContextManager
     from typing import Any
 
     from mlaunch.launch.launch_description import LaunchDescriptionEntity
@@ -33,10 +35,12 @@ if TYPE_CHECKING:
 
 
 class LabelCounter:
-    """ROS 2's global ``name-N`` counter, shared by everything resolved in one run."""
+    """ROS 2's global ``name-N`` counter, shared by everything resolved in one run, with the
+    run's own planning state (``LaunchContext.run_state``: the declared machines ...)."""
 
     def __init__(self) -> None:
         self._next = itertools.count(1)
+        self.run_state: dict[str, Any] = {}
 
     def next(self, base: str) -> str:
         return f"{base}-{next(self._next)}"
@@ -87,10 +91,12 @@ class Resolver:
         self.includes = IncludeChain()  # include cycles are errors, not a RecursionError
         self.depth = 0
         allow_deep_trees()
+        context.planner = self  # the seam: actions plan through their context (plan.planner)
+        context.run_state = labels.run_state
 
     # --- visiting -----------------------------------------------------------------------------
 
-    def visit(self, entity: Any) -> None:
+    def visit(self, entity: object) -> None:
         if self.depth >= DEPTH_LIMIT:
             origin = getattr(entity, "origin", None)
             raise too_deep(origin, "launch actions (groups, includes)", includes=self.includes)
@@ -100,7 +106,7 @@ class Resolver:
         finally:
             self.depth -= 1
 
-    def _visit(self, entity: Any) -> None:
+    def _visit(self, entity: object) -> None:
         visit = getattr(entity, "visit", None)
         if visit is None:
             raise LaunchFileError(
@@ -108,7 +114,7 @@ class Resolver:
                 " (expected actions such as Node, ExecuteProcess, DeclareLaunchArgument)"
             )
         try:
-            more = visit(self)
+            more = visit(self.context)
         except MlaunchError as e:
             origin = getattr(entity, "origin", None)
             if e.where is None and origin:
@@ -129,7 +135,7 @@ class Resolver:
         error.args = (error.message,)
         error.argument = None
 
-    def visit_all(self, entities: Iterable[Any]) -> None:
+    def visit_all(self, entities: Iterable[object]) -> None:
         for entity in entities:
             self.visit(entity)
 
@@ -162,6 +168,12 @@ class Resolver:
     def warn(self, message: str) -> None:
         self.plan.warnings.append(message)
 
+    def declare_argument(self, info: ArgumentInfo) -> ArgumentInfo:
+        return self.plan.arguments.setdefault(info.name, info)
+
+    def including(self, path: str, origin: str) -> AbstractContextManager[None]:
+        return self.includes.enter(path, origin, self.context)
+
     def new_label(self, base: str) -> str:
         return self.labels.next(base)
 
@@ -176,24 +188,23 @@ class Resolver:
             return Deferred(entities, snapshot, origin, callback)
         return Deferred(entities, self.context, origin, callback, captured=snapshot)
 
-    def float_value(self, value: Any, what: str, origin: str) -> float:
-        text = value if isinstance(value, (int, float)) else perform(self.context, value)
-        try:
-            number = float(text)
-        except (TypeError, ValueError):
-            raise MlaunchError(f"{what} is {text!r}, expected a number", where=origin)
-        if number != number or number in (float("inf"), float("-inf")):
-            raise MlaunchError(f"{what} is {text!r}, expected a finite number", where=origin)
-        return number
+    def float_value(self, value: object, what: str, origin: str) -> float:
+        return number(self.context, value, what, origin)
 
-    def load_source(self, source: Any, context: LaunchContext, origin: str) -> Any:
+    def load_source(self, source: object, origin: str) -> object:
         """The LaunchDescription an include names (built directly, or loaded from its file)."""
+        from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+
+        if not isinstance(source, LaunchDescriptionSource):
+            raise LaunchFileError(
+                f"{source!r:.60} is not a launch description source", where=origin
+            )
         if source.launch_description is not None:
             return source.launch_description
         from mlaunch import frontends
 
-        path = source.get_launch_file_location(context)
-        if not os.path.exists(path):
+        path = source.get_launch_file_location(self.context)
+        if path is None or not os.path.exists(path):
             raise LaunchFileError(f"included launch file {path!r} does not exist", where=origin)
         return frontends.load(path, source.format_hint)
 
@@ -306,18 +317,24 @@ def resolve_deferred(
 ) -> Plan:
     """Resolve a timer's or handler's entities now, in the context captured when registered."""
     plan = Plan(temp_dir=options.temp_dir)
+    live = deferred.context
+    if not isinstance(live, LaunchContext):
+        raise TypeError(f"a deferred step's context is {type(live).__name__}, not a LaunchContext")
     if deferred.captured is None:
-        context = deferred.context.snapshot()
+        context = live.snapshot()
     else:
         # launch's rule: the live state, which the body's own actions change for later ones.
-        context = deferred.context
+        context = live
+        captured = deferred.captured
+        assert isinstance(captured, LaunchContext)
         from mlaunch.resolve.binding import differences, warn_once
 
-        diffs = differences(deferred.captured, context, deferred.entities, deferred.callback)
-        message = warn_once(deferred.captured, deferred.origin, diffs)
+        diffs = differences(captured, context, deferred.entities, deferred.callback)
+        message = warn_once(captured, deferred.origin, diffs)
         if message:
             plan.warnings.append(message)
-    saved = context._locals, context._warn  # the live context's locals are the event's only now
+    # the live context's locals (and planner) are the event's only now
+    saved = context._locals, context._warn, context._planner
     context._locals, context._warn = dict(saved[0]), plan.warnings.append
     if event is not None:
         context.extend_locals({"event": event})
@@ -331,7 +348,7 @@ def resolve_deferred(
                 entities = returned_entities(resolver.call_user(deferred.callback, event, context))
             resolver.visit_all(entities)
     finally:
-        context._locals, context._warn = saved
+        context._locals, context._warn, context._planner = saved
     return plan
 
 

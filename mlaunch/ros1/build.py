@@ -38,7 +38,7 @@ from mlaunch.ros1.model import (
 )
 
 if TYPE_CHECKING:
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 
 class MappingWarning(Action):
@@ -49,8 +49,9 @@ class MappingWarning(Action):
         self.message = message
         self.origin = origin
 
-    def execute(self, resolver: Resolver) -> None:
-        resolver.warn(f"{rel_origin(self.origin)}: {self.message}")
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.warn(f"{rel_origin(self.origin)}: {self.message}")
 
     def describe_short(self) -> str:
         return f"warning: {self.message}"
@@ -63,14 +64,15 @@ class ConstantArgument(SetLaunchConfiguration):
         super().__init__(name, value)
         self.arg_name = name
 
-    def execute(self, resolver: Resolver) -> None:
-        given = {a.split(":=", 1)[0] for a in resolver.context.argv}
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        given = {a.split(":=", 1)[0] for a in context.argv}
         if self.arg_name in given:
-            resolver.warn(
+            planner.warn(
                 f"{rel_origin(self.origin)}: arg {self.arg_name!r} has a fixed value in the launch"
                 " file; the command-line value is ignored (roslaunch refuses to override it)"
             )
-        super().execute(resolver)
+        super().execute(context)
 
 
 def to_actions(items: list[Item]) -> list[Any]:

@@ -16,7 +16,7 @@ from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.plan.steps import Note
 
 if TYPE_CHECKING:
-    from mlaunch.resolve.resolver import Resolver
+    from mlaunch.launch.launch_context import LaunchContext
 
 CONFIG_PREFIX = "mlaunch_expect"
 KINDS = ("topic", "service", "node", "lifecycle", "output", "clock")
@@ -210,22 +210,22 @@ class Expect(Action):
         ((self.kind, self.target),) = given.items()
         self.rate, self.state, self.process, self.within = rate, state, process, within
 
-    def execute(self, resolver: Resolver) -> None:
-        ctx = resolver.context
-        target = perform(ctx, self.target)
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        target = perform(context, self.target)
         where = f"Expect at {self.origin}"
         if self.kind == "topic" and self.rate is not None:
             target = f"{target}:{self.rate}"
         elif self.kind == "lifecycle":
             target = f"{target}:{self.state}"
         elif self.kind == "output" and self.process is not None:
-            target = f"{perform(ctx, self.process)}:{target}"
+            target = f"{perform(context, self.process)}:{target}"
         try:
             expectation = parse_target(self.kind, target, where)
         except UsageError as e:
             raise LaunchFileError(str(e), where=self.origin) from None
         expectation.within = self.within
-        resolver.add(ExpectStep(origin=self.origin, expectation=expectation))
+        planner.add(ExpectStep(origin=self.origin, expectation=expectation))
 
 
 class _CollectConfigurations(Action):
@@ -236,8 +236,8 @@ class _CollectConfigurations(Action):
         self.found: list[Expectation] = []
         self.use_sim_time = False
 
-    def execute(self, resolver: Resolver) -> None:
-        configs = resolver.context.launch_configurations
+    def execute(self, context: LaunchContext) -> None:
+        configs = context.launch_configurations
         for name in sorted(configs):
             if name.startswith(CONFIG_PREFIX):
                 origin = f"launch configuration {name}"

@@ -1,0 +1,92 @@
+"""The seam between a launch action and what executes it: the ``Planner`` a context carries.
+
+Launch actions follow upstream's contract: ``entity.visit(context)`` returns the entities to
+visit next (or None), and ``Action.visit`` evaluates the condition, then calls
+``execute(context)``. Whatever an action makes happen at run time (a process, a timer, an event
+handler, an event, a shutdown) it hands to ``context.planner`` as a step of the Plan; the engine
+carries the steps out in order. Resolve (``mlaunch.resolve.resolver.Resolver``) is the planner of
+a run; a bare ``LaunchContext()`` gets a standalone one (``mlaunch.launch.planning``) that
+collects the steps, so an action can be visited on its own, as unit tests of extensions do.
+
+This layer knows no launch classes: entities and contexts are ``object`` here, and each side of
+the seam types them itself. Only type checkers import this module (typing costs start-up time).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from contextlib import AbstractContextManager
+from typing import Protocol, TypeVar
+
+from mlaunch.plan.steps import ArgumentInfo, Deferred, ProcessSpec, Step
+
+R = TypeVar("R")
+
+
+class PlanningOptions(Protocol):
+    """What the caller decided about planning that actions read."""
+
+    @property
+    def standins(self) -> bool: ...  # stand-ins may replace programs that are not installed
+
+    @property
+    def temp_dir(self) -> str | None: ...  # where params files are written
+
+    @property
+    def capture(self) -> bool: ...  # timers and handlers take the values where written
+
+    @property
+    def scoped_parameters(self) -> bool: ...  # SetParameter stays in its scoped group
+
+
+class Planner(Protocol):
+    """How an action's execution becomes steps of a Plan (see the module docstring)."""
+
+    @property
+    def options(self) -> PlanningOptions: ...
+
+    def add(self, step: Step) -> None:
+        """Append a step to the plan being built."""
+
+    def spawn(self, spec: ProcessSpec) -> None:
+        """Append the start of a process."""
+
+    def warn(self, message: str) -> None:
+        """A warning of planning, said once before the run."""
+
+    def new_label(self, base: str) -> str:
+        """launch's global ``name-N`` label for a process."""
+
+    def declare_argument(self, info: ArgumentInfo) -> ArgumentInfo:
+        """Note a launch argument; the first declaration of a name wins and is returned."""
+
+    def defer(
+        self,
+        entities: Iterable[object],
+        origin: str = "",
+        callback: Callable[..., object] | None = None,
+    ) -> Deferred:
+        """Entities (or a function returning them) to visit when a timer or handler fires."""
+
+    def visit(self, entity: object) -> None:
+        """Visit one entity now, then whatever its visit returns."""
+
+    def visit_all(self, entities: Iterable[object]) -> None:
+        """Visit entities in order."""
+
+    def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
+        """Call launch-file code, locating its exceptions in the user's file."""
+
+    def including(self, path: str, origin: str) -> AbstractContextManager[None]:
+        """While an included file is visited (include cycles are errors, not recursion)."""
+
+    def load_source(self, source: object, origin: str) -> object:
+        """The LaunchDescription an include's source names, built or loaded from its file."""
+
+    def locate_program(
+        self, argv: list[str], *, shell: bool, origin: str
+    ) -> tuple[list[str], str | None]:
+        """argv with a stand-in for a program that is not installed, and what it replaces."""
+
+    def float_value(self, value: object, what: str, origin: str) -> float:
+        """A finite number from a number or substitutions, or a located error."""
