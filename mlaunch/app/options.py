@@ -104,7 +104,8 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         "(ROS 1 -> ROS 2), 'mlaunch export FILE' (systemd units), 'mlaunch ctl [RUN] list|stop|"
         "start|restart|mute|unmute|logs LABEL' (control a running launch). "
         "Exit status: 0 ok, 1 a required process failed, 2 bad input, "
-        "70 an internal error of mlaunch, 128+N stopped by signal N (130 Ctrl-C).",
+        "70 an internal error of mlaunch, 74 stdout cannot be written, 128+N stopped by signal N"
+        " (130 Ctrl-C).",
     )
     parser.add_argument(
         "target", help="launch file, or package name followed by a launch file name"

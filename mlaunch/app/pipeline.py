@@ -136,6 +136,7 @@ def launch(opts: Options, attach: Sequence[Attach]) -> int:
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
     with Lifeline() as life:
         path, description = load_target(opts)
+        streams_back(path)
         if opts.show_args:
             from mlaunch.resolve.describe import format_arguments
             from mlaunch.resolve.resolver import collect_arguments
@@ -160,10 +161,19 @@ def launch(opts: Options, attach: Sequence[Attach]) -> int:
         plan, options, labels = resolve_for_run(
             opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir
         )
+        streams_back(path)
         if opts.print_plan:
             write_stdout(describe(opts, plan, path))
             return 0
         return supervise(opts, plan, options, labels, log_dir, life, attach)
+
+
+def streams_back(path: str) -> None:
+    """Reopen the standard streams the launch file's code closed (it runs in this interpreter)."""
+    from mlaunch.engine.lifeline import ensure_std_streams, say
+
+    for name in ensure_std_streams():
+        say(f"mlaunch: warning: {path} closed sys.{name}; mlaunch opened it again for itself")
 
 
 def describe(opts: Options, plan: Plan, path: str) -> str:

@@ -6,6 +6,7 @@ Exit status (the table is mlaunch.plan.errors'):
   2    bad command line or launch file: missing file, syntax error, bad argument, failed
        substitution, missing package or executable (one line on stderr, no traceback)
   70   an internal error of mlaunch (a bug: --debug shows the traceback)
+  74   standard output cannot be written (a full disk, /dev/full): one line on stderr
   128+N  mlaunch was stopped by signal N: 130 for Ctrl-C (SIGINT), 143 SIGTERM, 129 SIGHUP
 """
 
@@ -35,6 +36,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         from mlaunch.engine.lifeline import stdout_gone
 
         return stdout_gone()
+    except OSError as e:
+        return report_error(_output_error(e) if _is_write_error(e) else e, debug)
     except (Exception, KeyboardInterrupt) as e:  # KeyboardInterrupt: Ctrl-C, lifeline.Stopped
         return report_error(e, debug)
 
@@ -84,12 +87,40 @@ def program() -> None:
         code = main()
     except SystemExit as e:  # argparse's usage errors and --help
         code = e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    code = flush_std_streams(code)
+    os._exit(code)
+
+
+def flush_std_streams(code: int) -> int:
+    """Flush what print() left buffered; a stdout that cannot take it makes a 0 status 74."""
+    from mlaunch.plan.errors import EXIT_OUTPUT
+
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
-        except (OSError, ValueError):  # a closed pipe (mlaunch ... | head)
+        except BrokenPipeError:  # a closed pipe (mlaunch ... | head)
             pass
-    os._exit(code)
+        except OSError as e:
+            if stream is sys.stdout and code == 0:
+                report_error(_output_error(e), False)
+                code = EXIT_OUTPUT
+        except ValueError:  # closed
+            pass
+    return code
+
+
+def _is_write_error(error: OSError) -> bool:
+    """A write that the disk or device refused (no file named: print() to a full stdout)."""
+    import errno
+
+    codes = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO)
+    return error.errno in codes and error.filename is None
+
+
+def _output_error(error: OSError) -> Exception:
+    from mlaunch.plan.errors import OutputError
+
+    return OutputError(f"cannot write to standard output: {error.strerror or error}")
 
 
 if __name__ == "__main__":

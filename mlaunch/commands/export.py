@@ -114,7 +114,9 @@ def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) ->
         remove_private_dir(temp_dir)
     for warning in export.warnings:
         print(f"mlaunch export: warning: {warning}", file=sys.stderr)
-    print(f"wrote {len(units)} services and {prefix}.target to {out_dir} (see its README.md)")
+    from mlaunch.engine.lifeline import write_stdout
+
+    write_stdout(f"wrote {len(units)} services and {prefix}.target to {out_dir} (see README.md)\n")
     return 0
 
 

@@ -29,7 +29,7 @@ import time
 
 from mlaunch.engine import guard as guards
 from mlaunch.engine import proctable
-from mlaunch.plan.errors import exit_for_signal
+from mlaunch.plan.errors import OutputError, exit_for_signal
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -229,11 +229,14 @@ def remove_private_dir(path: str) -> None:
         pass
 
 
-def ensure_std_streams() -> None:
-    """Give a closed fd 0, 1 or 2 /dev/null, and Python a stream for it.
+def ensure_std_streams() -> list[str]:
+    """Give a closed fd 0, 1 or 2 /dev/null, and Python a stream for it; the names of the Python
+    streams (``sys.stdout`` ...) that had none or a closed one.
 
     Started with stdout closed (``>&-``), the first file mlaunch opens would otherwise get
-    fd 1, and the terminal's output would go into it (a log file, the guard's pipe).
+    fd 1, and the terminal's output would go into it (a log file, the guard's pipe). A launch
+    file runs in mlaunch's interpreter and may close ``sys.stdout`` (or fd 1) itself: called
+    again after loading and resolving, this gives mlaunch its streams back.
     """
     for fd in (0, 1, 2):
         try:
@@ -245,12 +248,16 @@ def ensure_std_streams() -> None:
         if devnull != fd:
             os.dup2(devnull, fd)
             os.close(devnull)
-    if sys.stdin is None:
-        sys.stdin = open(0, encoding="utf-8", closefd=False)  # noqa: SIM115
-    if sys.stdout is None:
-        sys.stdout = open(1, "w", encoding="utf-8", closefd=False)  # noqa: SIM115
-    if sys.stderr is None:
-        sys.stderr = open(2, "w", encoding="utf-8", errors="backslashreplace", closefd=False)  # noqa: SIM115
+    restored = []
+    for fd, name in enumerate(("stdin", "stdout", "stderr")):
+        stream = getattr(sys, name)
+        if stream is not None and not getattr(stream, "closed", False):
+            continue
+        errors = "backslashreplace" if name == "stderr" else "strict"
+        mode = "r" if fd == 0 else "w"
+        setattr(sys, name, open(fd, mode, encoding="utf-8", errors=errors, closefd=False))  # noqa: SIM115
+        restored.append(name)
+    return restored
 
 
 def say(text: str) -> None:
@@ -273,10 +280,15 @@ def write_stdout(text: str) -> None:
     except (AttributeError, ValueError, OSError):  # not a file (a test's capture)
         sys.stdout.write(text)
         return
-    sys.stdout.flush()
     view = memoryview(text.encode("utf-8", "surrogateescape"))
-    while view:
-        view = view[os.write(fd, view) :]
+    try:
+        sys.stdout.flush()
+        while view:
+            view = view[os.write(fd, view) :]
+    except BrokenPipeError:
+        raise
+    except OSError as e:  # /dev/full, a full disk or quota, an I/O error: not mlaunch's bug
+        raise OutputError(f"cannot write to standard output: {e.strerror or e}") from None
 
 
 def stdout_gone() -> int:

@@ -327,7 +327,7 @@ class Entity:
         try:
             parts = parse_template(text)
         except TemplateError as e:
-            raise self.error(f"{e.message} in {text!r}", attr, e.index)
+            raise self.error(f"{e.message} in {_excerpt(text, e.index)}", attr, e.index)
         if len(parts) == 1 and isinstance(parts[0], str):
             return parts[0]
         return parts
@@ -360,3 +360,12 @@ def _did_you_mean(name: str, options: Any) -> str:
 def did_you_mean(name: str, options: Any) -> str:
     """`` (did you mean 'x'?)`` when a close option exists, else empty."""
     return _did_you_mean(name, options)
+
+
+def _excerpt(text: str, index: int, width: int = 60) -> str:
+    """``text`` quoted, cut to ``width`` characters either side of ``index`` when it is long
+    (one error line, not a 60 KB generated attribute)."""
+    if len(text) <= 3 * width:
+        return repr(text)
+    start, end = max(0, index - width), index + width
+    return ("..." if start else "") + repr(text[start:end]) + ("..." if end < len(text) else "")

@@ -50,6 +50,7 @@ def load(path: str) -> LaunchDescription:
             raise not_utf8(source, path) or LaunchFileError(e.msg, where=f"{path}:{e.lineno}")
         col = f":{e.offset}" if e.offset else ""
         raise LaunchFileError(f"Python syntax error: {e.msg}", where=f"{path}:{e.lineno}{col}")
+    check_encoding(source, path)
     module = types.ModuleType("python_launch_file")
     module.__file__ = path
     run_user_code(path, lambda: exec(code, module.__dict__), "while loading the launch file")
@@ -64,6 +65,25 @@ def load(path: str) -> LaunchDescription:
             where=path,
         )
     return description
+
+
+def check_encoding(source: bytes, path: str) -> None:
+    """Refuse bytes that are not UTF-8 without a ``# coding:`` line, wherever they are.
+
+    compile() of bytes lets a bad byte in a comment through; Python's import and ros2 launch
+    refuse the file ("Non-UTF-8 code starting with '\\xe9'"), and so does mlaunch.
+    """
+    try:
+        source.decode("utf-8")
+    except UnicodeDecodeError:
+        import re  # error path only
+
+        head = source.split(b"\n", 2)[:2]
+        if any(re.match(rb"[ \t\f]*#.*?coding[:=][ \t]*[-\w.]+", line) for line in head):
+            return
+        from mlaunch.frontends.encoding import not_utf8
+
+        raise not_utf8(source, path) or LaunchFileError("the file is not UTF-8", where=path)
 
 
 def run_user_code(path: str, call: Any, during: str) -> Any:

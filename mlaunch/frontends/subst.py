@@ -25,6 +25,7 @@ import re
 from collections.abc import Callable
 
 import mlaunch.launch.substitutions as core
+from mlaunch.launch.substitution import SUBSTITUTION_DEPTH_LIMIT
 from mlaunch.launch.substitutions import Substitution
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -208,6 +209,7 @@ class _Scanner:
     def __init__(self, text: str) -> None:
         self.s = text
         self.n = len(text)
+        self.depth = 0  # substitutions open around the one being read
 
     def top(self, parts: Parts) -> None:
         s, i, n = self.s, 0, self.n
@@ -251,7 +253,23 @@ class _Scanner:
         spec = SUBSTITUTIONS.get(name)
         if spec is None:
             raise TemplateError(_unknown_name(name), m.start())
-        i = m.end()
+        if self.depth >= SUBSTITUTION_DEPTH_LIMIT:
+            raise TemplateError(
+                f"substitutions nest deeper than {SUBSTITUTION_DEPTH_LIMIT} levels, mlaunch's"
+                " limit; flatten them",
+                start,
+            )
+        self.depth += 1
+        try:
+            return self.substitution_body(start, name, spec, m.end(), quote)
+        finally:
+            self.depth -= 1
+
+    def substitution_body(
+        self, start: int, name: str, spec: SubstitutionSpec, i: int, quote: str | None
+    ) -> tuple[Substitution, int]:
+        """The arguments and ')' of ``$(name`` (read up to ``i``), built into its Substitution."""
+        s = self.s
         args: list[Parts] = []
         if i >= self.n:
             raise TemplateError(f"'$({name}' is not closed with ')'", start)

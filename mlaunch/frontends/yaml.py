@@ -71,6 +71,8 @@ class _Reader:
             raise LaunchFileError(f"malformed YAML: {e}", where=self.path)
         if root is None:
             raise LaunchFileError("the file is empty; expected a 'launch:' list", where=self.path)
+        if b"&" in data:  # an anchor: aliases may repeat what it names (no '&', no alias)
+            self.check_expansion(root)
         if not isinstance(root, MappingNode) or len(root.value) != 1:
             raise self.error(root, "the root must be a map with the single key 'launch'")
         key, value = root.value[0]
@@ -95,6 +97,37 @@ class _Reader:
                     )
             elif isinstance(event, CollectionEndEvent):
                 depth -= 1
+
+    def check_expansion(self, root: Node) -> None:
+        """Stop aliases that expand the file past ``EXPANDED_NODE_LIMIT`` nodes, or into itself.
+
+        Composing shares an anchored node among its aliases, so a 75-line file of lists of
+        aliases of lists (a "billion laughs") composes at once and only explodes when walked:
+        24 levels took 6.5 GB, 16 planned 131,071 processes. Each node's expanded size is
+        counted once (iteratively, a flat walk), before any entity is built.
+        """
+        sizes: dict[int, int] = {}
+        on_path: set[int] = set()
+        stack: list[tuple[Node, bool]] = [(root, False)]
+        while stack:
+            node, finished = stack.pop()
+            key = id(node)
+            if finished:
+                on_path.discard(key)
+                size = 1 + sum(sizes[id(c)] for c in _node_children(node))
+                if size > EXPANDED_NODE_LIMIT:
+                    raise self.error(
+                        node,
+                        f"YAML aliases expand this {_shape(node)[2:]} past {EXPANDED_NODE_LIMIT:,}"
+                        " nodes, mlaunch's limit for a launch file (an alias bomb?)",
+                    )
+                sizes[key] = size
+            elif key in on_path:
+                raise self.error(node, f"a YAML alias repeats the {_shape(node)[2:]} it is in")
+            elif key not in sizes:
+                on_path.add(key)
+                stack.append((node, True))
+                stack.extend((c, False) for c in _node_children(node))
 
     # --- nodes to entities ----------------------------------------------------------------------
 
@@ -216,6 +249,16 @@ class _Reader:
 
 # A nesting level of groups is two or three YAML levels (a map, its children list ...).
 _NODE_DEPTH_LIMIT = 3 * DEPTH_LIMIT
+# YAML nodes a launch file may expand to, aliases repeated: a 10,000-line file has ~30,000.
+EXPANDED_NODE_LIMIT = 200_000
+
+
+def _node_children(node: Node) -> list[Node]:
+    if isinstance(node, SequenceNode):
+        return list(node.value)
+    if isinstance(node, MappingNode):
+        return [n for pair in node.value for n in pair]
+    return []
 
 
 def _bound_of_depth(data: bytes) -> int:

@@ -78,11 +78,29 @@ def is_substitution_like(value: Any) -> bool:
     )
 
 
+# How deep substitutions may nest in one another ($(env X $(env Y ...)), or the same built in a
+# loop in Python): real files nest a handful; 200 levels cost ~600 interpreter frames, which fits
+# beside the deepest launch tree (mlaunch.frontends.limits), where 20,000 ended in a RecursionError.
+SUBSTITUTION_DEPTH_LIMIT = 200
+_depth = [0]  # substitutions being performed inside one another now (resolving is one thread)
+
+
 def perform_substitutions(context: LaunchContext, subs: Sequence[Substitution]) -> str:
     """Perform each substitution and concatenate the results."""
-    if len(subs) == 1:
-        return subs[0].perform(context)
-    return "".join(s.perform(context) for s in subs)
+    if _depth[0] >= SUBSTITUTION_DEPTH_LIMIT:
+        from mlaunch.plan.errors import SubstitutionFailure  # error path only
+
+        raise SubstitutionFailure(
+            f"substitutions nest deeper than {SUBSTITUTION_DEPTH_LIMIT} levels, mlaunch's limit"
+            f" (the innermost: {subs[0].describe()[:60] if subs else '?'}); flatten them"
+        )
+    _depth[0] += 1
+    try:
+        if len(subs) == 1:
+            return subs[0].perform(context)
+        return "".join(s.perform(context) for s in subs)
+    finally:
+        _depth[0] -= 1
 
 
 def perform(context: LaunchContext, value: Any) -> str:

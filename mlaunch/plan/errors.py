@@ -15,6 +15,7 @@ EXIT_OK = 0  # every process ended and nothing required failed; a smoke run or t
 EXIT_FAILURE = 1  # a required process failed; a smoke expectation or a launch test failed
 EXIT_USAGE = 2  # bad input: command line, launch file, argument, substitution, package
 EXIT_INTERNAL = 70  # a bug in mlaunch (BSD's EX_SOFTWARE): reported with --debug for details
+EXIT_OUTPUT = 74  # stdout cannot be written (BSD's EX_IOERR): a full disk, /dev/full, EIO
 SIGNAL_BASE = 128  # stopped by signal N: 128 + N, as a shell reports it
 EXIT_INTERRUPTED = SIGNAL_BASE + 2  # Ctrl-C (SIGINT)
 
@@ -120,6 +121,12 @@ class PackageNotFoundError(MlaunchError):
 
 class UsageError(MlaunchError):
     """The command line itself is wrong."""
+
+
+class OutputError(MlaunchError):
+    """Standard output cannot be written (not a reader that left: that is SIGPIPE's 141)."""
+
+    exit_code = EXIT_OUTPUT
 
 
 class StandinError(MlaunchError):
