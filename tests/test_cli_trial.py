@@ -267,6 +267,7 @@ def test_readme_exit_status_table_is_the_codes() -> None:
     rows = re.findall(r"^\| ([0-9+N]+) \| (.+) \|$", section.split("\n\n", 2)[1], re.M)
     statuses = [status for status, _ in rows]
     codes = [errors.EXIT_OK, errors.EXIT_FAILURE, errors.EXIT_USAGE, errors.EXIT_INTERNAL]
+    codes.append(errors.EXIT_OUTPUT)
     assert statuses == [*map(str, codes), f"{errors.SIGNAL_BASE}+N"]
     meaning = dict(rows)
     assert "130 for Ctrl-C" in meaning["128+N"]
