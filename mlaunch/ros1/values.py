@@ -22,7 +22,10 @@ def convert_value(value: str, type_name: str) -> Any:
     kind = type_name.lower()
     if kind == "auto":
         try:
-            return float(value) if "." in value else int(value)
+            if "." in value:
+                return float(value)
+            if "_" not in value:  # Python reads 1_000 as a number; roslaunch keeps it text
+                return int(value)
         except ValueError:
             pass
         if value.lower() in ("true", "false"):

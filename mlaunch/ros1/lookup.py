@@ -1,0 +1,105 @@
+"""How a roslaunch file finds packages and runs ``<param command>``, as ROS 1 does.
+
+``$(find pkg)`` is rospack's lookup: the folders of ``ROS_PACKAGE_PATH`` (a folder with a
+``package.xml`` is a package; its subfolders are not searched), then Debian's ``/usr/share``
+(where Debian installs ROS 1 packages), then mlaunch's own search (installed ROS 2 packages and
+source packages near the launch file). ``xacro`` found nowhere is the PyPI xacro mlaunch runs
+in-process, so ``$(find xacro)/xacro FILE`` works without a ROS xacro package.
+"""
+
+from __future__ import annotations
+
+import os
+import shlex
+import subprocess
+from collections.abc import Callable, Mapping
+
+from mlaunch.plan.errors import LaunchFileError
+from mlaunch.ros.packages import package_name
+
+XACRO_PROGRAMS = ("xacro", "xacro.py")
+
+
+def ros_package_folders(environ: Mapping[str, str]) -> dict[str, str]:
+    """Package name -> folder along ROS_PACKAGE_PATH and /usr/share (first found wins)."""
+    found: dict[str, str] = {}
+    roots = [p for p in environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+    for root in [*roots, "/usr/share"]:
+        _crawl(root, found, depth=0 if root == "/usr/share" else 16)
+    return found
+
+
+def _crawl(folder: str, found: dict[str, str], depth: int) -> None:
+    manifest = os.path.join(folder, "package.xml")
+    if os.path.isfile(manifest):
+        name = package_name(manifest)
+        if name and name not in found:
+            found[name] = folder
+        return
+    try:
+        entries = sorted(os.scandir(folder), key=lambda e: e.name)
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith(".") or not entry.is_dir():
+            continue
+        if depth > 0 or os.path.isfile(os.path.join(entry.path, "package.xml")):
+            _crawl(entry.path, found, depth - 1)
+
+
+def package_finder(launch_file: str, environ: Mapping[str, str]) -> Callable[[str], str]:
+    """``$(find pkg)`` for one resolution (the folders are scanned once)."""
+    cache: dict[str, str] | None = None
+
+    def find(name: str) -> str:
+        nonlocal cache
+        if cache is None:
+            cache = ros_package_folders(environ)
+        if name in cache:
+            return cache[name]
+        from mlaunch.ros import packages
+
+        package = packages.index(environ=environ, launch_files=[launch_file]).find(name)
+        if package is not None:
+            return str(package.share_directory)
+        if name == "xacro":
+            import xacro
+
+            return os.path.dirname(os.path.abspath(str(xacro.__file__)))
+        raise LaunchFileError(f"package {name!r} not found (ROS_PACKAGE_PATH, /usr/share)")
+
+    return find
+
+
+def command_runner(environ: Mapping[str, str], launch_file: str) -> Callable[[str], str]:
+    """``<param command>``: the program's standard output (xacro runs in-process)."""
+
+    def run(command: str) -> str:
+        argv = shlex.split(command)
+        if not argv:
+            raise LaunchFileError("<param command> is empty")
+        if os.path.basename(argv[0]) in XACRO_PROGRAMS and not _is_program(argv[0]):
+            from mlaunch.launch_ros import xacro
+            from mlaunch.ros import packages
+
+            index = packages.index(environ=environ, launch_files=[launch_file])
+            rc, out, err = xacro.run_program(["xacro", *argv[1:]], environ, index)
+            if rc != 0:
+                raise LaunchFileError(xacro.failure_message(argv, rc, err))
+            return out
+        try:
+            done = subprocess.run(argv, capture_output=True, env=dict(environ), check=False)
+        except OSError as e:
+            raise LaunchFileError(f"cannot run <param command> {command!r}: {e.strerror}")
+        if done.returncode != 0:
+            raise LaunchFileError(
+                f"<param command> {command!r} exited with status {done.returncode}:"
+                f" {done.stderr.decode('utf-8', 'replace').strip()}"
+            )
+        return done.stdout.decode("utf-8")
+
+    return run
+
+
+def _is_program(path: str) -> bool:
+    return os.path.isfile(path) and os.access(path, os.X_OK)
