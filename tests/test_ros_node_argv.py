@@ -766,7 +766,7 @@ def test_missing_package_names_what_was_searched(prefix: Path, temp_dir: str) ->
     text = str(err.value)
     assert "package 'no_such_pkg_xyz' not found, wanted for executable 'run_me'" in text
     assert f"ament prefixes searched: {prefix}" in text
-    assert "source packages searched under:" in text
+    assert "--package-path DIR" in text and "MLAUNCH_PACKAGE_PATH" in text
     assert err.value.where == node.origin
     assert err.value.what == "Node(package='no_such_pkg_xyz', executable='run_me')"
     assert isinstance(err.value, KeyError)  # as ament_index_python's error is

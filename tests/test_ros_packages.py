@@ -164,7 +164,8 @@ def test_missing_package_error_says_where_it_looked(tmp_path: Path) -> None:
     assert str(prefix) in message and str(tmp_path / "src") in message
     assert isinstance(err.value, KeyError) and isinstance(err.value, LookupError)
     unset = packages.index(environ={}).searched()
-    assert unset.startswith("AMENT_PREFIX_PATH is not set; source packages searched under:")
+    assert unset.startswith("AMENT_PREFIX_PATH is not set; ")
+    assert "--package-path DIR" in unset and "MLAUNCH_PACKAGE_PATH" in unset
 
 
 def test_scanning_this_repository_finds_its_robots_once() -> None:

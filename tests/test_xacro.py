@@ -202,7 +202,7 @@ def test_errors_name_the_file_line_and_xacros_message(tmp_path: Path) -> None:
     assert err.value.message.startswith(
         f"xacro failed on {find}: PackageNotFoundError: package 'no_such_pkg' not found"
     )
-    assert "source packages searched under" in err.value.message and missing
+    assert "--package-path DIR" in err.value.message and missing
 
 
 def test_a_broken_robot_description_is_located_at_the_node(tmp_path: Path) -> None:

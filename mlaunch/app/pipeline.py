@@ -107,6 +107,7 @@ def resolve_for_run(
         temp_dir=temp_dir,
         capture=opts.capture,
         scoped_parameters=opts.scoped_parameters,
+        dry_run=opts.print_plan,
     )
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions import with_use_sim_time

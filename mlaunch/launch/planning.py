@@ -29,6 +29,7 @@ class StandaloneOptions:
 
     __slots__ = ()
     standins = False
+    dry_run = False
     temp_dir: str | None = None
     capture = False
     scoped_parameters = False

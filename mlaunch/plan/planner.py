@@ -38,6 +38,9 @@ class PlanningOptions(Protocol):
     @property
     def scoped_parameters(self) -> bool: ...  # SetParameter stays in its scoped group
 
+    @property
+    def dry_run(self) -> bool: ...  # --print: a program not built is a warning, not an error
+
 
 class Planner(Protocol):
     """How an action's execution becomes steps of a Plan (see the module docstring)."""

@@ -53,7 +53,7 @@ class ResolveOptions(Record):
     None for the default search); ``temp_dir`` is where params files are written.
     """
 
-    _fields = ("standins", "packages", "temp_dir", "capture", "scoped_parameters")
+    _fields = ("standins", "packages", "temp_dir", "capture", "scoped_parameters", "dry_run")
     __slots__ = _fields
 
     def __init__(
@@ -63,6 +63,7 @@ class ResolveOptions(Record):
         temp_dir: str | None = None,
         capture: bool = False,
         scoped_parameters: bool = False,
+        dry_run: bool = False,
     ) -> None:
         self.standins = standins
         self.packages = packages
@@ -71,6 +72,9 @@ class ResolveOptions(Record):
         self.capture = capture
         # SetParameter(s)FromFile stay inside scoped groups (mlaunch.launch_ros.actions).
         self.scoped_parameters = scoped_parameters
+        # --print: a program that is not built or installed is a warning and the plan is shown
+        # (a dry run on a laptop); a run refuses it before anything starts.
+        self.dry_run = dry_run
 
 
 class Resolver:
@@ -238,8 +242,16 @@ class Resolver:
         hint = standins.hint_for(argv) if not self.options.standins else ""
         if os.sep in program:
             problem = "does not exist" if not os.path.exists(program) else "is not executable"
-            raise PackageNotFoundError(f"program {program!r} {problem}{hint}", where=origin)
-        raise PackageNotFoundError(f"program {program!r} not found on the PATH{hint}", where=origin)
+            error = PackageNotFoundError(f"program {program!r} {problem}{hint}", where=origin)
+        else:
+            error = PackageNotFoundError(
+                f"program {program!r} not found on the PATH{hint}", where=origin
+            )
+        if not self.options.dry_run:
+            raise error
+        if not any(f"shown as {program!r}," in w for w in self.plan.warnings):  # a Node's, said
+            self.warn(f"{error}; a run refuses to start without it")
+        return argv, None
 
 
 def _note_needs(entities: Iterable[Any], needs: set[str]) -> None:

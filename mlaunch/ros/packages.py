@@ -231,7 +231,13 @@ class PackageIndex:
         else:
             where = f"ament prefixes searched: {', '.join(prefixes) or '(none exist)'}"
         sources = self.source_paths()
-        return f"{where}; source packages searched under: {', '.join(sources) or '(none)'}"
+        hint = (
+            "; name the folders that hold it with --package-path DIR (repeatable) or"
+            " MLAUNCH_PACKAGE_PATH=DIR[:DIR...], or source its workspace's setup"
+        )
+        if not sources:  # a launch file outside any repository, nothing named
+            return f"{where}; no source folder to search{hint}"
+        return f"{where}; source packages searched under: {', '.join(sources)}{hint}"
 
 
 def _is_program(path: str) -> bool:
