@@ -217,7 +217,7 @@ def test_early_exit_fails_with_status_and_last_output(tmp_path: Path) -> None:
     assert done.returncode == 1, done.stdout + done.stderr
     row = _row(done.stdout, "process worker-2")
     assert row.startswith("FAIL")
-    assert "exited with status 4 after" in row and "before the test ended" in row
+    assert "exited with status 4 after" in row and "before the launch was ready" in row
     assert "last output of worker-2:\n  | warming up\n  | bye\n" in done.stdout
     case = (
         ET.parse(report)
@@ -366,7 +366,7 @@ def test_system_passes_with_lifecycle_nodes_brought_up_in_order(
         (
             ["variant:=crash"],
             "process lidar-2 starts and keeps running",
-            r"exited with status 3 after [\d.]+ s \(pid \d+\), before the test ended",
+            r"exited with status 3 after [\d.]+ s \(pid \d+\), before the launch was ready",
         ),
         (
             # The deadline of this one check only: the others keep the default 30 s, so a

@@ -12,12 +12,16 @@ Ready means, by default:
   - with use_sim_time (``--use-sim-time``, ``use_sim_time:=true``, a SetParameter or a node's
     own parameter), ``/clock`` is advancing;
 and at the end, every process stopped within its stop ladder (none needed SIGKILL). A process
-that exits with a failure (non-zero status, or a signal) before the end fails the test; one that
-exits 0 is a one-shot (a spawner, a loader) and fine, unless it was started with respawn: a
-respawning process that exits fails even with status 0, and ``--allow-exit LABEL`` lets it
-(label or base name) finish with status 0. At the end, a process that started less than
-STARTUP_GRACE seconds ago is given the rest of that time before the stop signals, so it is not
-interrupted half-way through its imports. Processes started later by
+that exits with a failure (non-zero status, or a signal) fails the test, whenever it happens:
+before ready, during the hold or during the shutdown (there, only the stop signal mlaunch sent
+is a clean end: "stopped by SIGINT"); a required process (on_exit=Shutdown()) that crashes
+fails it although the launch then shuts down as it should. One that exits 0 is a one-shot (a
+spawner, a loader) and fine, unless it was started with respawn: a respawning process that
+exits fails even with status 0. ``--allow-exit LABEL[:CODES]`` lets a process (label or base
+name) end that way: without CODES with status 0; CODES is a comma-separated list of statuses
+and signals (``--allow-exit driver:0,3,SIGSEGV``), or ``any``. At the end, a process that
+started less than STARTUP_GRACE seconds ago is given the rest of that time before the stop
+signals, so it is not interrupted half-way through its imports. Processes started later by
 timers or event handlers are watched from when they start.
 
 More expectations, from the command line (each has the overall ``--timeout`` as deadline unless
@@ -150,9 +154,10 @@ def build_parser() -> argparse.ArgumentParser:
         "--allow-exit",
         action="append",
         default=[],
-        metavar="LABEL",
-        help="a respawning process (label or base name) that may still finish with status 0"
-        " (repeatable; a process without respawn that exits 0 is a one-shot, fine anyway)",
+        metavar="LABEL[:CODES]",
+        help="a process (label or base name) that may end with status 0, or with one of CODES"
+        " (statuses and signals, comma-separated: driver:3,SIGSEGV; or driver:any); repeatable."
+        " A process without respawn that exits 0 is a one-shot, fine anyway",
     )
     return parser
 
@@ -207,6 +212,8 @@ def parse_settings(args: Sequence[str]) -> Settings:
             raise UsageError(f"{what} {value!r}: expected a number of seconds >= 0")
     if ns.timeout == 0:
         raise UsageError("--timeout 0: the deadline must be > 0 seconds")
+    for value in ns.allow_exit:
+        parse_allow_exit(value)  # a bad CODES is a usage error before anything starts
     return Settings(
         expectations=list(getattr(ns, "expectations", None) or []),
         timeout=ns.timeout,
@@ -214,3 +221,33 @@ def parse_settings(args: Sequence[str]) -> Settings:
         junit=ns.junit,
         allow_exit=list(ns.allow_exit),
     )
+
+
+def parse_allow_exit(value: str) -> tuple[str, frozenset[int] | None]:
+    """``LABEL[:CODES]`` of --allow-exit: (label, the return codes allowed; None: any).
+
+    Return codes as the supervisor has them: a status (0-255) or minus a signal's number.
+    """
+    import signal
+
+    label, sep, codes = value.partition(":")
+    if not label:
+        raise UsageError(f"--allow-exit {value!r}: expected LABEL[:CODES] (a process label first)")
+    if not sep:
+        return label, frozenset({0})
+    if codes.strip().lower() == "any":
+        return label, None
+    allowed: set[int] = set()
+    for word in codes.split(","):
+        word = word.strip()
+        name = word.upper() if word.upper().startswith("SIG") else "SIG" + word.upper()
+        if word.isdigit() and int(word) <= 255:
+            allowed.add(int(word))
+        elif name in signal.Signals.__members__:
+            allowed.add(-signal.Signals[name].value)
+        else:
+            raise UsageError(
+                f"--allow-exit {value!r}: {word!r} is neither an exit status (0-255) nor a signal"
+                " name (SIGSEGV, ABRT ...); CODES is a comma-separated list of them, or 'any'"
+            )
+    return label, frozenset(allowed)

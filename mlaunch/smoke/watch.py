@@ -32,6 +32,12 @@ GRAPH_PERIOD = 0.2
 TICK = 0.1
 # Waiting for a lifecycle node's get_state answer while checking (it is asked again later).
 STATE_QUERY_TIMEOUT = 1.0
+# Where the run was when a process ended, in the words of the report's table.
+_PHASES = {
+    "waiting": "before the launch was ready",
+    "holding": "during the hold",
+    "done": "in the shutdown",
+}
 GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock"})
 _ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
@@ -163,20 +169,30 @@ class SmokeRun:
         self._checker.start()
 
     def _exited(self, e: Expectation, process: Process) -> None:
+        """A process ended: a failure whenever it happens (before ready, in the hold, in the
+        shutdown), unless it was a one-shot, the end of mlaunch's own stop or allowed."""
         from mlaunch.engine.process import describe_status
 
+        if process.user_stop:
+            return  # stopped or restarted through mlaunch ctl: the user's own act
         code = process.returncode if process.returncode is not None else 0
         uptime = max(0.0, process.ended_at - process.started_at)
         what = f"{describe_status(code)} after {uptime:.1f} s (pid {process.pid})"
-        if self.phase == "done" or process.stopping or self.supervisor.shutting_down:
-            return
-        if code == 0 and process.spec.respawn.mode == "never":
+        if process.stopping:
+            if code == 0 or _stop_signal(code, process.signals_sent):
+                return  # the stop ladder's own end (SIGKILL: the shutdown check says so)
+            what += f", after mlaunch's {'/'.join(_names(process.signals_sent))}"
+        elif code == 0 and (process.spec.respawn.mode == "never" or self.supervisor.shutting_down):
             e.seen = f"{what}: a one-shot, finished"
             return
-        if code == 0 and _allowed(process.spec, self.settings.allow_exit):
+        if _allowed(process.spec, self.settings.allow_exit, code):
             e.seen = f"{what}: allowed by --allow-exit"
             return
-        self._fail(e, f"{what}, before the test ended")
+        seen = f"{what}, {_PHASES[self.phase]}"
+        if self.phase == "done":
+            self._mark(e, "failed", seen)  # the verdict counts it; the shutdown is under way
+        else:
+            self._fail(e, seen)
 
     def _on_transition(self, outcome: Outcome) -> None:
         """The lifecycle manager's results: a failed bring-up fails its node's check at once."""
@@ -348,8 +364,26 @@ def _messages(count: int) -> str:
     return "1 message" if count == 1 else f"{count} messages"
 
 
-def _allowed(spec: ProcessSpec, allowed: Iterable[str]) -> bool:
-    return any(name in (spec.label, spec.base_name) for name in allowed)
+def _allowed(spec: ProcessSpec, allowed: Iterable[str], code: int) -> bool:
+    """Whether an --allow-exit LABEL[:CODES] lets ``spec``'s process end with ``code``."""
+    from mlaunch.smoke.settings import parse_allow_exit
+
+    for value in allowed:
+        name, codes = parse_allow_exit(value)
+        if name in (spec.label, spec.base_name) and (codes is None or code in codes):
+            return True
+    return False
+
+
+def _stop_signal(code: int, sent: Iterable[int]) -> bool:
+    """Ended by a stop signal mlaunch sent (killed by it, or a shell's 128+N for it)."""
+    return any(code in (-sig, 128 + sig) for sig in sent)
+
+
+def _names(signals: Iterable[int]) -> list[str]:
+    from mlaunch.engine.process import signal_name
+
+    return [signal_name(int(s)) for s in signals] or ["stop"]
 
 
 def _graph_environ(plan: Plan) -> dict[str, str]:
