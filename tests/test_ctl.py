@@ -293,3 +293,18 @@ def test_a_log_folder_that_takes_no_socket_sends_it_to_the_runtime_folder(tmp_pa
     assert [p["label"] for p in processes] == ["only"]
     assert stat.S_IMODE(os.stat(runtime / "mlaunch").st_mode) == 0o700
     assert not os.path.exists(path) and not (logs / "control" / "where").exists()
+
+
+def test_options_go_anywhere_as_the_readme_writes_them(live: Live) -> None:
+    """``mlaunch ctl logs -n 3 talker`` (the README's form) was a usage error."""
+    for args in (
+        ("logs", "-n", "3", "talker"),
+        ("-n", "3", "logs", "talker"),
+        ("logs", "talker", "-n", "3"),
+        ("latest", "logs", "-n", "3", "talker"),
+        ("logs", "--lines=3", "talker"),
+    ):
+        lines = live.ok(*args).splitlines()
+        assert len(lines) == 3 and all(line.startswith("tick ") for line in lines), (args, lines)
+    answer = live.answer("logs", "-n", "2", "sleeper")
+    assert answer["ok"] is True and answer["label"] == "sleeper"

@@ -27,6 +27,8 @@ if TYPE_CHECKING:
 
 # How long the run may take to take a request (its loop answers between two turns).
 ANSWER_TIMEOUT = 5.0
+# The longest answer line read (a logs answer is at most a few MiB of JSON).
+MAX_ANSWER = 64 * 1024 * 1024
 RUN_ID = re.compile(r"(\d+)-[0-9a-f]{8}")
 
 DESCRIPTION = """\
@@ -118,7 +120,8 @@ def split_words(words: Sequence[str]) -> tuple[str | None, str, str | None]:
 
 def command(args: Sequence[str]) -> int:
     """``mlaunch ctl ...``: find the run, send the request, say the answer; raises on failure."""
-    ns = parser().parse_args(list(args))
+    # Intermixed: options go anywhere, as the README writes them (ctl logs -n 3 talker).
+    ns = parser().parse_intermixed_args(list(args))
     run, op, label = split_words(ns.words)
     request: dict[str, object] = {"version": PROTOCOL, "op": op}
     if label is not None:
@@ -144,6 +147,11 @@ def command(args: Sequence[str]) -> int:
         raise CtlError(str(answer.get("error")), status if isinstance(status, int) else 1)
     if not ns.json:
         sys.stdout.write(say(op, answer))
+    if "limit" in answer:
+        sys.stderr.write(
+            f"mlaunch ctl: only the last {answer['limit']} lines (a request gets at most that"
+            f" many, and 4 MiB); every line is in {label}'s log file in {target.folder}\n"
+        )
     return EXIT_OK
 
 
@@ -211,28 +219,39 @@ def _run_folders(base: str) -> list[str]:
 
 
 def _newest_live(base: str) -> Target:
-    """The newest run that answers; stale sockets are skipped, and named if nothing answers."""
+    """The newest run of the caller's that answers; stale sockets are skipped, and named if
+    nothing answers; other users' sockets are skipped (never connected to), and named too."""
+    from mlaunch.commands.ctl_trust import untrusted
+
     candidates = []
     latest = os.path.join(base, "latest")
     if os.path.isdir(latest):
         candidates.append(os.path.realpath(latest))
     candidates += [os.path.join(base, name) for name in _run_folders(base)]
-    stale = []
+    stale: list[str] = []
+    foreign: list[str] = []
     seen = set()
     for folder in candidates:
         path = find_socket(folder) if folder not in seen else None
         if path is None:
             continue
         seen.add(folder)
-        if _answers(path):
+        why = untrusted(path)
+        if why:
+            foreign.append(why)
+        elif _answers(path):
             return Target(folder, path)
-        stale.append(folder)
+        else:
+            stale.append(folder)
+    skipped = f"; {len(foreign)} not yours skipped ({foreign[0]})" if foreign else ""
     if stale:
         raise CtlError(
             f"no running launch under {base}: the newest with a control socket, {stale[0]},"
-            " has ended (its socket is stale: nothing accepts on it)"
+            f" has ended (its socket is stale: nothing accepts on it){skipped}"
         )
-    raise CtlError(f"no running launch under {base} (no run's log folder has a control socket)")
+    raise CtlError(
+        f"no running launch under {base} (no run's log folder has a control socket{skipped})"
+    )
 
 
 def _answers(path: str) -> bool:
@@ -252,19 +271,40 @@ def _run_id(run: str | None) -> str | None:
 
 
 def _connect(path: str, timeout: float) -> socket.socket:
-    sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    sock.settimeout(timeout)
-    try:
-        with Address(path) as address:
-            sock.connect(address)
-    except BaseException:
-        sock.close()
-        raise
-    return sock
+    """Connected to ``path`` within ``timeout``; a full listen queue (EAGAIN: many clients at
+    once) is tried again until then."""
+    import time
+
+    deadline = time.monotonic() + timeout
+    pause = 0.005
+    while True:
+        sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        sock.settimeout(max(0.01, deadline - time.monotonic()))
+        try:
+            with Address(path) as address:
+                sock.connect(address)
+            return sock
+        except BlockingIOError:
+            sock.close()
+            if time.monotonic() + pause > deadline:
+                raise TimeoutError(f"{path}: its queue stayed full for {timeout:g} s") from None
+            time.sleep(pause)  # the run's loop accepts between two turns
+            pause = min(pause * 2, 0.1)
+        except BaseException:
+            sock.close()
+            raise
 
 
 def ask(target: Target, request: dict[str, object]) -> dict[str, object]:
-    """Send ``request``, return the final answer (after ``accepted``, if the run sends one)."""
+    """Send ``request``, return the final answer (after ``accepted``, if the run sends one).
+
+    Only a socket of the caller's own, in a folder only they can write, served by a process of
+    theirs (SO_PEERCRED) is asked (mlaunch.commands.ctl_trust); an answer that is not what a run
+    sends is an error that says what came.
+    """
+    from mlaunch.commands.ctl_trust import check_peer, check_place
+
+    check_place(target.path)
     try:
         sock = _connect(target.path, ANSWER_TIMEOUT)
     except (ConnectionRefusedError, FileNotFoundError):
@@ -276,20 +316,62 @@ def ask(target: Target, request: dict[str, object]) -> dict[str, object]:
     except OSError as e:
         raise CtlError(f"cannot reach the run in {target.folder}: {e.strerror or e}") from None
     with sock:
-        sock.sendall(json.dumps(request).encode() + b"\n")
-        reader = sock.makefile("rb")
-        while True:
-            try:
-                line = reader.readline()
-            except TimeoutError:
-                raise CtlError(f"the run in {target.folder} did not answer in time") from None
-            if not line:
-                raise CtlError(f"the run in {target.folder} ended before it answered")
-            message = json.loads(line)
-            if message.get("accepted"):
-                sock.settimeout(float(message.get("wait", 60.0)))
-                continue
-            return dict(message)
+        peer = check_peer(sock, target.path)
+        try:
+            sock.sendall(json.dumps(request).encode() + b"\n")
+        except OSError as e:
+            raise CtlError(f"the run in {target.folder} took no request: {e.strerror or e}")
+        answer = _final_answer(sock, target)
+    about = answer.get("run")
+    if isinstance(about, dict) and about.get("pid") not in (None, peer):
+        raise CtlError(
+            f"the control socket {target.path} is served by pid {peer}, but its answer names"
+            f" pid {about.get('pid')!r}: not an answer to trust"
+        )
+    return answer
+
+
+def _final_answer(sock: socket.socket, target: Target) -> dict[str, object]:
+    reader = sock.makefile("rb")
+    while True:
+        try:
+            line = reader.readline(MAX_ANSWER)
+        except TimeoutError:
+            raise CtlError(f"the run in {target.folder} did not answer in time") from None
+        except OSError as e:
+            raise CtlError(f"the run in {target.folder} broke off: {e.strerror or e}") from None
+        if not line:
+            raise CtlError(f"the run in {target.folder} ended before it answered")
+        message = _message(line, target)
+        if message.get("accepted") is True:
+            wait = message.get("wait", 60.0)
+            if not isinstance(wait, (int, float)) or not 0 < wait <= 24 * 3600:
+                raise _unexpected(target, line, "its wait is not a number of seconds")
+            sock.settimeout(float(wait))
+            continue
+        if not isinstance(message.get("ok"), bool):
+            raise _unexpected(target, line, "it has no 'ok'")
+        return message
+
+
+def _message(line: bytes, target: Target) -> dict[str, object]:
+    if not line.endswith(b"\n"):
+        raise _unexpected(target, line, f"no end of line within {MAX_ANSWER} bytes")
+    try:
+        message = json.loads(line)
+    except (ValueError, RecursionError) as e:
+        raise _unexpected(target, line, f"not JSON ({e})") from None
+    if not isinstance(message, dict):
+        raise _unexpected(target, line, "not a JSON object")
+    return message
+
+
+def _unexpected(target: Target, line: bytes, why: str) -> CtlError:
+    shown = line[:80].decode("utf-8", "replace") + ("..." if len(line) > 80 else "")
+    return CtlError(
+        f"the control socket {target.path} answered something no mlaunch run sends ({why}):"
+        f" {shown.strip()!r}"
+    )
 
 
 # --- saying the answer --------------------------------------------------------------------------

@@ -15,6 +15,11 @@ may take), then the answer once the process has exited (or started again). Every
 ``run`` (pid, run id, log folder). A failed request answers ``ok: false`` with ``error`` (one
 line), ``status`` (errors' exit-status table) and, for an unknown label, ``labels`` and
 ``close``.
+
+Nothing a client sends stops or stalls the run: a request is bounded in size (MAX_REQUEST) and
+nesting (MAX_DEPTH), every malformed one is answered with an error, a ``logs`` answer is bounded
+(MAX_LOG_LINES, logfiles.TAIL_MAX_BYTES), and an error in carrying out a request is answered,
+never raised into the loop.
 """
 
 from __future__ import annotations
@@ -37,8 +42,15 @@ NAME = "ctl.sock"
 # In FOLDER when the socket is elsewhere (the log folder takes no socket): its path.
 WHERE = "where"
 PROTOCOL = 1
-# A request line longer than this is refused (a request is a few dozen bytes).
-MAX_REQUEST = 64 * 1024
+# A request line longer than this is refused (a request is a few dozen bytes)...
+MAX_REQUEST = 4096
+# ... and so is one nested deeper than this (a request is one flat object; json's parser
+# recurses once per level, and a line of 60,000 '[' ran it out of stack).
+MAX_DEPTH = 4
+# Connections the kernel queues before mlaunch's loop accepts them (30 shells at once).
+BACKLOG = 128
+# ``logs``: at most this many lines per request (and logfiles.TAIL_MAX_BYTES of them).
+MAX_LOG_LINES = 10_000
 # Beyond a stop ladder's own timeouts, what an answer to a stop or restart may take.
 WAIT_MARGIN = 5.0
 # AF_UNIX paths longer than this (108 bytes on Linux, with the NUL) are reached through the folder.
@@ -116,7 +128,7 @@ def _listen(path: str) -> socket.socket:
         with Address(path) as address:
             listener.bind(address)
         os.chmod(path, 0o600)
-        listener.listen(8)
+        listener.listen(BACKLOG)
         listener.setblocking(False)
     except BaseException:
         listener.close()
@@ -203,6 +215,7 @@ class ControlSocket:
         if client in self._clients:
             self._clients.remove(client)
         _unregister(self.supervisor.selector, client.conn)
+        _drain(client.conn)
         client.conn.close()
 
     def close(self) -> None:
@@ -224,11 +237,57 @@ class ControlSocket:
                 pass
 
 
+def _drain(conn: socket.socket, most: int = 1024 * 1024) -> None:
+    """Read what the client sent past its request (a line too long): closing a socket with
+    unread input resets the connection, and the client would lose its answer."""
+    try:
+        conn.setblocking(False)
+        while most > 0:
+            data = conn.recv(65536)
+            if not data:
+                return
+            most -= len(data)
+    except OSError:
+        return
+
+
+def nesting(line: bytes) -> int:
+    """How deep the JSON text ``line`` nests arrays and objects (brackets in strings aside)."""
+    depth = deepest = 0
+    in_string = escaped = False
+    for byte in line:
+        if in_string:
+            if escaped:
+                escaped = False
+            elif byte == 0x5C:  # backslash
+                escaped = True
+            elif byte == 0x22:  # quote
+                in_string = False
+        elif byte == 0x22:
+            in_string = True
+        elif byte in (0x5B, 0x7B):  # [ {
+            depth += 1
+            deepest = max(deepest, depth)
+        elif byte in (0x5D, 0x7D):
+            depth -= 1
+    return deepest
+
+
+def _shown(line: bytes) -> str:
+    """A request line in an error: its start, readable whatever it holds."""
+    text = line[:60].decode("utf-8", "replace")
+    return repr(text + ("..." if len(line) > 60 else ""))
+
+
 def _unregister(selector: selectors.BaseSelector, sock: socket.socket) -> None:
     try:
         selector.unregister(sock)
     except (KeyError, ValueError, RuntimeError, OSError):
         pass  # never registered, or the loop's selector is closed already
+
+
+class BadRequest(Exception):
+    """A request that is JSON but not one of the protocol's (exit status 2 for the client)."""
 
 
 class _Client:
@@ -246,6 +305,17 @@ class _Client:
 
     def on_ready(self, fd: int) -> None:
         """Readable before the request is whole; writable while an answer waits."""
+        try:
+            self._on_ready()
+        except Exception as e:  # a bug in answering one client must not end the run
+            self.answered = True
+            self.out = b""
+            self.server.forget(self)
+            self.server.supervisor.printer.message(
+                "WARNING", "launch", f"control socket: a request failed: {type(e).__name__}: {e}"
+            )
+
+    def _on_ready(self) -> None:
         if self.out:
             self._send()
             return
@@ -258,12 +328,13 @@ class _Client:
         if self.asked:
             return  # past the request: its answer comes when it is done
         self.received += data
-        if b"\n" in self.received:
+        line, newline, _ = self.received.partition(b"\n")
+        if len(line) > MAX_REQUEST:
             self.asked = True
-            self.handle(self.received.split(b"\n", 1)[0])
-        elif len(self.received) > MAX_REQUEST:
+            self.fail(f"the request is too long (more than {MAX_REQUEST} bytes)", EXIT_USAGE)
+        elif newline:
             self.asked = True
-            self.fail("the request is too long", EXIT_USAGE)
+            self.handle(line)
 
     def _recv(self) -> bytes | None:
         """What the client sent (b"" when it left), None if nothing yet."""
@@ -277,16 +348,11 @@ class _Client:
     # --- the request -----------------------------------------------------------------------
 
     def handle(self, line: bytes) -> None:
+        """Carry out one request line; whatever it holds, the client gets an answer."""
         from mlaunch.parts.control import AmbiguousLabel, ControlError, UnknownLabel
 
-        try:
-            import json  # at the first request, not when the socket opens
-
-            request = json.loads(line)
-            if not isinstance(request, dict):
-                raise ValueError("not an object")
-        except ValueError as e:
-            self.fail(f"the request is not a JSON object: {e}", EXIT_USAGE)
+        request = self._parse(line)
+        if request is None:
             return
         try:
             self.carry_out(request)
@@ -296,25 +362,51 @@ class _Client:
             self.fail(str(e), e.exit_code, labels=e.labels)
         except ControlError as e:
             self.fail(str(e), e.exit_code)
+        except BadRequest as e:
+            self.fail(str(e), EXIT_USAGE)
+        except Exception as e:  # an odd value this code did not foresee: said, not raised
+            self.fail(f"the request {_shown(line)} failed: {type(e).__name__}: {e}")
+
+    def _parse(self, line: bytes) -> dict[str, object] | None:
+        """The request as an object, or None once the error is answered."""
+        depth = nesting(line)
+        if depth > MAX_DEPTH:
+            self.fail(f"the request is nested {depth} deep (at most {MAX_DEPTH})", EXIT_USAGE)
+            return None
+        try:
+            import json  # at the first request, not when the socket opens
+
+            request = json.loads(line)
+        except (ValueError, RecursionError) as e:
+            self.fail(f"the request {_shown(line)} is not JSON: {e}", EXIT_USAGE)
+            return None
+        if not isinstance(request, dict):
+            self.fail(f"the request {_shown(line)} is not a JSON object", EXIT_USAGE)
+            return None
+        return request
 
     def carry_out(self, request: dict[str, object]) -> None:
-        from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS, ControlError
+        from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
 
         control = self.server.supervisor.control
         op, label = request.get("op"), request.get("label")
         if op not in OPERATIONS:
-            raise ControlError(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
+            raise BadRequest(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
         if op == "list":
             rows = [info.as_dict() for info in control.processes()]
             self.answer({"processes": rows})
             return
         if not isinstance(label, str):
-            raise ControlError(f"{op} needs a process label")
+            raise BadRequest(f"{op} needs a process label")
         if op == "logs":
             lines = request.get("lines", DEFAULT_LINES)
-            if not isinstance(lines, int):
-                raise ControlError(f"lines must be a number, not {lines!r}")
-            self.answer({"label": label, "lines": control.logs(label, lines)})
+            if not isinstance(lines, int) or isinstance(lines, bool):
+                raise BadRequest(f"lines must be a whole number, not {lines!r}")
+            payload: dict[str, object] = {"label": label}
+            payload["lines"] = control.logs(label, min(lines, MAX_LOG_LINES))
+            if lines > MAX_LOG_LINES:
+                payload["limit"] = MAX_LOG_LINES
+            self.answer(payload)
         elif op in ("mute", "unmute"):
             info = (
                 control.mute(label, by="ctl") if op == "mute" else control.unmute(label, by="ctl")
