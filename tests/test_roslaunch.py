@@ -208,11 +208,12 @@ def test_env_optenv_anon_dirname_and_find(tmp_path: Path) -> None:
         """,
     )
     (talker,) = plan_of(path).processes()
-    # ROS 2 semantics (docs/ros1.md): a substitution is one argument, even with spaces or empty
-    assert talker.argv[1:6] == (
+    # roslaunch substitutes, then splits like a shell: words split, an empty one disappears
+    assert talker.argv[1:7] == (
         "/home/ros1",
-        "a b c",
-        "",
+        "a",
+        "b",
+        "c",
         str(tmp_path / "launch"),
         f"{tmp_path / 'demo_cfg'}/x.yaml",
     )

@@ -74,15 +74,21 @@ class Source:
         except MlaunchError as e:  # a package not here: ROS 2 will look it up when launching
             return item.path, f"cannot check for a converted twin of the included file: {e}"
         last = item.path[-1] if item.path else ""
-        if path is None or not path.endswith(".launch") or not isinstance(last, str):
+        ros1 = next((s for s in (".launch", ".launch.xml") if path and path.endswith(s)), None)
+        if path is None or ros1 is None or not isinstance(last, str):
             return item.path, None
         suffix = FORMATS[self.fmt]
-        if os.path.exists(path[: -len(".launch")] + suffix):
-            return (*item.path[:-1], last[: -len(".launch")] + suffix), None
+        stem = path[: -len(ros1)]
+        if suffix != ros1 and os.path.exists(stem + suffix):
+            return (*item.path[:-1], last[: -len(ros1)] + suffix), None
+        name = os.path.basename(path)
+        how = "mlaunch includes it as it is, ROS 2 cannot"
+        if ros1 == ".launch.xml":
+            how = "roslaunch reads every include as ROS 1 XML, ROS 2 would read it as ROS 2 XML"
+        other = "py" if suffix == ros1 else self.fmt
         return item.path, (
-            f"{os.path.basename(path)} is a ROS 1 file: mlaunch includes it as it is, ROS 2"
-            f" cannot (convert it too: mlaunch convert {os.path.basename(path)} --to {self.fmt}"
-            f" -o {os.path.basename(path)[: -len('.launch')]}{suffix})"
+            f"{name} is a ROS 1 file: {how} (convert it too: mlaunch convert {name} --to {other}"
+            f" -o {os.path.basename(stem)}{FORMATS[other]})"
         )
 
 

@@ -32,9 +32,14 @@ FORMAT_MODULES = {
     "yaml": "mlaunch.frontends.yaml",
     "xml": "mlaunch.frontends.xml",
 }
+# A file a roslaunch file includes: roslaunch XML whatever its suffix (ROS 1 packages name their
+# fragments *.launch.xml).
+ROSLAUNCH_HINT = "roslaunch"
 
 
 def frontend_for(path: str, hint: str | None = None) -> str:
+    if hint == ROSLAUNCH_HINT:
+        return FRONTENDS[".launch"]
     name = os.path.basename(path).lower()
     for suffix in sorted(FRONTENDS, key=len, reverse=True):
         if name.endswith(suffix):

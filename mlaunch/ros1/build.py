@@ -5,6 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.launch.actions import Action, SetLaunchConfiguration
+from mlaunch.launch_ros.parameter_descriptions import ParameterValue
+from mlaunch.ros1.actions import RoslaunchNode, RoslaunchSource, RoslaunchValue
 from mlaunch.ros1.eval import RoslaunchEval
 from mlaunch.ros1.model import (
     MACHINE_FIELDS,
@@ -124,9 +126,7 @@ def _action(item: Item) -> Any:
             actions.insert(0, push)
         return core.GroupAction(actions, scoped=item.scoped)
     if isinstance(item, Include):
-        from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
-
-        source = AnyLaunchDescriptionSource(subs(item.path))
+        source = RoslaunchSource(subs(item.path))
         arguments = [(name, subs(value)) for name, value in item.arguments]
         return core.IncludeLaunchDescription(source, launch_arguments=arguments)
     if isinstance(item, MachineItem):
@@ -135,6 +135,10 @@ def _action(item: Item) -> Any:
         optional = {k: subs(getattr(item, k)) for k, _ in MACHINE_FIELDS if getattr(item, k)}
         return Machine(name=subs(item.name), address=subs(item.address), **optional)
     if isinstance(item, NodeItem):
+        if item.shell_args is not None:
+            keywords = node_keywords(item)
+            keywords.pop("arguments", None)
+            return RoslaunchNode(shell_args=subs(item.shell_args), **keywords)
         return ros.Node(**node_keywords(item))
     if isinstance(item, ProcessItem):
         return core.ExecuteProcess(cmd=[subs(c) for c in item.cmd], **process_keywords(item))
@@ -205,10 +209,10 @@ def parameter_value(value: PValue) -> Any:
     if value.dynamic is None:
         return value.literal
     converted = subs(value.dynamic)
+    if value.auto:
+        return RoslaunchValue(converted)
     if value.vtype is None:
         return converted
-    from mlaunch.launch_ros.parameter_descriptions import ParameterValue
-
     return ParameterValue(converted, value_type=value.vtype)
 
 

@@ -150,6 +150,8 @@ class ElementReader:
         self.descriptions: list[Desc] = []
         self.arbotix: list[tuple[NodeItem, ProcessItem, NodeItem, str]] = []
         self.jsp_nodes: list[NodeItem] = []
+        # values ROS 2 cannot hold met while reading one tag (each its own warning)
+        self.unheld: list[str] = []
         # warnings for the nodes a robot_description / use_gui global reaches, by its origin
         self.desc_notes: dict[str, list[str]] = {}
 

@@ -84,6 +84,7 @@ class NodeMapper(ElementReader):
             )
         else:
             node.arguments = self.static_tf_arguments(node, list(args), ros1_tf)
+            node.shell_args = None
         program = "tf2_ros static_transform_publisher"
         if self.converting or self.available("tf2_ros", "static_transform_publisher"):
             return [node]

@@ -107,12 +107,14 @@ class PValue:
     """A parameter value: a typed literal, or substitutions typed when resolved.
 
     ``vtype`` (str, int, float, bool) forces the type of ``dynamic``; None reads it with ROS 2's
-    YAML rules.
+    YAML rules, or with ``auto`` (an untyped ``<param value>``) by roslaunch's rule when mlaunch
+    runs the file (a converted ROS 2 file can only say YAML).
     """
 
     literal: Any = None
     dynamic: Value | None = None
     vtype: type | None = None
+    auto: bool = False
 
 
 Params = list[tuple[Value, PValue]]
@@ -233,6 +235,9 @@ class NodeItem(Process):
     name: Value | None
     namespace: Value | None = None
     arguments: list[Value] = field(default_factory=list)
+    # ``args`` as written when it has substitutions: roslaunch substitutes, then splits (None:
+    # ``arguments`` is exact, or a mapping rewrote them)
+    shell_args: Value | None = None
     parameters: Params = field(default_factory=list)
     remappings: list[tuple[Value, Value]] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)

@@ -34,7 +34,12 @@ class ParamReader(ElementReader):
     """The parameter tags of a roslaunch file (inside a node or global)."""
 
     def tag_param(self, el: Element, scope: Scope, out: Out) -> None:
-        self.global_params(self.param_entries(el, scope), el, scope, out)
+        try:
+            entries = self.param_entries(el, scope)
+        finally:
+            for message in self.drain_unheld():
+                out.body.append(Warn(origin=self.origin(el), message=message))
+        self.global_params(entries, el, scope, out)
 
     def param_entries(self, el: Element, scope: Scope) -> list[tuple[Value, PValue]]:
         """The (name, value) pairs one <param> sets (a yaml dict sets several)."""
@@ -67,7 +72,8 @@ class ParamReader(ElementReader):
             return [(name, PValue(dynamic=(CommandRef(raw),), vtype=vtype))]
         found = static_text(raw)
         if found is None:
-            return [(name, PValue(dynamic=raw, vtype=VTYPES[type_name]))]
+            auto = type_name == "auto"
+            return [(name, PValue(dynamic=raw, vtype=VTYPES[type_name], auto=auto))]
         try:
             literal = convert_value(found.strip(), type_name)
         except (ValueError, yaml.YAMLError) as e:
@@ -81,9 +87,14 @@ class ParamReader(ElementReader):
             for key, inner in value.items():
                 out += self.flatten((*name, "/", str(key)), inner, el)
             return out
+        if numeric_rows(value):
+            # nav2's footprint (and costmap polygons) take the ROS 1 list of points as text
+            return [(name, PValue(literal=flow_text(value)))]
         problem = ros2_problem(value)
         if problem is not None:
-            raise Skip(f"parameter {describe_value(name)}: {problem}; it is not set")
+            # only this key is lost: the load's other keys are set (each such key a warning)
+            self.unheld.append(f"parameter {describe_value(name)}: {problem}; it is not set")
+            return []
         if isinstance(value, (list, tuple)) and any(isinstance(v, float) for v in value):
             value = [float(v) for v in value]
         elif not isinstance(value, (bool, int, float, str, list)):
@@ -149,8 +160,16 @@ class ParamReader(ElementReader):
         except Skip as skip:
             out.body.append(Warn(origin=self.origin(el), message=skip.message))
             return
+        finally:
+            for message in self.drain_unheld():
+                out.body.append(Warn(origin=self.origin(el), message=message))
         if entries:
             self.global_params(entries, el, scope, out)
+
+    def drain_unheld(self) -> list[str]:
+        """The warnings for values ROS 2 cannot hold met since the last call."""
+        found, self.unheld = self.unheld, []
+        return found
 
     def rosparam_entries(self, el: Element, scope: Scope) -> list[tuple[Value, PValue]]:
         command = self.literal(el, "command", scope) or "load"
@@ -216,6 +235,25 @@ class ParamReader(ElementReader):
         if isinstance(value.literal, str) and "$(" in value.literal:
             return name, PValue(dynamic=self.value(value.literal, el, "rosparam", scope))
         return entry
+
+
+def numeric_rows(value: Any) -> bool:
+    """A list of lists of numbers (a footprint, a polygon): ROS 2 packages take it as text."""
+    if not isinstance(value, (list, tuple)) or not value:
+        return False
+    return all(
+        isinstance(row, (list, tuple))
+        and row
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in row)
+        for row in value
+    )
+
+
+def flow_text(value: Any) -> str:
+    """``[[x, y], ...]`` as YAML's flow style writes it (nav2's footprint string)."""
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(flow_text(v) for v in value) + "]"
+    return repr(value)
 
 
 def ros2_problem(value: Any) -> str | None:

@@ -309,6 +309,8 @@ class Reader(ParamReader, NodeMapper):
         )
         args = self.attr(el, "args", scope)
         node.arguments = split_arguments(args) if args is not None else []
+        if args is not None and static_text(args) is None:
+            node.shell_args = args
         self.process_attributes(node, el, scope)
         self.node_children(node, el, scope, out)
         for attr_name, why in (("cwd", _CWD), ("clear_params", _CLEAR_PARAMS)):
@@ -361,6 +363,9 @@ class Reader(ParamReader, NodeMapper):
                 self.node_child(node, child, scope, out)
             except Skip as skip:
                 node.warnings.append(f"<{child.tag}> at line {child.line}: {skip.message}")
+            finally:
+                for message in self.drain_unheld():
+                    node.warnings.append(f"<{child.tag}> at line {child.line}: {message}")
 
     def node_child(self, node: NodeItem, child: Element, scope: Scope, out: Out) -> None:
         if child.tag == "remap":
