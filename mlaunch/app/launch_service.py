@@ -191,9 +191,9 @@ class LaunchService:
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
         from mlaunch.app.pipeline import components_part
         from mlaunch.engine.guard import Guard, new_run_id
-        from mlaunch.engine.lifeline import private_temp_dir, remove_private_dir
         from mlaunch.engine.logfiles import make_run_log_dir
         from mlaunch.engine.output import Printer, stdout_is_color_terminal
+        from mlaunch.engine.privatedir import private_temp_dir, remove_private_dir
         from mlaunch.engine.supervisor import Supervisor
         from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
 

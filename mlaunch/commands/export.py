@@ -82,7 +82,7 @@ def command(args: Sequence[str]) -> int:
 
 def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) -> int:
     from mlaunch.app import pipeline
-    from mlaunch.engine.lifeline import private_temp_dir, remove_private_dir
+    from mlaunch.engine.privatedir import private_temp_dir, remove_private_dir
     from mlaunch.export import systemd
     from mlaunch.resolve.resolver import resolve_deferred
 

@@ -25,6 +25,9 @@ mlaunch batches its lines: ``watch``/``forget`` only queue them, and the supervi
 was ~25 ms per hundred children). If mlaunch dies between a spawn and the flush, the marker
 scan still finds that child.
 
+At start the guard also removes the params folders of earlier runs that were killed together
+with their guard (mlaunch.engine.privatedir.sweep_dead_runs), off mlaunch's path to its first child.
+
 The /proc readers it shares with the supervisor's stray sweep live in mlaunch.engine.proctable.
 """
 
@@ -36,6 +39,7 @@ import signal
 import time
 from collections.abc import Iterable
 
+from mlaunch.engine.privatedir import sweep_dead_runs
 from mlaunch.engine.proctable import ProcInfo, marked, read_file, scan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -217,6 +221,8 @@ def _guard_main(fd: int, run_id: str, temp_dir: str | None, cgroup: str | None) 
         signal.signal(sig, signal.SIG_IGN)
     signal.signal(signal.SIGCHLD, signal.SIG_DFL)
     _keep_only_fds(fd)
+    # Off mlaunch's path to its first child: the folders of runs killed with their guard.
+    sweep_dead_runs()
     groups: dict[int, float] = {}
     leftovers: list[bytes] = []  # files to remove if mlaunch dies (its control socket)
     clean = False

@@ -29,6 +29,7 @@ import time
 
 from mlaunch.engine import guard as guards
 from mlaunch.engine import proctable
+from mlaunch.engine.privatedir import private_temp_dir, remove_private_dir
 from mlaunch.plan.errors import OutputError, exit_for_signal
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -190,41 +191,6 @@ def _reap_any() -> None:
 def _send(pid: int, sig: int) -> None:
     try:
         os.kill(pid, sig)
-    except OSError:
-        pass
-
-
-def private_temp_dir() -> str:
-    """A directory only this user can read, for params files (tempfile costs ~4 ms to import)."""
-    base = os.environ.get("TMPDIR") or "/tmp"
-    for _ in range(100):
-        path = os.path.join(base, f"mlaunch-{os.getpid()}-{os.urandom(4).hex()}")
-        try:
-            os.mkdir(path, 0o700)
-        except FileExistsError:
-            continue
-        return path
-    raise OSError(f"cannot create a private directory in {base}")
-
-
-def remove_private_dir(path: str) -> None:
-    """Remove the params-file folder: flat, so no shutil (2 ms to import at exit)."""
-    try:
-        entries = list(os.scandir(path))
-    except FileNotFoundError:
-        return
-    if any(e.is_dir(follow_symlinks=False) for e in entries):
-        import shutil
-
-        shutil.rmtree(path, ignore_errors=True)
-        return
-    for entry in entries:
-        try:
-            os.unlink(entry.path)
-        except FileNotFoundError:
-            pass
-    try:
-        os.rmdir(path)
     except OSError:
         pass
 
