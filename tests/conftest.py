@@ -10,6 +10,12 @@ from pathlib import Path
 import pytest
 from ros_domain import claim as claim_domain
 
+from mlaunch import compat
+
+# The suite loads launch files through mlaunch's library as the applications do: with the ROS 2
+# module names served (mlaunch.compat), which each application installs before loading.
+compat.install()
+
 REPO = Path(__file__).resolve().parent.parent
 
 HAVE_RCLPY = importlib.util.find_spec("rclpy") is not None

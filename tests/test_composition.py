@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch.actions import LaunchDescription
 from mlaunch.launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
 from mlaunch.launch_ros.composable import ComposableNode
@@ -126,7 +126,7 @@ EXPECTED = [
 @pytest.mark.parametrize("suffix", ["py", "xml", "yaml"])
 def test_requests_are_launch_ros_requests_in_every_frontend(suffix: str, prefix: Path) -> None:
     path = str(HERE / f"demo.launch.{suffix}")
-    plan = plan_of(frontends.load(path), path, prefix)
+    plan = plan_of(readers.load(path), path, prefix)
     (container,) = plan.processes()
     assert container.node is not None and container.node.fully_qualified_name == "/my_container"
     assert loads(plan) == EXPECTED
@@ -135,14 +135,14 @@ def test_requests_are_launch_ros_requests_in_every_frontend(suffix: str, prefix:
 @pytest.mark.parametrize("suffix", ["py", "xml", "yaml"])
 def test_a_false_condition_drops_that_node_only(suffix: str, prefix: Path) -> None:
     path = str(HERE / f"demo.launch.{suffix}")
-    plan = plan_of(frontends.load(path), path, prefix, with_listener="false")
+    plan = plan_of(readers.load(path), path, prefix, with_listener="false")
     first = loads(plan)[0][1]
     assert [r.node_name for r in first] == ["talker"]
 
 
 def test_target_container_name_is_used_as_given(prefix: Path) -> None:
     path = str(HERE / "demo.launch.py")
-    plan = plan_of(frontends.load(path), path, prefix, container="c2")
+    plan = plan_of(readers.load(path), path, prefix, container="c2")
     assert [target for target, _ in loads(plan)] == ["/c2", "/c2"]
 
 
@@ -150,7 +150,7 @@ def test_print_shows_each_component_with_container_plugin_params_and_remaps(
     prefix: Path,
 ) -> None:
     path = str(HERE / "demo.launch.xml")
-    text = describe_plan(plan_of(frontends.load(path), path, prefix), path)
+    text = describe_plan(plan_of(readers.load(path), path, prefix), path)
     assert "component /robot/client   (loaded into /my_container)" in text
     assert "  plugin:  composition::Client   (package composition)" in text
     assert "  remap:   /tf:=tf" in text
@@ -257,7 +257,7 @@ def test_a_parameter_description_is_refused_as_launch_ros_fails_on_it(
         "    ])\n"
     )
     with pytest.raises(MlaunchError) as caught:
-        plan_of(frontends.load(str(path)), str(path), prefix)
+        plan_of(readers.load(str(path)), str(path), prefix)
     error = caught.value
     assert error.where == f"{path}:7"
     assert (
@@ -286,4 +286,4 @@ def test_composable_node_at_top_level_says_where_it_belongs(tmp_path: Path) -> N
     path = tmp_path / "t.launch.xml"
     path.write_text('<launch><composable_node pkg="p" plugin="p::P" name="n"/></launch>')
     with pytest.raises(LaunchFileError, match="inside <node_container> or <load_composable_node>"):
-        frontends.load(str(path))
+        readers.load(str(path))

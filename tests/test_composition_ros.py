@@ -22,7 +22,7 @@ from test_composition import EXPECTED, HERE, loads, plan_of
 from test_composition import prefix as prefix  # the fixture, used by name
 from test_standin_nodes import URDF, Proc, spawn, standin
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import (
     BOOL,
@@ -107,7 +107,7 @@ def test_the_recording_container_receives_launch_ros_requests(
         "recorder",
     )
     path = str(HERE / f"demo.launch.{suffix}")
-    plan = plan_of(frontends.load(path), path, prefix)
+    plan = plan_of(readers.load(path), path, prefix)
     steps = [s for s in plan.steps if isinstance(s, LoadComponents)]
     for step in steps:
         driver.start(step)

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch.frontends import load
-from mlaunch.frontends.subst import SUBSTITUTIONS, TemplateError, parse_template
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import Substitution, normalize, perform_substitutions
+from mlaunch.launch_ros.subst import SUBSTITUTIONS, TemplateError, parse_template
 from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.readers import load
 
 
 def ctx(**configs: str) -> LaunchContext:

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch import actions
 from mlaunch.launch.conditions import IfCondition, UnlessCondition
 from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError, MlaunchError
@@ -26,12 +26,12 @@ def write(tmp_path: Path, body: str, name: str = "t.launch.xml") -> Path:
 
 
 def load(tmp_path: Path, body: str, name: str = "t.launch.xml") -> actions.LaunchDescription:
-    return frontends.load(str(write(tmp_path, body, name)))
+    return readers.load(str(write(tmp_path, body, name)))
 
 
 def plan_of(tmp_path: Path, body: str, **args: str) -> Plan:
     path = write(tmp_path, body)
-    description = frontends.load(str(path))
+    description = readers.load(str(path))
     return resolve(
         description, path=str(path), arguments=args, environ=ENV, options=ResolveOptions()
     )
@@ -40,7 +40,7 @@ def plan_of(tmp_path: Path, body: str, **args: str) -> Plan:
 def error(tmp_path: Path, body: str) -> LaunchFileError:
     path = write(tmp_path, body)
     with pytest.raises(LaunchFileError) as caught:
-        frontends.load(str(path))
+        readers.load(str(path))
     return caught.value
 
 
@@ -404,7 +404,7 @@ def test_included_file_errors_name_the_included_file(tmp_path: Path) -> None:
     write(tmp_path, "<launch>\n  <lgo message='x'/>\n</launch>\n", "bad.launch.xml")
     path = write(tmp_path, '<launch><include file="$(dirname)/bad.launch.xml"/></launch>')
     with pytest.raises(MlaunchError) as caught:
-        resolve(frontends.load(str(path)), path=str(path), arguments={}, environ=ENV, options=None)
+        resolve(readers.load(str(path)), path=str(path), arguments={}, environ=ENV, options=None)
     assert caught.value.where == f"{tmp_path}/bad.launch.xml:2:3"
     assert "did you mean 'log'?" in str(caught.value)
 
@@ -446,7 +446,7 @@ def ros_plan(tmp_path: Path) -> object:
         env = {**ENV, "AMENT_PREFIX_PATH": str(prefix)}
         options = ResolveOptions(temp_dir=str(temp), standins=False)
         return resolve(
-            frontends.load(str(path)), path=str(path), arguments=args, environ=env, options=options
+            readers.load(str(path)), path=str(path), arguments=args, environ=env, options=options
         )
 
     run.prefix = prefix  # type: ignore[attr-defined]

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch import actions
 from mlaunch.launch.conditions import IfCondition, UnlessCondition
 from mlaunch.plan.errors import LaunchFileError
@@ -26,13 +26,13 @@ def write(tmp_path: Path, body: str, name: str = "t.launch.yaml") -> Path:
 
 
 def load(tmp_path: Path, body: str) -> actions.LaunchDescription:
-    return frontends.load(str(write(tmp_path, body)))
+    return readers.load(str(write(tmp_path, body)))
 
 
 def plan_of(tmp_path: Path, body: str, **args: str) -> Plan:
     path = write(tmp_path, body)
     return resolve(
-        frontends.load(str(path)),
+        readers.load(str(path)),
         path=str(path),
         arguments=args,
         environ=ENV,
@@ -43,7 +43,7 @@ def plan_of(tmp_path: Path, body: str, **args: str) -> Plan:
 def error(tmp_path: Path, body: str) -> LaunchFileError:
     path = write(tmp_path, body)
     with pytest.raises(LaunchFileError) as caught:
-        frontends.load(str(path))
+        readers.load(str(path))
     return caught.value
 
 
@@ -277,7 +277,7 @@ def test_errors_are_located(tmp_path: Path, body: str, where: str, message: str)
     path = tmp_path / "t.launch.yaml"
     path.write_text(body)
     with pytest.raises(LaunchFileError) as caught:
-        frontends.load(str(path))
+        readers.load(str(path))
     err = caught.value
     assert message in err.message, err.message
     assert err.where == (f"{path}:{where}" if where else str(path))
@@ -297,8 +297,8 @@ def test_a_yaml_file_without_nodes_does_not_import_the_ros_layer(tmp_path: Path)
 
     path = write(tmp_path, "launch:\n- log: {message: hi}\n- executable: {cmd: 'true'}\n")
     code = (
-        "import sys; import mlaunch.frontends;"
-        f" mlaunch.frontends.load({str(path)!r});"
+        "import sys; import mlaunch.readers;"
+        f" mlaunch.readers.load({str(path)!r});"
         " print(sorted(m for m in sys.modules if m.startswith(('mlaunch.ros', 'rclpy'))))"
     )
     out = subprocess.run(
@@ -329,7 +329,7 @@ def ros_plan(tmp_path: Path) -> Any:
         env = {**ENV, "AMENT_PREFIX_PATH": str(prefix)}
         options = ResolveOptions(temp_dir=str(temp), standins=False)
         return resolve(
-            frontends.load(str(path)), path=str(path), arguments=args, environ=env, options=options
+            readers.load(str(path)), path=str(path), arguments=args, environ=env, options=options
         )
 
     return run

@@ -168,7 +168,7 @@ def test_events_emitted_before_run_wait_for_it() -> None:
 def test_importable_as_launch_launch_service() -> None:
     import importlib
 
-    from mlaunch.app import compat
+    from mlaunch import compat
 
     compat.install()
     module = importlib.import_module("launch")

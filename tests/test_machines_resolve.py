@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.steps import Plan
 from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
@@ -67,7 +67,7 @@ def resolve_text(tmp_path: Path, suffix: str, text: str) -> Plan:
     path = tmp_path / f"m.launch.{suffix}"
     path.write_text(text)
     return resolve(
-        frontends.load(str(path)),
+        readers.load(str(path)),
         path=str(path),
         arguments={},
         environ={"PATH": os.environ["PATH"]},
@@ -161,7 +161,7 @@ def test_ros1_machines_run_and_convert_alike(tmp_path: Path, fmt: str) -> None:
         path = tmp_path / f"converted.launch.{fmt}"
         path.write_text(convert(str(source), fmt, str(path)))
     plan = resolve(
-        frontends.load(str(path)),
+        readers.load(str(path)),
         path=str(path),
         arguments={},
         environ={"PATH": os.environ["PATH"], "AMENT_PREFIX_PATH": str(EXAMPLES_PREFIX)},
@@ -187,7 +187,7 @@ def test_ros1_node_on_an_undeclared_machine_is_a_located_error(tmp_path: Path) -
     )
     with pytest.raises(MlaunchError, match=r"m\.launch:2.*machine 'far' is not declared"):
         resolve(
-            frontends.load(str(path)),
+            readers.load(str(path)),
             path=str(path),
             arguments={},
             environ={"PATH": os.environ["PATH"], "AMENT_PREFIX_PATH": str(EXAMPLES_PREFIX)},

@@ -16,7 +16,7 @@ from typing import Any
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.plan.steps import (
     AddHandler,
     Deferred,
@@ -56,7 +56,7 @@ def summarize(name: str, fmt: str, args: dict[str, str], tmp_path: Path) -> dict
     options = ResolveOptions(temp_dir=str(temp_dir))
     labels = LabelCounter()
     plan = resolve(
-        frontends.load(path),
+        readers.load(path),
         path=path,
         arguments=args,
         environ=ENV,

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch.actions import (
     AppendEnvironmentVariable,
     DeclareLaunchArgument,
@@ -35,8 +35,8 @@ from mlaunch.plan.errors import (
     MlaunchError,
     SubstitutionFailure,
 )
+from mlaunch.plan.pragmas import PRAGMA
 from mlaunch.plan.steps import AddHandler, Log, Plan, StartTimer
-from mlaunch.resolve.binding import PRAGMA
 from mlaunch.resolve.resolver import (
     LabelCounter,
     ResolveOptions,
@@ -316,7 +316,7 @@ def test_a_comment_in_the_file_asks_for_capture(tmp_path: Path) -> None:
         - let: {name: v, value: late}
         """,
     )
-    plan = resolve(frontends.load(path), path=path, arguments={}, environ={})
+    plan = resolve(readers.load(path), path=path, arguments={}, environ={})
     (timer,) = [s for s in plan.steps if isinstance(s, StartTimer)]
     assert timer.body is not None
     fired = resolve_deferred(timer.body, labels=LabelCounter(), options=ResolveOptions())
@@ -367,7 +367,7 @@ def test_include_of_missing_file_is_an_error(tmp_path: Path) -> None:
 def test_python_loader_errors_are_located(tmp_path: Path) -> None:
     bad = write(tmp_path, "bad.launch.py", "def generate_launch_description(:\n    pass\n")
     with pytest.raises(LaunchFileError, match="syntax error") as err:
-        frontends.load(bad)
+        readers.load(bad)
     assert err.value.where == f"{bad}:1:33"
     raising = write(
         tmp_path,
@@ -381,14 +381,14 @@ def test_python_loader_errors_are_located(tmp_path: Path) -> None:
         """,
     )
     with pytest.raises(LaunchFileError, match="ValueError in generate_launch_description") as err:
-        frontends.load(raising)
+        readers.load(raising)
     assert err.value.where == f"{raising}:3"
     none = write(tmp_path, "none.launch.py", "x = 1\n")
     with pytest.raises(LaunchFileError, match="no generate_launch_description"):
-        frontends.load(none)
+        readers.load(none)
     wrong = write(tmp_path, "wrong.launch.py", "def generate_launch_description():\n    return 3\n")
     with pytest.raises(LaunchFileError, match="returned int"):
-        frontends.load(wrong)
+        readers.load(wrong)
 
 
 def test_show_args_follows_includes_and_marks_conditional(tmp_path: Path) -> None:

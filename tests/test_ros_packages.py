@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch.actions import LaunchDescription, LogInfo
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import perform
@@ -287,7 +287,7 @@ def test_a_launch_file_finds_a_package_next_to_it_while_loading(tmp_path: Path) 
             """
         )
     )
-    description = frontends.load(str(launch))
+    description = readers.load(str(launch))
     plan = resolve(
         description, path=str(launch), arguments={}, environ={}, options=ResolveOptions()
     )

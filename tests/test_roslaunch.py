@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 import yaml
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.steps import Plan, ProcessSpec
 from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
@@ -70,7 +70,7 @@ def plan_of(
     temp_dir = temp or Path(path).parent / "params"
     temp_dir.mkdir(exist_ok=True)
     return resolve(
-        frontends.load(path),
+        readers.load(path),
         path=path,
         arguments=args or {},
         environ={**ENV, **env},
@@ -190,7 +190,7 @@ def test_required_arg_and_undeclared_arg_are_errors_with_the_line(tmp_path: Path
         "</launch>\n",
     )
     with pytest.raises(MlaunchError) as caught:
-        frontends.load(bad)
+        readers.load(bad)
     assert str(caught.value).startswith(f"{bad}:2:")
     assert "arg 'nope' is not defined" in str(caught.value)
 
@@ -268,7 +268,7 @@ def test_bad_node_attributes_are_located_errors(
         f'<launch>\n\n  <node pkg="mlaunch_demo" type="talker" name="t" {attribute}/>\n</launch>\n',
     )
     with pytest.raises(MlaunchError) as caught:
-        frontends.load(path)
+        readers.load(path)
     assert str(caught.value).startswith(f"{path}:3:"), str(caught.value)
     assert message in str(caught.value)
 
@@ -277,7 +277,7 @@ def test_malformed_xml_is_an_error(tmp_path: Path) -> None:
     # <machine> and machine= are mlaunch.machines': tests/test_machines_resolve.py.
     broken = write(tmp_path, "x.launch", "<launch>\n  <node name='a'>\n</launch>\n")
     with pytest.raises(MlaunchError, match=r"x\.launch:3: malformed XML"):
-        frontends.load(broken)
+        readers.load(broken)
 
 
 # --- parameters ---------------------------------------------------------------------------------
@@ -327,7 +327,7 @@ def test_bad_param_value_for_its_type_is_a_located_error(tmp_path: Path) -> None
         '<launch>\n  <param name="x" type="int" value="many"/>\n</launch>\n',
     )
     with pytest.raises(MlaunchError, match=r"t\.launch:2: <param>: param value 'many' is not of"):
-        frontends.load(path)
+        readers.load(path)
 
 
 def test_rosparam_files_inline_yaml_subst_value_and_angles(tmp_path: Path) -> None:

@@ -16,6 +16,7 @@ import textwrap
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 from procutil import wait_until
@@ -25,7 +26,6 @@ from mlaunch.engine.logfiles import LogFile
 from mlaunch.engine.output import Printer
 from mlaunch.engine.process import (
     MAX_PARTIAL,
-    Process,
     core_dump_hint,
     expand_core_pattern,
     utf8_safe_cut,
@@ -36,6 +36,9 @@ from mlaunch.engine.screen import Screen
 from mlaunch.engine.supervisor import Supervisor
 from mlaunch.plan.events import Event, Exited, Output, Started
 from mlaunch.plan.steps import Plan, ProcessSpec, RespawnPolicy, Spawn
+
+if TYPE_CHECKING:
+    from mlaunch.plan.events import ProcessView
 
 PY = sys.executable
 
@@ -102,7 +105,7 @@ class Harness:
         """Run ``action(label, line)`` in the loop the first time a child prints ``needle``."""
         self._triggers.append((needle, action))
 
-    def listen(self, listener: Callable[[str, Process], object]) -> None:
+    def listen(self, listener: Callable[[str, ProcessView], object]) -> None:
         """Call ``listener("started" | "exited", process)`` from the supervisor's event stream."""
 
         def on_event(event: Event) -> None:
@@ -364,13 +367,13 @@ def write_launch(tmp_path: Path, body: str) -> Path:
 
 
 def plan_from(path: Path, tmp_path: Path) -> Plan:
-    from mlaunch import frontends
+    from mlaunch import readers
     from mlaunch.resolve.resolver import ResolveOptions, resolve
 
     temp = tmp_path / "temp"
     temp.mkdir(exist_ok=True)
     return resolve(
-        frontends.load(str(path)),
+        readers.load(str(path)),
         path=str(path),
         arguments={},
         environ=dict(os.environ),

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 import xacro
 
-from mlaunch import frontends
+from mlaunch import readers
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS, Command, perform
 from mlaunch.launch_ros import xacro as in_process
@@ -261,7 +261,7 @@ def test_launch_file_calling_xacro_directly_finds_packages(
             """
         )
     )
-    description = frontends.load(str(launch))
+    description = readers.load(str(launch))
     plan = resolve(
         description, path=str(launch), arguments={}, environ={}, options=ResolveOptions()
     )

@@ -72,9 +72,9 @@ def check(path: str) -> list[Finding]:
 
 
 def _check_one(path: str) -> tuple[list[Finding], list[str]]:
-    from mlaunch import frontends
+    from mlaunch import readers
 
-    module = frontends.frontend_for(path)
+    module = readers.frontend_for(path)
     if module == "mlaunch.ros1.roslaunch":
         return [
             Finding(
@@ -89,7 +89,7 @@ def _check_one(path: str) -> tuple[list[Finding], list[str]]:
 
         return check_python(path)
     walker = _Walker(module.rsplit(".", 1)[1])
-    root = frontends.load_root(path)
+    root = readers.load_root(path)
     walker.root(root)
     return walker.findings, walker.includes
 
@@ -212,7 +212,7 @@ class _Walker:
         """Jazzy shlex-splits each text piece between substitutions on its own."""
         import shlex
 
-        from mlaunch.frontends.subst import TemplateError, parse_template
+        from mlaunch.launch_ros.subst import TemplateError, parse_template
 
         try:
             parts = parse_template(text)

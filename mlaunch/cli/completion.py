@@ -237,12 +237,13 @@ def argument_words(path: str, prefix: str, parsed_args: Any) -> list[str]:
 
 def declared_arguments(path: str, parsed_args: Any) -> list[Any]:
     """The file's arguments, with its included files', as ``mlaunch FILE --show-args`` lists."""
-    from mlaunch import frontends
+    from mlaunch import compat, readers
     from mlaunch.resolve.resolver import collect_arguments
     from mlaunch.ros.search import PackageSearch, searching
 
+    compat.install()
     path = os.path.abspath(path)
     search = PackageSearch(getattr(parsed_args, "package_path", None) or [], path, os.environ)
     with searching(search):
-        description = frontends.load(path)
+        description = readers.load(path)
         return collect_arguments(description, path=path, arguments={}, environ=os.environ)

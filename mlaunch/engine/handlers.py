@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.plan.events import ProcessView
 
 
 class LaunchHandlers:
@@ -109,10 +110,10 @@ class LaunchHandlers:
         processes = self.supervisor.processes
         return [p for p in processes if p.running and (matcher is None or matcher(p))]
 
-    def _started(self, process: Process) -> None:
+    def _started(self, process: ProcessView) -> None:
         self.dispatch("process_start", process, ev.ProcessStarted(**_details(process)))
 
-    def _exited(self, process: Process, code: int) -> None:
+    def _exited(self, process: ProcessView, code: int) -> None:
         event = ev.ProcessExited(**_details(process), returncode=code)
         self.dispatch("process_exit", process, event)
         if process.spec.on_exit is not None:
@@ -134,7 +135,7 @@ class LaunchHandlers:
             if handler.body is not None:
                 self.supervisor.fire(handler.body, record.event)
 
-    def dispatch(self, kind: str, process: Process | None, event: Any) -> None:
+    def dispatch(self, kind: str, process: ProcessView | None, event: Any) -> None:
         """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec."""
         for handler in list(self.handlers):
             if handler.kind != kind:
@@ -150,7 +151,7 @@ class LaunchHandlers:
             if handler.body is not None:
                 self.supervisor.fire(handler.body, event)
 
-    def output(self, process: Process, stream: str, data: bytes) -> None:
+    def output(self, process: ProcessView, stream: str, data: bytes) -> None:
         """Complete lines of a child to the OnProcessIO handlers that want its ``stream``."""
         event_type = ev.ProcessStdout if stream == "stdout" else ev.ProcessStderr
         for handler in list(self.handlers):
@@ -203,7 +204,7 @@ def _completes(handler: AddHandler, action: object) -> bool:
     return handler.matcher is None or bool(handler.matcher(_Target(action)))
 
 
-def _details(process: Process) -> dict[str, Any]:
+def _details(process: ProcessView) -> dict[str, Any]:
     """What launch's process events carry about the process (ExecuteProcess.process_details)."""
     spec = process.spec
     return {

@@ -25,7 +25,7 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.engine.process import Process
+    from mlaunch.plan.events import ProcessView
 
 # Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
 # which mlaunch always writes so every process has its log).
@@ -298,7 +298,7 @@ class Printer(Sayings):
         else:
             self.output(process.label, event.stream, process.spec.output, event.data)
 
-    def _viewer_output(self, process: Process, data: bytes) -> None:
+    def _viewer_output(self, process: ProcessView, data: bytes) -> None:
         """A viewer stand-in's stdout with its address line, which mlaunch says itself.
 
         The address must be seen whatever the viewer's output mode (``log`` hides its stdout)

@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
-    from mlaunch.engine.process import Process
+    from mlaunch.plan.events import ProcessView
 
 # The viewer stand-in (mlaunch.standins.viewer) prints its page's address as a line starting
 # with this on stdout; mlaunch says the line itself, in every output mode and under -q.
@@ -123,7 +123,7 @@ class Sayings:
             if hint:
                 self.message("INFO", label, hint)
 
-    def _core_hint(self, process: Process, signal_number: int) -> str | None:
+    def _core_hint(self, process: ProcessView, signal_number: int) -> str | None:
         from mlaunch.engine.process import core_dump_hint, core_limit, read_core_pattern
 
         if self._core is None:

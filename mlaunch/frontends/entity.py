@@ -16,8 +16,8 @@ from __future__ import annotations
 import difflib
 from collections.abc import Callable
 
-from mlaunch.frontends.subst import Parts, TemplateError, parse_template
 from mlaunch.launch.substitutions import to_bool
+from mlaunch.launch_ros.subst import Parts, TemplateError, parse_template
 from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms to import

@@ -10,8 +10,8 @@ import mlaunch.launch.actions as core
 from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
-from mlaunch.frontends.subst import Part, Parts
 from mlaunch.launch.substitutions import Substitution, to_bool
+from mlaunch.launch_ros.subst import Part, Parts
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.steps import OUTPUT_MODES
 

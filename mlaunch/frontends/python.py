@@ -31,10 +31,13 @@ def set_launch_argv(target: str, second: str | None, arguments: list[str]) -> No
 
 
 def load(path: str) -> LaunchDescription:
-    from mlaunch.app import compat
+    """The description a Python launch file's generate_launch_description() returns.
+
+    The application serves the ROS 2 module names (``mlaunch.compat.install()``) before it loads
+    anything, so the file's ``from launch... import`` get mlaunch's classes.
+    """
     from mlaunch.launch.actions import LaunchDescription
 
-    compat.install()
     try:
         with open(path, "rb") as f:
             source = f.read()

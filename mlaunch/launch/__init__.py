@@ -1,4 +1,4 @@
-"""The ``launch`` API of ROS 2, served by mlaunch (see mlaunch.app.compat).
+"""The ``launch`` API of ROS 2, served by mlaunch (see mlaunch.compat).
 
 Launch files import ``launch``, ``launch.actions``, ``launch.substitutions`` ... and get these
 modules. The top-level names load on first use, so importing one submodule stays cheap.
@@ -12,7 +12,6 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.app.launch_service import LaunchService
     from mlaunch.launch.conditions import Condition
     from mlaunch.launch.event_handlers import EventHandler
     from mlaunch.launch.events import Event
@@ -33,7 +32,6 @@ _NAMES: dict[str, tuple[str, str]] = {
     "LaunchDescriptionEntity": ("mlaunch.launch.launch_description", "LaunchDescriptionEntity"),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
     "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
-    "LaunchService": ("mlaunch.app.launch_service", "LaunchService"),
     "EventHandler": ("mlaunch.launch.event_handlers", "EventHandler"),
     "Event": ("mlaunch.launch.events", "Event"),
     "LaunchDescriptionSource": (
@@ -62,9 +60,20 @@ _SUBMODULES = (
 )
 
 
+# Names of the launch API that a higher layer implements (``LaunchService`` runs the engine):
+# the application that serves the ROS 2 names adds them with ``provide`` (mlaunch.compat), so
+# this layer never imports upward.
+_PROVIDED: dict[str, tuple[str, str]] = {}
+
+
+def provide(name: str, module: str, attribute: str) -> None:
+    """Serve ``launch.<name>`` as ``attribute`` of ``module`` (imported on first use)."""
+    _PROVIDED[name] = (module, attribute)
+
+
 def __getattr__(name: str) -> Any:
-    if name in _NAMES:
-        module_name, attribute = _NAMES[name]
+    if name in _NAMES or name in _PROVIDED:
+        module_name, attribute = _NAMES[name] if name in _NAMES else _PROVIDED[name]
         value = getattr(importlib.import_module(module_name), attribute)
         globals()[name] = value
         return value

@@ -202,9 +202,10 @@ class ExecuteProcess(Action):
         pushed = context.launch_configurations.get(PUSHED_MACHINE)
         if self.machine is None and not pushed:
             return None  # the common case: nothing of mlaunch.machines is imported
-        from mlaunch.machines.actions import machine_for
+        from mlaunch.plan.machine import lookup
 
-        return machine_for(context, self.machine, self.origin)
+        name = pushed if self.machine is None else perform_substitutions(context, self.machine)
+        return lookup(context.run_state, str(name), self.origin) if name else None
 
     def _prefix(self, ctx: LaunchContext, argv: list[str]) -> list[str]:
         if self.prefix is not None:

@@ -269,25 +269,25 @@ def parameter_type(name: str, value: Any) -> int:
 
 def describe_request(request: LoadRequest, container: str, origin: str) -> list[str]:
     """--print lines of one component load, as a process is shown."""
-    from mlaunch.resolve.describe import _rel, _shorten, _value_text
+    from mlaunch.plan.text import rel, shorten, value_text
 
     lines = [
         f"component {request.full_name}   (loaded into {container})"
-        + (f"   {_rel(origin)}" if origin else ""),
+        + (f"   {rel(origin)}" if origin else ""),
         f"  plugin:  {request.plugin_name}   (package {request.package_name})",
     ]
     for rule in request.remap_rules:
         lines.append(f"  remap:   {rule}")
     for p in request.parameters:
-        lines.append(f"  param:   {p.name} = {_shorten(_value_text(_listed(p.value)), 120)}")
+        lines.append(f"  param:   {p.name} = {shorten(value_text(_listed(p.value)), 120)}")
     for p in request.extra_arguments:
-        lines.append(f"  extra:   {p.name} = {_value_text(_listed(p.value))}")
+        lines.append(f"  extra:   {p.name} = {value_text(_listed(p.value))}")
     return lines
 
 
 def request_data(request: LoadRequest) -> dict[str, Any]:
     """--print --format json: one component load as data (mlaunch.resolve.plan_json)."""
-    from mlaunch.resolve.plan_json import json_safe
+    from mlaunch.plan.text import json_safe
 
     def typed(p: TypedParameter) -> dict[str, Any]:
         return {"name": p.name, "value": json_safe(p.value), "type": TYPE_NAMES[p.type]}

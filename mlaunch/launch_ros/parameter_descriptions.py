@@ -331,7 +331,7 @@ class ParameterFile:
 
 def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -> str:
     """Perform the ``$(...)`` in a params file and write the result to a new file."""
-    from mlaunch.frontends.subst import TemplateError, parse_template
+    from mlaunch.launch_ros.subst import TemplateError, parse_template
 
     try:
         text = path.read_text(encoding="utf-8")

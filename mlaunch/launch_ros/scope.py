@@ -109,7 +109,7 @@ def _extend_shared(
     context: LaunchContext, action: Any, key: str, entries: tuple[Any, ...], what: str
 ) -> None:
     planner = context.planner
-    from mlaunch.resolve.binding import SCOPED_PARAMETERS, file_has
+    from mlaunch.plan.pragmas import SCOPED_PARAMETERS, file_has
 
     configs = context.launch_configurations
     current = configs.get(key)

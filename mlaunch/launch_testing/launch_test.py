@@ -73,7 +73,7 @@ def build_parser(prog: str = "launch_test") -> argparse.ArgumentParser:
 
 def load_module(name: str, path: str) -> ModuleType:
     """Import the test file as module ``name``, with the ROS 2 names served by mlaunch."""
-    from mlaunch.app import compat
+    from mlaunch import compat
 
     compat.install()
     spec = importlib.util.spec_from_file_location(name, path)

@@ -49,7 +49,7 @@ def pytest_pycollect_makemodule(module_path: Path, parent: Any) -> Any:
         return None
     if not _ROS_IMPORT.search(source):
         return None
-    from mlaunch.app import compat
+    from mlaunch import compat
 
     compat.install()
     if _LAUNCH_TEST_MARK.search(source) and b"generate_test_description" in source:

@@ -14,7 +14,7 @@ from mlaunch.launch.execute_process import PUSHED_MACHINE as PUSHED
 from mlaunch.launch.launch_description import Action
 from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
 from mlaunch.plan.errors import LaunchFileError
-from mlaunch.plan.machine import DEFAULT_TIMEOUT, MachineSpec, check_name, declared
+from mlaunch.plan.machine import DEFAULT_TIMEOUT, MachineSpec, check_name, declared, lookup
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -129,40 +129,11 @@ class PushMachine(Action):
 
     def execute(self, context: LaunchContext) -> None:
         name = perform_substitutions(context, self.name)
-        lookup(context, name, self.origin)
+        lookup(context.run_state, name, self.origin)
         context.launch_configurations[PUSHED] = name
 
     def describe_short(self) -> str:
         return f"PushMachine({describe(self.name)})"
-
-
-def lookup(context: LaunchContext, name: str, origin: str) -> MachineSpec:
-    """The declared machine ``name``, or a located error naming the declared ones."""
-    table = declared(context.run_state)
-    spec = table.get(name)
-    if spec is not None:
-        return spec
-    import difflib
-
-    close = difflib.get_close_matches(name, list(table), n=1)
-    if close:
-        hint = f" (did you mean {close[0]!r}?)"
-    elif table:
-        hint = f"; declared: {', '.join(sorted(table))}"
-    else:
-        hint = "; no machine is declared (Machine(...), <machine>) before it"
-    raise LaunchFileError(f"machine {name!r} is not declared{hint}", where=origin)
-
-
-def machine_for(context: LaunchContext, given: Any, origin: str) -> MachineSpec | None:
-    """The machine a process runs on: its own ``machine=``, else the pushed one, else None."""
-    if given is not None:
-        name = perform_substitutions(context, given)
-    else:
-        name = str(context.launch_configurations.get(PUSHED, ""))
-    if not name:
-        return None
-    return lookup(context, name, origin)
 
 
 def _flag(context: LaunchContext, value: Any) -> bool:

@@ -55,6 +55,7 @@ from mlaunch.plan.events import Controlled, Event, Exited, FailedToStart, NotSta
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.plan.events import ProcessView
 
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
 OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs")
@@ -328,7 +329,7 @@ class Control:
         elif isinstance(event, NotStarted):
             self._restarted(event.spec.label)
 
-    def _exited(self, process: Process) -> None:
+    def _exited(self, process: ProcessView) -> None:
         for wait in list(self._waits):
             waited, what, done = wait
             if waited is not process:

@@ -57,6 +57,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.process import Process
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.bridge import RosGraph, TransitionResult
+    from mlaunch.plan.events import ProcessView
 
 # get_state is asked again this often while waiting for a node (a lost request is not fatal).
 STATE_ATTEMPT = 2.0
@@ -91,7 +92,7 @@ class Managed:
     fqn: str
     spec: ProcessSpec
     drive: str = ""  # "autostart", "sequence" or "" (only events move it)
-    process: Process | None = None
+    process: ProcessView | None = None
     generation: int = 0  # bumped on every exit, so a late result of a dead process is ignored
     state: str = "unknown"
     brought_up: bool = False
@@ -197,7 +198,7 @@ class LifecycleManager:
                 event.taken = True
                 self._on_change_state(event.event)
 
-    def _on_process(self, exited: bool, process: Process) -> None:
+    def _on_process(self, exited: bool, process: ProcessView) -> None:
         managed = self._track(process.spec)
         if managed is None:
             return
@@ -423,7 +424,10 @@ class LifecycleManager:
             for fqn in reversed(self.activation_order)
             if fqn in self.nodes and self.nodes[fqn].process is not None
         ]
-        held = [m.process for m in targets if m.process is not None and m.process.running]
+        from mlaunch.engine.process import Process
+
+        # The records name processes by their view; the supervisor holds its own Process objects.
+        held = [m.process for m in targets if isinstance(m.process, Process) and m.process.running]
         if not held or not self.graph.started:
             return
         # They keep running until _release() hands them to the ladder.

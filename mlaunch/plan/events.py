@@ -24,8 +24,36 @@ from collections.abc import Callable
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.engine.process import Process
+    from typing import Protocol
+
     from mlaunch.plan.steps import Handoff, ProcessSpec
+
+    class ProcessView(Protocol):
+        """What a record tells of one running (or ended) process: the engine's Process
+        (mlaunch.engine.process) is one; this layer names only what subscribers read."""
+
+        spec: ProcessSpec
+        index: int
+        restarts: int
+        pid: int
+        returncode: int | None
+        started_at: float
+        ended_at: float
+        stopping: bool
+        user_stop: str
+        signals_sent: list[int]
+        core_dumped: bool
+        peak_rss: int
+        cpu_time: float
+
+        @property
+        def label(self) -> str: ...
+
+        @property
+        def argv(self) -> tuple[str, ...]: ...
+
+        @property
+        def running(self) -> bool: ...
 
 
 class Event:
@@ -47,7 +75,7 @@ class Started(Event):
 
     __slots__ = ("process",)
 
-    def __init__(self, process: Process) -> None:
+    def __init__(self, process: ProcessView) -> None:
         self.process = process
 
 
@@ -56,7 +84,7 @@ class FailedToStart(Event):
 
     __slots__ = ("process", "reason")
 
-    def __init__(self, process: Process, reason: str) -> None:
+    def __init__(self, process: ProcessView, reason: str) -> None:
         self.process = process
         self.reason = reason
 
@@ -84,7 +112,7 @@ class Output(Event):
 
     __slots__ = ("data", "process", "stream")
 
-    def __init__(self, process: Process, stream: str, data: bytes) -> None:
+    def __init__(self, process: ProcessView, stream: str, data: bytes) -> None:
         self.process = process
         self.stream = stream
         self.data = data
@@ -95,7 +123,7 @@ class Exited(Event):
 
     __slots__ = ("code", "process")
 
-    def __init__(self, process: Process, code: int) -> None:
+    def __init__(self, process: ProcessView, code: int) -> None:
         self.process = process
         self.code = code
 
@@ -105,7 +133,7 @@ class Escalated(Event):
 
     __slots__ = ("previous", "process", "signal", "waited")
 
-    def __init__(self, process: Process, signal: int, previous: int, waited: float) -> None:
+    def __init__(self, process: ProcessView, signal: int, previous: int, waited: float) -> None:
         self.process = process
         self.signal = signal
         self.previous = previous
@@ -118,7 +146,7 @@ class RespawnScheduled(Event):
     __slots__ = ("attempt", "code", "delay", "max_retries", "process")
 
     def __init__(
-        self, process: Process, code: int, attempt: int, max_retries: int, delay: float
+        self, process: ProcessView, code: int, attempt: int, max_retries: int, delay: float
     ) -> None:
         self.process = process
         self.code = code
@@ -132,7 +160,7 @@ class GaveUp(Event):
 
     __slots__ = ("code", "process", "restarts")
 
-    def __init__(self, process: Process, code: int, restarts: int) -> None:
+    def __init__(self, process: ProcessView, code: int, restarts: int) -> None:
         self.process = process
         self.code = code
         self.restarts = restarts

@@ -132,6 +132,26 @@ def declared(run_state: dict[str, Any]) -> dict[str, MachineSpec]:
     return table
 
 
+def lookup(run_state: dict[str, Any], name: str, origin: str) -> MachineSpec:
+    """The declared machine ``name``, or a located error naming the declared ones."""
+    table = declared(run_state)
+    spec = table.get(name)
+    if spec is not None:
+        return spec
+    import difflib
+
+    from mlaunch.plan.errors import LaunchFileError
+
+    close = difflib.get_close_matches(name, list(table), n=1)
+    if close:
+        hint = f" (did you mean {close[0]!r}?)"
+    elif table:
+        hint = f"; declared: {', '.join(sorted(table))}"
+    else:
+        hint = "; no machine is declared (Machine(...), <machine>) before it"
+    raise LaunchFileError(f"machine {name!r} is not declared{hint}", where=origin)
+
+
 def remote_machines(run_state: dict[str, Any]) -> list[MachineSpec]:
     """The declared machines reached over ssh (empty for a launch without machines)."""
     table: dict[str, MachineSpec] = run_state.get("machines") or {}

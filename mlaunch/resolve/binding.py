@@ -15,10 +15,7 @@ file:line of the timer or handler, saying what differs.
 
 from __future__ import annotations
 
-import re
-
-PRAGMA = "mlaunch: capture-at-definition"
-SCOPED_PARAMETERS = "mlaunch: scoped-parameters"
+from mlaunch.plan.pragmas import PRAGMA
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -26,38 +23,12 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
 
-_FILES: dict[str, str] = {}
-_PRAGMAS: dict[tuple[str, str], bool] = {}
 # The launch configurations launch_ros keeps the pushed namespace, parameters and remaps in.
 _ROS_STATE = {
     "ros_namespace": "the ROS namespace",
     "global_params": "the global parameters",
     "ros_remaps": "the global remaps",
 }
-
-
-def file_captures(origin: str) -> bool:
-    """Whether the launch file of ``origin`` (``path:line``) asks for capture-at-definition."""
-    return file_has(origin, PRAGMA)
-
-
-def file_has(origin: str, pragma: str) -> bool:
-    """Whether the launch file of ``origin`` (``path:line``) has ``pragma`` as a comment line:
-    ``# ...`` (Python, YAML) or ``<!-- ... -->`` (XML), so the file runs unchanged in ros2."""
-    if not origin:
-        return False
-    path = origin.rsplit(":", 1)[0] if origin[-1:].isdigit() else origin
-    if path not in _FILES:
-        try:
-            with open(path, encoding="utf-8", errors="replace") as f:
-                _FILES[path] = f.read()
-        except OSError:
-            _FILES[path] = ""
-    key = (path, pragma)
-    if key not in _PRAGMAS:
-        line = re.compile(r"^[ \t]*(#|<!--)[ \t]*" + re.escape(pragma), re.MULTILINE)
-        _PRAGMAS[key] = line.search(_FILES[path]) is not None
-    return _PRAGMAS[key]
 
 
 class _Uses:

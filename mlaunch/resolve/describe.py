@@ -18,6 +18,7 @@ from mlaunch.plan.steps import (
     Spawn,
     StartTimer,
 )
+from mlaunch.plan.text import rel, shorten, value_text
 
 LONG_VALUE = 160
 
@@ -32,7 +33,7 @@ HANDLER_WORDS = {
 
 def describe_plan(plan: Plan, path: str) -> str:
     processes = plan.processes()
-    out = [f"Plan for {_rel(path)}: {len(processes)} process(es) at start", ""]
+    out = [f"Plan for {rel(path)}: {len(processes)} process(es) at start", ""]
     for warning in plan.warnings:
         out.append(f"warning: {warning}")
     if plan.warnings:
@@ -44,7 +45,7 @@ def describe_plan(plan: Plan, path: str) -> str:
             out.append(f"log [{step.level}] {step.message}")
         elif isinstance(step, StartTimer) and step.body is not None:
             out.append(
-                f"timer after {step.period:g} s: {step.body.describe()}   ({_rel(step.origin)})"
+                f"timer after {step.period:g} s: {step.body.describe()}   ({rel(step.origin)})"
             )
         elif isinstance(step, AddHandler) and step.body is not None:
             target = "any process" if step.matcher is None else "its target"
@@ -55,7 +56,7 @@ def describe_plan(plan: Plan, path: str) -> str:
             what = (
                 step.body.describe() if (step.body.entities or step.body.callback) else "callbacks"
             )
-            out.append(f"handler {when}: {what}   ({_rel(step.origin)})")
+            out.append(f"handler {when}: {what}   ({rel(step.origin)})")
         elif isinstance(step, RemoveHandler):
             out.append("remove a handler")
         elif isinstance(step, RequestShutdown):
@@ -74,11 +75,9 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
     head = spec.label
     if spec.standin:
         head += f"   (stand-in for {spec.standin})"
-    lines = [head + (f"   {_rel(spec.origin)}" if spec.origin else "")]
+    lines = [head + (f"   {rel(spec.origin)}" if spec.origin else "")]
     argv = " ".join(spec.argv) if spec.shell else shlex.join(spec.argv)
-    lines.append(
-        f"  argv:    {_shorten(argv, 400)}" + ("   [via /bin/sh -c]" if spec.shell else "")
-    )
+    lines.append(f"  argv:    {shorten(argv, 400)}" + ("   [via /bin/sh -c]" if spec.shell else ""))
     if spec.node is not None and spec.node.fully_qualified_name:
         kind = "lifecycle node" if spec.node.lifecycle else "node"
         auto = " (autostart)" if spec.node.autostart else ""
@@ -88,7 +87,7 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
     lines.append(f"  cwd:     {spec.cwd or '(inherited)'}")
     if spec.env_changes:
         changes = [
-            f"{k}={_shorten(v, 60)}" if v is not None else f"-{k}"
+            f"{k}={shorten(v, 60)}" if v is not None else f"-{k}"
             for k, v in sorted(spec.env_changes.items())
         ]
         lines.append(f"  env:     {' '.join(changes)}")
@@ -126,7 +125,7 @@ def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         for node, section in (data or {}).items():
             params = (section or {}).get("ros__parameters", {})
             for name, value in _flatten(params):
-                out.append(f"  param:   {name} = {_value_text(value)}   [{node}]")
+                out.append(f"  param:   {name} = {value_text(value)}   [{node}]")
     return out
 
 
@@ -139,34 +138,6 @@ def _flatten(params: dict[str, object], prefix: str = "") -> list[tuple[str, obj
         else:
             items.append((name, value))
     return items
-
-
-def _value_text(value: object) -> str:
-    if isinstance(value, str):
-        if len(value) > 80 or "\n" in value:
-            first = value.strip().splitlines()[0] if value.strip() else ""
-            return f"<string, {len(value)} chars: {_shorten(first, 50)}>"
-        return repr(value)
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(value)
-
-
-def _shorten(text: str, limit: int) -> str:
-    text = text.replace("\n", "\\n")
-    if len(text) <= limit:
-        return text
-    return f"{text[: limit - 20]}... <{len(text)} chars>"
-
-
-def _rel(path: str) -> str:
-    if not path:
-        return ""
-    try:
-        rel = os.path.relpath(path)
-    except ValueError:
-        return path
-    return rel if not rel.startswith("../../") else path
 
 
 def format_arguments(infos: Sequence[ArgumentInfo]) -> str:

@@ -16,7 +16,6 @@ Only ``--print`` imports this module (json and yaml stay off a launch's start-up
 from __future__ import annotations
 
 import json
-import math
 import os
 import signal
 
@@ -33,7 +32,8 @@ from mlaunch.plan.steps import (
     StartTimer,
     Step,
 )
-from mlaunch.resolve.describe import _flatten, _rel
+from mlaunch.plan.text import json_safe, rel
+from mlaunch.resolve.describe import _flatten
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -69,7 +69,7 @@ def arguments_json(infos: Sequence[ArgumentInfo], path: str, given: Mapping[str,
     arguments = [{**_argument(info, given), "value": given.get(info.name)} for info in infos]
     document = {
         "schema": ARGUMENTS_SCHEMA_ID,
-        "launch_file": _rel(path),
+        "launch_file": rel(path),
         "arguments": arguments,
     }
     return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
@@ -90,7 +90,7 @@ def plan_document(
     }
     return {
         "schema": SCHEMA_ID,
-        "launch_file": _rel(path),
+        "launch_file": rel(path),
         "arguments": [_argument(info, given) for info in plan.arguments.values()],
         "undeclared_arguments": undeclared,
         "warnings": list(plan.warnings),
@@ -106,8 +106,8 @@ def origin_data(origin: str) -> dict[str, Any] | None:
         return None
     file, sep, line = origin.rpartition(":")
     if not sep or not line.isdigit():
-        return {"file": _rel(origin), "line": None}
-    return {"file": _rel(file), "line": int(line)}
+        return {"file": rel(origin), "line": None}
+    return {"file": rel(file), "line": int(line)}
 
 
 def _argument(info: ArgumentInfo, given: Mapping[str, str]) -> dict[str, Any]:
@@ -425,20 +425,6 @@ def _as_rcl_reads(value: Any) -> Any:
     if isinstance(value, list):
         return [_as_rcl_reads(v) for v in value]
     if value is None or isinstance(value, (bool, int, float, str, dict, tuple)):
-        return value
-    return str(value)
-
-
-def json_safe(value: Any) -> Any:
-    """YAML data as JSON data: non-finite floats as YAML spells them, other scalars (dates,
-    bytes) as text, keys as text."""
-    if isinstance(value, dict):
-        return {str(k): json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_safe(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return ".nan" if math.isnan(value) else (".inf" if value > 0 else "-.inf")
-    if value is None or isinstance(value, (bool, int, float, str)):
         return value
     return str(value)
 

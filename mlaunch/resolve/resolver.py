@@ -182,7 +182,7 @@ class Resolver:
         return self.labels.next(base)
 
     def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
-        from mlaunch.resolve.binding import file_captures
+        from mlaunch.plan.pragmas import file_captures
 
         entities = list(entities)
         # Resolved only when they fire: what they may need must be known before the run.
@@ -205,12 +205,12 @@ class Resolver:
             )
         if source.launch_description is not None:
             return source.launch_description
-        from mlaunch import frontends
+        from mlaunch import readers
 
         path = source.get_launch_file_location(self.context)
         if path is None or not os.path.exists(path):
             raise LaunchFileError(f"included launch file {path!r} does not exist", where=origin)
-        return frontends.load(path, source.format_hint)
+        return readers.load(path, source.format_hint)
 
     def locate_program(
         self, argv: list[str], *, shell: bool, origin: str
@@ -466,10 +466,10 @@ def collect_arguments(
         if location in seen or not os.path.exists(location):
             return
         seen.add(location)
-        from mlaunch import frontends
+        from mlaunch import readers
 
         with context.file_locals(location):
-            walk([frontends.load(location, source.format_hint)], conditional)
+            walk([readers.load(location, source.format_hint)], conditional)
 
     if path is None:
         walk([description], False)

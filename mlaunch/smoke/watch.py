@@ -15,10 +15,10 @@ from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
 if TYPE_CHECKING:
-    from mlaunch.engine.process import Process
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.handoff import SharedGraph
     from mlaunch.parts.lifecycle import LifecycleManager, Outcome
+    from mlaunch.plan.events import ProcessView
     from mlaunch.plan.steps import Plan, ProcessSpec
 
 # At the end, the youngest process is given up to this long since its start before the stop
@@ -122,7 +122,7 @@ class SmokeRun:
                     break
         self._maybe_ready()
 
-    def _on_process(self, exited: bool, process: Process) -> None:
+    def _on_process(self, exited: bool, process: ProcessView) -> None:
         label = process.label
         e = next((x for x in self.expectations if x.key() == ("process", label)), None)
         if e is None:
@@ -168,7 +168,7 @@ class SmokeRun:
         )
         self._checker.start()
 
-    def _exited(self, e: Expectation, process: Process) -> None:
+    def _exited(self, e: Expectation, process: ProcessView) -> None:
         """A process ended: a failure whenever it happens (before ready, in the hold, in the
         shutdown), unless it was a one-shot, the end of mlaunch's own stop or allowed."""
         from mlaunch.engine.process import describe_status

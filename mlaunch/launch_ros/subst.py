@@ -16,6 +16,10 @@ Deliberate differences from ROS 2: a backslash before any other character is kep
 it, so ``\\d`` became ``d``), and a lone ``$`` is text (ROS 2's grammar rejects it).
 
 Errors are ``TemplateError(message, index)``; the frontend turns the index into file:line:col.
+
+It sits at the top of the launch API (here, in launch_ros) because it builds launch's and
+launch_ros's substitutions, and ``ParameterFile(allow_substs=True)`` reads params files with it;
+the readers (mlaunch.frontends) use it from here.
 """
 
 from __future__ import annotations

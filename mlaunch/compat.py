@@ -106,6 +106,9 @@ def install() -> None:
     """Serve the ROS 2 names from now on in this process (idempotent)."""
     if _FINDER in sys.meta_path:
         return
+    import mlaunch.launch
+
+    mlaunch.launch.provide("LaunchService", "mlaunch.app.launch_service", "LaunchService")
     sys.meta_path.insert(0, _FINDER)
     # A real launch/launch_ros/ament_index_python imported earlier must not win.
     for name in list(sys.modules):
