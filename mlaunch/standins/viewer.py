@@ -400,6 +400,20 @@ class DepthFeed:
         self.state.set_depth(msg.width, msg.height, msg.encoding, msg.data, 0.0, time.monotonic())
 
 
+def driver(node: Node) -> Any:
+    """What the page's keys call: publish (linear m/s, angular rad/s) as a Twist on cmd_vel."""
+    from geometry_msgs.msg import Twist
+
+    publisher = node.create_publisher(Twist, "cmd_vel", 10)
+
+    def drive(linear: float, angular: float) -> None:
+        msg = Twist()
+        msg.linear.x, msg.angular.z = linear, angular
+        publisher.publish(msg)
+
+    return drive
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the viewer until shutdown; 1 with a one-line error when its input is unusable."""
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
@@ -426,10 +440,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             node.get_logger().warn(warning)
         state = ViewerState(config)
         subscribe(node, state)
-        server = serve(state, port, time.monotonic)
+        server = serve(state, port, time.monotonic, driver(node))
         node.get_logger().info(
             f"stand-in for rviz2: fixed frame {config.fixed_frame!r}, drawing "
-            f"{config.description_topic}, {config.odom_topic}, {config.scan_topic}"
+            f"{config.description_topic}, {config.odom_topic}, {config.scan_topic}; the page's"
+            " arrow keys publish cmd_vel"
         )
         print(f"viewer: open http://127.0.0.1:{server.server_address[1]}/", flush=True)
         spin(node, stop)

@@ -1,18 +1,26 @@
-"""The viewer stand-in's web server: the page, its JSON state and the depth picture.
+"""The viewer stand-in's web server: the page, its JSON state, the depth picture, and driving.
 
 Only the standard library (http.server in a thread). A browser that goes away mid-request is
 routine and costs no traceback in the launch output.
+
+It listens on 127.0.0.1 only, and answers only requests addressed to it by that name: a
+``Host:`` of ``127.0.0.1`` or ``localhost`` (with its port, if any). A web page elsewhere could
+otherwise point a name of its own at 127.0.0.1 (DNS rebinding) and read ``/state.json``. A
+connection that sends nothing for ``IDLE_TIMEOUT`` seconds is closed (each holds a thread).
+``POST /cmd_vel`` (the page's keys) is taken only from the page itself: same Host, an
+``Origin`` of this server, and a JSON body, which a cross-site form cannot send.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from mlaunch.standins.viewer_config import PORT_ENV, ViewerError
 
@@ -20,13 +28,80 @@ if TYPE_CHECKING:
     from mlaunch.standins.viewer import ViewerState
 
 PAGE = Path(__file__).with_name("viewer.html")
+IDLE_TIMEOUT = 5.0  # seconds a connection may stay silent (the page polls every 0.1 s)
+LOCAL_NAMES = ("127.0.0.1", "localhost")
+# The fastest the page may ask for (m/s, rad/s): a key held is a command, not a typo's 1e9.
+MAX_LINEAR, MAX_ANGULAR = 2.0, 3.0
 
 
-def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRequestHandler]:
-    """A request handler class serving the page and its JSON for this ``state``."""
+class Drive(Protocol):
+    def __call__(self, linear: float, angular: float) -> None: ...
+
+
+def make_handler(
+    state: ViewerState, page: bytes, clock: Any, drive: Drive | None = None
+) -> type[BaseHTTPRequestHandler]:
+    """A request handler class serving the page and its JSON for this ``state``; ``drive``
+    publishes the page's velocity commands (None: driving is off)."""
 
     class Handler(BaseHTTPRequestHandler):
+        timeout = IDLE_TIMEOUT
+
+        def origins(self) -> set[str]:
+            address = self.server.server_address
+            port = address[1] if isinstance(address, tuple) else 0
+            return {f"{name}:{port}" for name in LOCAL_NAMES} | set(LOCAL_NAMES)
+
+        def host_allowed(self) -> bool:
+            host = (self.headers.get("Host") or "").strip().lower()
+            if host in self.origins():
+                return True
+            self._send(421, "text/plain; charset=utf-8", b"this server answers 127.0.0.1 only\n")
+            return False
+
+        def do_POST(self) -> None:
+            if not self.host_allowed():
+                return
+            if self.path.split("?", 1)[0] != "/cmd_vel" or drive is None:
+                self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
+                return
+            origin = (self.headers.get("Origin") or "").lower()
+            if not origin.startswith("http://") or origin[7:] not in self.origins():
+                self._send(403, "text/plain; charset=utf-8", b"only the viewer's page drives\n")
+                return
+            command = self._command()
+            if command is None:
+                return
+            drive(*command)
+            self._send(204, "text/plain; charset=utf-8", b"")
+
+        def _command(self) -> tuple[float, float] | None:
+            """(linear, angular) from a small JSON body, or None once the 400 is sent."""
+            kind = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
+            try:
+                length = int(self.headers.get("Content-Length") or "-1")
+            except ValueError:
+                length = -1
+            if kind != "application/json" or not 0 <= length <= 1024:
+                self._send(400, "text/plain; charset=utf-8", b"expected a small JSON body\n")
+                return None
+            try:
+                body = json.loads(self.rfile.read(length))
+                linear, angular = float(body["linear"]), float(body["angular"])
+            except (ValueError, KeyError, TypeError):
+                linear = angular = math.nan
+            if not (math.isfinite(linear) and math.isfinite(angular)):
+                self._send(
+                    400,
+                    "text/plain; charset=utf-8",
+                    b'expected {"linear": m/s, "angular": rad/s}\n',
+                )
+                return None
+            return _clamp(linear, MAX_LINEAR), _clamp(angular, MAX_ANGULAR)
+
         def do_GET(self) -> None:
+            if not self.host_allowed():
+                return
             path = self.path.split("?", 1)[0]
             if path in ("/", "/index.html"):
                 self._send(200, "text/html; charset=utf-8", page)
@@ -51,6 +126,10 @@ def make_handler(state: ViewerState, page: bytes, clock: Any) -> type[BaseHTTPRe
             pass  # a poll every 100 ms would flood the launch output
 
     return Handler
+
+
+def _clamp(value: float, limit: float) -> float:
+    return max(-limit, min(limit, value))
 
 
 # A browser that goes away mid-request (a reload, a cancelled poll, a closed tab) is routine.
@@ -84,11 +163,11 @@ class PageServer(ThreadingHTTPServer):
             pass
 
 
-def serve(state: ViewerState, port: int, clock: Any) -> PageServer:
+def serve(state: ViewerState, port: int, clock: Any, drive: Drive | None = None) -> PageServer:
     """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
     page = PAGE.read_bytes()
     try:
-        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock))
+        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock, drive))
     except OSError as exc:
         raise ViewerError(
             f"cannot listen on 127.0.0.1:{port}: {exc.strerror}; valid: a free port, or 0 for"
