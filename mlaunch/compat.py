@@ -49,15 +49,6 @@ SYNONYMS: dict[str, str] = {
     "launch_ros.events.lifecycle": "mlaunch.launch_ros.events",
     "launch_ros.utilities": "mlaunch.launch_ros",
     "ament_index_python.packages": "mlaunch.ros.ament_index",
-    "launch_testing.tools.text": "mlaunch.launch_testing.text",
-    "launch_testing.tools.output": "mlaunch.launch_testing.tools",
-    "launch_testing.tools.process": "mlaunch.launch_testing.tools",
-    "launch_testing.decorator": "mlaunch.launch_testing.markers",
-    "launch_testing.parametrize": "mlaunch.launch_testing.markers",
-    "launch_testing.ready_to_test_action_timeout": "mlaunch.launch_testing.markers",
-    "launch_testing.test_result": "mlaunch.launch_testing.test_runner",
-    "launch_testing.util.proc_lookup": "mlaunch.launch_testing.util",
-    "launch_pytest.tools.process": "mlaunch.launch_pytest.tools",
 }
 
 

@@ -12,10 +12,11 @@ from mlaunch.launch.actions import ExecuteProcess
 from mlaunch.launch.events import ProcessExited, ProcessIO
 from mlaunch.launch_testing.asserts import SequentialTextChecker, assertExitCodes, assertInStdout
 from mlaunch.launch_testing.io_handler import IoHandler
-from mlaunch.launch_testing.markers import parametrize, retry_on_failure
+from mlaunch.launch_testing.markers import retry_on_failure
+from mlaunch.launch_testing.parametrize import parametrize
 from mlaunch.launch_testing.proc_info_handler import ProcInfoHandler
-from mlaunch.launch_testing.text import build_line_match, build_text_match
 from mlaunch.launch_testing.tools import basic_output_filter, expect_output
+from mlaunch.launch_testing.tools.text import build_line_match, build_text_match
 from mlaunch.launch_testing.util import NO_CMD_ARGS, NoMatchingProcessException, resolveProcesses
 
 
@@ -77,7 +78,7 @@ def test_processes_by_action_by_name_and_by_arguments() -> None:
         resolveProcesses(output, process="talker")
     with pytest.raises(NoMatchingProcessException, match="Procs: "):
         resolveProcesses(output, process="nobody")
-    with pytest.raises(TypeError, match="ExecuteProcess action or a str"):
+    with pytest.raises(TypeError, match="must be .ExecuteProcess. or .str. not"):
         resolveProcesses(output, process=3)
     assertInStdout(output, "listener-2 up", "listener")
     with pytest.raises(AssertionError, match="Did not find 'nope'"):

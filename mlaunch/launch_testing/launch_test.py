@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
     from types import ModuleType
 
-    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+    from mlaunch.launch_testing.test_runner import LaunchTestRunner
 
 # mlaunch.plan.errors' table: a launch test's own errors (its file, its arguments) are bad input.
 EXIT_PASS = EXIT_OK
@@ -40,12 +40,8 @@ def is_launch_test_file(path: str) -> bool:
         return False
 
 
-def build_parser(prog: str = "launch_test") -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog=prog,
-        description="Run a launch_testing file: launch it, run its tests, report.",
-        epilog="Exit status: 0 every test passed, 1 a test failed, 2 bad input.",
-    )
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """launch_test's arguments, on ``parser``."""
     parser.add_argument("launch_test_file", help="path to the launch test (FILE.test.py)")
     parser.add_argument(
         "--package-name", default=None, help="package the test is in (names the JUnit report)"
@@ -68,7 +64,22 @@ def build_parser(prog: str = "launch_test") -> argparse.ArgumentParser:
         default=None,
         help="write a JUnit XML report to this path",
     )
+
+
+def build_parser(prog: str = "launch_test") -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description="Run a launch_testing file: launch it, run its tests, report.",
+        epilog="Exit status: 0 every test passed, 1 a test failed, 2 bad input.",
+    )
+    add_arguments(parser)
     return parser
+
+
+def parse_arguments() -> tuple[argparse.ArgumentParser, argparse.Namespace]:
+    """(parser, the parsed command line), as launch_testing's launch_test reads it."""
+    parser = build_parser()
+    return parser, parser.parse_args()
 
 
 def load_module(name: str, path: str) -> ModuleType:
@@ -84,8 +95,14 @@ def load_module(name: str, path: str) -> ModuleType:
     return module
 
 
-def run(args: argparse.Namespace) -> int:
-    from mlaunch.launch_testing.loader import load_test_runs
+def run(
+    parser: argparse.ArgumentParser,
+    args: argparse.Namespace,
+    test_runner_cls: type[LaunchTestRunner] | None = None,
+) -> int:
+    """Load the test file, run its launches and tests with ``test_runner_cls`` (launch_testing's
+    LaunchTestRunner unless told: launch_testing_ros passes its own), write the JUnit report."""
+    from mlaunch.launch_testing.loader import LoadTestsFromPythonModule
     from mlaunch.launch_testing.test_runner import LaunchTestRunner
 
     path = os.path.abspath(args.launch_test_file)
@@ -94,33 +111,32 @@ def run(args: argparse.Namespace) -> int:
     basename = os.path.splitext(os.path.basename(path))[0]
     package = args.package_name or basename
     module = load_module(package, path)
-    runs = load_test_runs(module, name=f"{package}.{basename}.launch_tests")
-    runner = LaunchTestRunner(runs, launch_file_arguments=args.launch_arguments, debug=args.verbose)
+    runs = LoadTestsFromPythonModule(module, name=f"{package}.{basename}.launch_tests")
+    runner = (test_runner_cls or LaunchTestRunner)(
+        runs, launch_file_arguments=args.launch_arguments, debug=args.verbose
+    )
     runner.validate()
     if args.show_args:
-        show_arguments(runs[0].launch_description(), path)
+        from mlaunch.launch_testing.print_arguments import print_arguments_of_launch_description
+
+        print_arguments_of_launch_description(
+            launch_description=runs[0].get_launch_description(), path=path
+        )
         return EXIT_PASS
     results = runner.run()
     if args.xmlpath:
-        from mlaunch.launch_testing.junitxml import write_report
+        from mlaunch.launch_testing.junitxml import unittestResultsToXml
 
-        write_report(args.xmlpath, f"{package}.{basename}", results)
+        report = unittestResultsToXml(test_results=results, name=f"{package}.{basename}")
+        report.write(args.xmlpath, encoding="utf-8", xml_declaration=True)
     return EXIT_PASS if all(r.wasSuccessful() for r in results.values()) else EXIT_FAIL
-
-
-def show_arguments(description: LaunchDescriptionEntity, path: str) -> None:
-    from mlaunch.resolve.describe import format_arguments
-    from mlaunch.resolve.resolver import collect_arguments
-
-    infos = collect_arguments(description, path=path, arguments={}, environ=os.environ)
-    sys.stdout.write(format_arguments(infos))
 
 
 def main(argv: Sequence[str] | None = None, prog: str = "launch_test") -> int:
     parser = build_parser(prog)
     args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
     try:
-        return run(args)
+        return run(parser, args)
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
     except Exception as e:

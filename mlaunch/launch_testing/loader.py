@@ -13,7 +13,7 @@ import functools
 import inspect
 import unittest
 
-from mlaunch.launch_testing.actions import ReadyToTest
+from mlaunch.launch_testing.actions.ready import ReadyToTest
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -48,7 +48,7 @@ class TestRun:
             # test_x becomes test_x[value, ...], so the report says which launch it ran on.
             for case in self.all_cases():
                 method = getattr(case, case._testMethodName)
-                renamed = case._testMethodName + self.format_params()
+                renamed = case._testMethodName + self._format_params()
                 case._testMethodName = renamed
                 setattr(case, renamed, method)
         # unittest drops each test from its suite after running it; JUnit reports need them.
@@ -63,14 +63,13 @@ class TestRun:
         )
         return markers
 
-    def test_description(self, ready_fn: Callable[[], None]) -> tuple[Any, dict[str, Any]]:
-        """(launch description, test context), with ``ready_fn`` on its ReadyToTest."""
-        function = self.description_function
-        if "ready_fn" in inspect.signature(function).parameters:
-            result = function(ready_fn=ready_fn)  # the old style: the test calls ready_fn itself
-            description, context = result if isinstance(result, tuple) else (result, {})
-            return description, dict(context)
-        result = function()
+    def normalized_test_description(self, *, ready_fn: Callable[[], object]) -> tuple[Any, Any]:
+        """(launch description, test context), with ``ready_fn`` on its ReadyToTest.
+
+        ``generate_test_description`` returns a description or (description, context); the
+        description must hold a ReadyToTest, however deep (groups, timers, handlers).
+        """
+        result = self.description_function()
         description, context = result if isinstance(result, tuple) else (result, {})
         ready = next(iter_ready_to_test(getattr(description, "entities", [])), None)
         if ready is None:
@@ -79,14 +78,22 @@ class TestRun:
                 " containing a ReadyToTest action"
             )
         ready._add_callback(ready_fn)
-        return description, dict(context)
+        return description, context
 
-    def launch_description(self) -> Any:
+    def get_launch_description(self) -> Any:
         """The description alone, for --show-args (not meant to be launched)."""
-        return self.test_description(lambda: None)[0]
+        return self.normalized_test_description(ready_fn=lambda: None)[0]
 
-    def bind(self, tests: unittest.TestSuite, values: dict[str, Any]) -> None:
-        """Give each test what it names as a parameter; also as ``self.NAME`` (ROS 2's old way)."""
+    def bind(
+        self,
+        tests: Any,
+        injected_attributes: dict[str, Any] | None = None,
+        injected_args: dict[str, Any] | None = None,
+    ) -> None:
+        """Give the tests ``injected_args`` as the parameters they name (test methods, setUp,
+        tearDown, setUpClass, tearDownClass), and ``injected_attributes`` as ``self.NAME``
+        (launch_testing's older way)."""
+        values = injected_args or {}
         for case in _cases(tests):
             method = getattr(case, case._testMethodName)
             setattr(case, case._testMethodName, _bind_matching(method, values))
@@ -95,21 +102,20 @@ class TestRun:
         for cls in _classes(tests):
             cls.setUpClass = _bind_matching(cls.setUpClass, values)  # type: ignore[method-assign]
             cls.tearDownClass = _bind_matching(cls.tearDownClass, values)  # type: ignore[method-assign]
-            for name in ("launch_service", "proc_info", "proc_output", "test_args"):
-                if name in values:
-                    setattr(cls, name, values[name])
+            for name, value in (injected_attributes or {}).items():
+                setattr(cls, name, value)
 
     def all_cases(self) -> Iterator[unittest.TestCase]:
         yield from _cases(self.pre_shutdown_tests)
         yield from _cases(self.post_shutdown_tests)
 
-    def format_params(self) -> str:
+    def _format_params(self) -> str:
         if not self.param_args:
             return ""
         return "[" + ", ".join(str(v) for v in self.param_args.values()) + "]"
 
     def __str__(self) -> str:
-        return self.name + self.format_params()
+        return self.name + self._format_params()
 
 
 def iter_ready_to_test(entities: Iterable[Any]) -> Iterator[ReadyToTest]:
@@ -134,13 +140,14 @@ def _children(entity: Any) -> list[Any]:
     return found
 
 
-def load_test_runs(module: ModuleType, name: str = "launch_tests") -> list[TestRun]:
-    """The TestRuns of a loaded launch test module (several when it is parametrized)."""
+def LoadTestsFromPythonModule(module: ModuleType, *, name: str = "launch_tests") -> list[TestRun]:
+    """The TestRuns of a launch test module: one, or one per value set when its
+    generate_test_description is parametrized."""
     generate = getattr(module, "generate_test_description", None)
     if generate is None:
         raise Exception(
-            f"{getattr(module, '__file__', module)}: a launch test file must define"
-            " generate_test_description()"
+            f"{getattr(module, '__file__', None) or module.__name__}: a launch test file must"
+            " define generate_test_description()"
         )
     parametrized = getattr(generate, "__parametrized__", False)
     runs = list(generate()) if parametrized else [(generate, {})]
@@ -149,11 +156,21 @@ def load_test_runs(module: ModuleType, name: str = "launch_tests") -> list[TestR
             name,
             function,
             args,
-            _loader(post_shutdown=False).loadTestsFromModule(module),
-            _loader(post_shutdown=True).loadTestsFromModule(module),
+            PreShutdownTestLoader().loadTestsFromModule(module),
+            PostShutdownTestLoader().loadTestsFromModule(module),
         )
         for function, args in runs
     ]
+
+
+def PreShutdownTestLoader() -> unittest.TestLoader:
+    """A loader of a module's active test classes (those not marked post_shutdown_test)."""
+    return _loader(post_shutdown=False)
+
+
+def PostShutdownTestLoader() -> unittest.TestLoader:
+    """A loader of a module's post_shutdown_test classes."""
+    return _loader(post_shutdown=True)
 
 
 def _loader(*, post_shutdown: bool) -> unittest.TestLoader:

@@ -9,14 +9,15 @@ on the main thread against what was recorded.
 from __future__ import annotations
 
 import threading
-import time
 import unittest
 
 from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import LaunchDescription, RegisterEventHandler
 from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
 from mlaunch.launch_testing.io_handler import ActiveIoHandler
+from mlaunch.launch_testing.parse_arguments import parse_launch_arguments
 from mlaunch.launch_testing.proc_info_handler import ActiveProcInfoHandler
+from mlaunch.launch_testing.test_result import FailResult, SkipResult, TestResult
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -26,80 +27,8 @@ if TYPE_CHECKING:
     from mlaunch.launch_testing.loader import TestRun
 
 
-class TestResult(unittest.TextTestResult):
-    """A TextTestResult that remembers every test it ran and how long each took."""
-
-    def __init__(self, stream: Any = None, descriptions: Any = None, verbosity: Any = None):
-        super().__init__(stream, descriptions, verbosity)
-        self._times: dict[unittest.TestCase, list[float]] = {}
-
-    @property
-    def testCases(self) -> list[unittest.TestCase]:
-        return list(self._times)
-
-    @property
-    def testTimes(self) -> dict[unittest.TestCase, float]:
-        return {case: end - start for case, (start, end) in self._times.items()}
-
-    def startTest(self, test: unittest.TestCase) -> None:
-        self._times[test] = [time.monotonic(), time.monotonic()]
-        super().startTest(test)
-
-    def stopTest(self, test: unittest.TestCase) -> None:
-        self._times[test][1] = time.monotonic()
-        super().stopTest(test)
-
-    def append(self, other: TestResult) -> None:
-        """Add the results of the post-shutdown tests to the active tests' results."""
-        self._times.update(other._times)
-        self.failures += other.failures
-        self.errors += other.errors
-        self.testsRun += other.testsRun
-        self.skipped += other.skipped
-        self.expectedFailures += other.expectedFailures
-        self.unexpectedSuccesses += other.unexpectedSuccesses
-
-
-class _WholeRunResult(unittest.TestResult):
-    """Every test of a run failed (the launch died early) or skipped (a skipped description)."""
-
-    def __init__(self, test_run: TestRun, *, failure: str | None = None, skip: str = "") -> None:
-        super().__init__()
-        self.failed = failure is not None
-        for case in test_run.all_cases():
-            if failure is not None:
-                self.addFailure(case, (Exception, Exception(failure), None))  # type: ignore[arg-type]
-            else:
-                self.addSkip(case, skip)
-            self.testsRun += 1
-
-    @property
-    def testCases(self) -> list[Any]:
-        return [case for case, _ in (self.failures if self.failed else self.skipped)]
-
-    @property
-    def testTimes(self) -> dict[Any, float]:
-        return dict.fromkeys(self.testCases, 0.0)
-
-    def wasSuccessful(self) -> bool:
-        return not self.failed
-
-
 class _LaunchDied(Exception):
     """The launch ended before the active tests did (every process exited, or Ctrl-C)."""
-
-
-def parse_launch_arguments(arguments: Sequence[str]) -> list[tuple[str, str]]:
-    """``name:=value`` items -> (name, value) pairs; anything else is a usage error."""
-    pairs = []
-    for item in arguments:
-        name, sep, value = item.partition(":=")
-        if not sep or not name:
-            raise ValueError(
-                f"malformed launch argument {item!r}, expected format '<name>:=<value>'"
-            )
-        pairs.append((name, value))
-    return pairs
 
 
 class _RunnerWorker:
@@ -121,28 +50,23 @@ class _RunnerWorker:
 
     def run(self) -> TestResult:
         run = self.test_run
-        description, context = run.test_description(self.ready.set)
+        description, context = run.normalized_test_description(ready_fn=self.ready.set)
         proc_info = ActiveProcInfoHandler()
         proc_output = ActiveIoHandler()
         test_args = dict(parse_launch_arguments(self.launch_arguments))
-        values = {**context, **run.param_args, "test_args": test_args}
-        run.bind(
-            run.pre_shutdown_tests,
-            {
-                **values,
-                "launch_service": self.service,
-                "proc_info": proc_info,
-                "proc_output": proc_output,
-            },
-        )
-        run.bind(
-            run.post_shutdown_tests,
-            {
-                **values,
-                "proc_info": proc_info._proc_info_handler,
-                "proc_output": proc_output._io_handler,
-            },
-        )
+        active = {
+            "launch_service": self.service,
+            "proc_info": proc_info,
+            "proc_output": proc_output,
+            "test_args": test_args,
+        }
+        run.bind(run.pre_shutdown_tests, active, {**context, **run.param_args, **active})
+        post = {
+            "proc_info": proc_info._proc_info_handler,
+            "proc_output": proc_output._io_handler,
+            "test_args": test_args,
+        }
+        run.bind(run.post_shutdown_tests, post, {**context, **run.param_args, **post})
         self.service.include_launch_description(
             LaunchDescription(
                 [
@@ -158,21 +82,21 @@ class _RunnerWorker:
                 ]
             )
         )
-        tests = threading.Thread(target=self._run_active_tests, name="active tests", daemon=True)
+        tests = threading.Thread(target=self._run_test, name="active tests", daemon=True)
         tests.start()
         self.service.run(shutdown_when_idle=not run.markers.get("keep_alive", False))
         if not self.done.is_set():
             print("Processes under test stopped before tests completed")
             _print_failed_processes(proc_info, proc_output)
             raise _LaunchDied()
-        post = unittest.TextTestRunner(verbosity=2, resultclass=TestResult).run(
+        after = unittest.TextTestRunner(verbosity=2, resultclass=TestResult).run(
             run.post_shutdown_tests
         )
-        assert self.results is not None and isinstance(post, TestResult)
-        self.results.append(post)
+        assert self.results is not None and isinstance(after, TestResult)
+        self.results.append(after)
         return self.results
 
-    def _run_active_tests(self) -> None:
+    def _run_test(self) -> None:
         if not self.ready.wait(self.test_run.timeout):
             print("Timed out waiting for processes to start up")
             self.service.shutdown()
@@ -227,24 +151,24 @@ class LaunchTestRunner:
         self.screen = screen
 
     def validate(self) -> None:
-        """Parametrized names must be parameters of generate_test_description, and back."""
+        """The launch arguments are well formed, and each parametrized value has a parameter of
+        generate_test_description and each of its parameters a value (as launch_testing says)."""
         import inspect
 
         parse_launch_arguments(self.launch_file_arguments)
         for run in self.test_runs:
-            base = inspect.unwrap(run.description_function)
-            spec = inspect.getfullargspec(base)
-            names = [n for n in spec.args + spec.kwonlyargs if n != "ready_fn"]
+            spec = inspect.getfullargspec(inspect.unwrap(run.description_function))
+            names = spec.args + spec.kwonlyargs
             for name in run.param_args:
                 if name not in names:
                     raise Exception(
-                        f"generate_test_description has no argument {name!r} for the"
-                        " parametrized value"
+                        "Could not find an argument in generate_test_description matching"
+                        f" prametrized argument '{name}'"
                     )
             for name in names:
                 if name not in run.param_args:
                     raise Exception(
-                        f"generate_test_description has unexpected extra argument {name!r}"
+                        f"generate_test_description has unexpected extra argument '{name}'"
                     )
 
     def run(self) -> dict[TestRun, unittest.TestResult]:
@@ -257,10 +181,8 @@ class LaunchTestRunner:
                 results[run] = worker.run()
             except unittest.SkipTest as skip:
                 print(f"{run} is skipped: {skip}")
-                results[run] = _WholeRunResult(run, skip=str(skip))
+                results[run] = SkipResult(run, skip_reason=str(skip))
             except _LaunchDied:
-                results[run] = _WholeRunResult(
-                    run, failure="Launch stopped before the active tests finished."
-                )
+                results[run] = FailResult(run, "Launch stopped before the active tests finished.")
                 break  # most likely Ctrl-C: the other runs would not fare better
         return results

@@ -2,6 +2,6 @@
 
 from __future__ import annotations
 
-from mlaunch.launch_testing.actions import ReadyToTest
+from mlaunch.launch_testing.actions.ready import ReadyToTest
 
 __all__ = ["ReadyToTest"]

@@ -1,4 +1,4 @@
-"""``launch_testing.actions``: ReadyToTest, the action that tells the runner to start the tests."""
+"""``launch_testing.actions.ready``: ReadyToTest, the action that starts the tests."""
 
 from __future__ import annotations
 
@@ -23,9 +23,9 @@ class ReadyToTest(Action):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
-        self._callbacks: list[Callable[[], None]] = []
+        self._callbacks: list[Callable[[], object]] = []
 
-    def _add_callback(self, callback: Callable[[], None]) -> None:
+    def _add_callback(self, callback: Callable[[], object]) -> None:
         self._callbacks.append(callback)
 
     def execute(self, context: LaunchContext) -> None:

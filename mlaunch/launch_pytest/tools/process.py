@@ -1,5 +1,5 @@
-"""``launch_pytest.tools`` (and ``launch_pytest.tools.process``): wait on a process of the
-launch fixture from a test, by its action: its start, its exit, its stdout or stderr.
+"""``launch_pytest.tools.process``: wait on a process of the launch fixture from a test, by its
+action: its start, its exit, its stdout or stderr.
 
 ``*_sync`` functions block the test; the others are coroutines for async tests. ``wait_for_*``
 return whether the condition held in time; ``assert_*`` raise the validator's last assertion.
@@ -8,7 +8,6 @@ return whether the condition held in time; ``assert_*`` raise the validator's la
 from __future__ import annotations
 
 import asyncio
-import sys
 
 from mlaunch.launch.events import ProcessExited
 
@@ -149,5 +148,17 @@ assert_stderr = _in_a_thread(assert_stderr_sync)
 wait_for_start = _in_a_thread(wait_for_start_sync)
 wait_for_exit = _in_a_thread(wait_for_exit_sync)
 
-# launch_pytest.tools.process is this module too (``from launch_pytest.tools import process``).
-process = sys.modules[__name__]
+__all__ = [
+    "assert_output",
+    "assert_output_sync",
+    "assert_stderr",
+    "assert_stderr_sync",
+    "wait_for_exit",
+    "wait_for_exit_sync",
+    "wait_for_output",
+    "wait_for_output_sync",
+    "wait_for_start",
+    "wait_for_start_sync",
+    "wait_for_stderr",
+    "wait_for_stderr_sync",
+]

@@ -1,0 +1,1 @@
+"""launch_testing's pytest plugin (``hooks``) and the hook it adds (``hookspecs``)."""
