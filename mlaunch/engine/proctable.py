@@ -143,12 +143,6 @@ def tree(root: int) -> list[ProcInfo]:
     return out
 
 
-def has_marker(pid: int, run_id: str) -> bool:
-    """Whether ``pid``'s environment carries ``MLAUNCH_RUN_ID=run_id``."""
-    env = _environ(pid)
-    return env is not None and f"{MARKER}={run_id}".encode() in env.split(b"\0")
-
-
 def _environ(pid: int) -> bytes | None:
     try:
         return read_file(f"/proc/{pid}/environ")

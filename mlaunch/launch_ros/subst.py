@@ -441,11 +441,3 @@ def _arity(spec: SubstitutionSpec) -> str:
         n = spec.min_args
         return "no arguments" if n == 0 else f"{n} argument{'s' if n != 1 else ''}"
     return f"{spec.min_args} to {spec.max_args} arguments"
-
-
-def template_value(text: str) -> str | Parts:
-    """An attribute value as actions take it: the plain str when it holds no substitution."""
-    parts = parse_template(text)
-    if len(parts) == 1 and isinstance(parts[0], str):
-        return parts[0]
-    return parts

@@ -13,7 +13,7 @@ import os
 from mlaunch.frontends.limits import DEPTH_LIMIT, IncludeChain, allow_deep_trees, too_deep
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.planning import number
-from mlaunch.launch.substitutions import Substitution, normalize, perform_substitutions
+from mlaunch.launch.substitutions import perform_substitutions
 from mlaunch.plan.errors import (
     LaunchFileError,
     MlaunchError,
@@ -477,11 +477,3 @@ def collect_arguments(
         with context.file_locals(path):
             walk([description], False)
     return list(found.values())
-
-
-def substitution_text(value: Any) -> str:
-    """Literal text of a value made only of TextSubstitutions, else its description."""
-    subs = normalize(value)
-    if all(type(s).__name__ == "TextSubstitution" for s in subs):
-        return "".join(s.text for s in subs)  # type: ignore[attr-defined]
-    return " + ".join(s.describe() for s in subs if isinstance(s, Substitution))
