@@ -16,7 +16,7 @@ from test_supervision import Harness, plan_from, write_launch
 
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.plan.events import Event, HandedOff, ShutdownBegun, Started
-from mlaunch.plan.steps import Plan
+from mlaunch.plan.steps import Need, Plan
 
 # A process that lives until the test's run is shut down, and one that exits at once.
 DEFERRED = """
@@ -74,7 +74,7 @@ def test_loads_in_timers_and_handlers_are_handed_over_in_launch_order(tmp_path: 
     plan = plan_from(write_launch(tmp_path, DEFERRED), tmp_path)
     # The timer's and the handlers' loads are not resolved yet; the driver is still needed.
     assert [s.target for s in plan.steps if isinstance(s, LoadComponents)] == ["/top"]
-    assert "components" in plan.needs
+    assert Need.COMPONENTS in plan.needs
     h = Harness(plan)
     loads = Loads(h, 4)
     assert h.run() == 0
@@ -139,7 +139,7 @@ def test_a_timer_tag_with_load_composable_node_is_handed_over(suffix: str, tmp_p
     path = tmp_path / f"timer.launch.{suffix}"
     path.write_text(textwrap.dedent(body))
     plan = plan_from(path, tmp_path)
-    assert "components" in plan.needs
+    assert Need.COMPONENTS in plan.needs
     h = Harness(plan)
     loads = Loads(h, 1)
     assert h.run() == 0

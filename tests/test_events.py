@@ -28,7 +28,7 @@ from mlaunch.plan.events import (
     Started,
     StoppingAll,
 )
-from mlaunch.plan.steps import Plan, Step
+from mlaunch.plan.steps import Need, Plan, Step
 
 PY = sys.executable
 REFERENCE_ENV = Path.home() / ".cache" / "ros2-launch-jazzy" / "env.sh"
@@ -193,7 +193,7 @@ def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
     from mlaunch.launch_ros.events import ChangeState
     from mlaunch.resolve.resolver import resolve
 
-    def needs(*entities: object) -> set[str]:
+    def needs(*entities: object) -> set[Need]:
         from mlaunch.launch.actions import LaunchDescription
 
         return resolve(LaunchDescription(list(entities)), path=None, arguments={}, environ={}).needs
@@ -201,9 +201,9 @@ def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
     p = ExecuteProcess(cmd=["true"])
     change = EmitEvent(event=ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=1))
     assert needs(p, TimerAction(period=1.0, actions=[])) == set()
-    assert needs(change) == {"lifecycle"}
+    assert needs(change) == {Need.LIFECYCLE}
     handler = RegisterEventHandler(OnProcessExit(target_action=p, on_exit=[change]))
-    assert needs(p, handler) == {"lifecycle"}  # deep in a handler that has not fired
+    assert needs(p, handler) == {Need.LIFECYCLE}  # deep in a handler that has not fired
 
 
 def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> None:

@@ -24,6 +24,7 @@ from mlaunch.launch_ros.lifecycle_sequence import (
 )
 from mlaunch.parts.handoff import LoopCall
 from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.steps import Need
 from mlaunch.resolve.resolver import resolve
 
 LAUNCHES = Path(__file__).resolve().parent / "launches"
@@ -99,7 +100,7 @@ def test_plain_plans_attach_nothing_and_lifecycle_plans_attach_without_rclpy() -
     from mlaunch.launch.actions import ExecuteProcess, TimerAction
 
     plain = _plan(ExecuteProcess(cmd=["true"]), TimerAction(period=1.0, actions=[]))
-    assert "lifecycle" not in plain.needs
+    assert Need.LIFECYCLE not in plain.needs
 
     code = f"""
 import sys
@@ -112,7 +113,8 @@ from mlaunch.engine.supervisor import Supervisor
 node = LifecycleNode(executable={sys.executable!r}, name="cam", namespace="r", autostart=True)
 ld = LaunchDescription([TimerAction(period=5.0, actions=[node])])
 plan = resolve(ld, path=None, arguments={{}}, environ={{}})
-assert "lifecycle" in plan.needs, "a LifecycleNode inside a timer counts"
+from mlaunch.plan.steps import Need
+assert Need.LIFECYCLE in plan.needs, "a LifecycleNode inside a timer counts"
 manager = attach({{}}, Supervisor(plan, Printer(out=lambda b: None), install_signals=False))
 assert manager is not None
 manager.close()

@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 
 from mlaunch.app.options import Options
 from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Started
-from mlaunch.plan.steps import Plan
+from mlaunch.plan.steps import Need, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -301,7 +301,7 @@ def lifecycle(run: Run) -> object:
 
     plan = run.plan
     if (
-        "lifecycle" in plan.needs
+        Need.LIFECYCLE in plan.needs
         or SEQUENCE_ARGUMENT in plan.arguments
         or SEQUENCE_ARGUMENT in run.opts.arguments
     ):
@@ -357,7 +357,7 @@ def components_part(plan: Plan, supervisor: Supervisor) -> object:
     (or a description a LaunchService includes later) can still make one, so without that need
     a watch attaches the driver at the first LoadComponents the supervisor hands over.
     """
-    if "components" in plan.needs:
+    if Need.COMPONENTS in plan.needs:
         from mlaunch.parts.components import ComponentDriver
 
         return ComponentDriver(supervisor)
@@ -377,7 +377,7 @@ class _ComponentsWatch:
         supervisor.events.subscribe(self._on_event)
 
     def _on_event(self, event: Event) -> None:
-        if not isinstance(event, HandedOff) or "components" not in event.step.needs:
+        if not isinstance(event, HandedOff) or Need.COMPONENTS not in event.step.needs:
             return
         from mlaunch.parts.components import ComponentDriver
 

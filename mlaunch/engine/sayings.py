@@ -200,7 +200,7 @@ class Sayings:
                 "ERROR",
                 "launch",
                 f"{type(step).__name__} ({step.origin}): nothing in this run carries it out"
-                f" (it needs {', '.join(sorted(step.needs))}); not done",
+                f" (it needs {', '.join(sorted(n.value for n in step.needs))}); not done",
             )
             return
         name = type(record.event).__name__

@@ -22,7 +22,7 @@ from mlaunch.launch_ros.actions import Node, make_namespace_absolute
 from mlaunch.launch_ros.composable import ComposableNode
 from mlaunch.launch_ros.node import node_name_counts
 from mlaunch.plan.errors import LaunchFileError, MlaunchError
-from mlaunch.plan.steps import Handoff
+from mlaunch.plan.steps import COMPONENTS, NO_NEEDS, Handoff, Need
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -30,10 +30,6 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch_ros.load_request import LoadRequest
-
-
-# What a load needs attached to the run (Plan.needs): the LoadNode driver.
-COMPONENTS = frozenset({"components"})
 
 
 class LoadComponents(Handoff):
@@ -115,9 +111,9 @@ class ComposableNodeContainer(Node):
         self._descriptions = _descriptions(composable_node_descriptions)
 
     @property
-    def needs(self) -> frozenset[str]:
+    def needs(self) -> frozenset[Need]:
         """The LoadNode driver, when there are nodes to load (seen in a timer or handler too)."""
-        return COMPONENTS if self._descriptions else frozenset()
+        return COMPONENTS if self._descriptions else NO_NEEDS
 
     # A Node returns nothing; a container also returns the load of its nodes (as launch_ros).
     def execute(self, context: LaunchContext) -> list[Any] | None:  # type: ignore[override]

@@ -19,6 +19,7 @@ from typing import Any
 
 from mlaunch.launch.event_handlers import EventHandler
 from mlaunch.launch.events import Event, matches_action
+from mlaunch.plan.steps import LIFECYCLE
 
 # lifecycle_msgs/msg/Transition and State ids, with their names.
 TRANSITIONS: dict[int, str] = {
@@ -52,7 +53,7 @@ class ChangeState(Event):
     """A request to move the matched lifecycle nodes through one transition."""
 
     name = "launch_ros.events.lifecycle.ChangeState"
-    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
+    needs = LIFECYCLE  # the run attaches lifecycle driving (Plan.needs)
     valid_transitions = TRANSITIONS
     valid_states = STATES
 
@@ -112,7 +113,7 @@ class OnStateTransition(EventHandler):
     """
 
     kind = "state_transition"
-    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
+    needs = LIFECYCLE  # the run attaches lifecycle driving (Plan.needs)
 
     def __init__(
         self,

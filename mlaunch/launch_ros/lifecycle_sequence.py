@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any
 from mlaunch.launch.actions import Action
 from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
 from mlaunch.plan.errors import LaunchFileError
-from mlaunch.plan.steps import SEQUENCE_ARGUMENT, Note
+from mlaunch.plan.steps import LIFECYCLE, SEQUENCE_ARGUMENT, Note
 
 if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
@@ -32,7 +32,7 @@ class SequenceStep(Note):
     """Plan step of a LifecycleSequence: the nodes' full names, in bring-up order (a Note: the
     lifecycle manager reads it from the plan)."""
 
-    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
+    needs = LIFECYCLE  # the run attaches lifecycle driving (Plan.needs)
 
     origin: str = ""  # Step is a plain class: a dataclass subclass names its field itself
     nodes: tuple[str, ...] = ()
@@ -57,7 +57,7 @@ class LifecycleSequence(Action):
     transitions. With ``shutdown_on_failure`` a failed transition ends the launch (status 1).
     """
 
-    needs = frozenset({"lifecycle"})  # seen in deferred bodies too (Plan.needs)
+    needs = LIFECYCLE  # seen in deferred bodies too (Plan.needs)
 
     def __init__(
         self,

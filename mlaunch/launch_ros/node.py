@@ -40,7 +40,7 @@ from mlaunch.launch_ros.scope import (
 from mlaunch.launch_ros.substitutions import ExecutableInPackage
 from mlaunch.plan.errors import LaunchFileError, MlaunchError, SubstitutionFailure
 from mlaunch.plan.record import Record
-from mlaunch.plan.steps import NodeInfo, ProcessSpec
+from mlaunch.plan.steps import LIFECYCLE, NodeInfo, ProcessSpec
 from mlaunch.ros import packages
 from mlaunch.ros.packages import PackageNotFoundError
 
@@ -371,7 +371,7 @@ class LifecycleNode(Node):
     it once it is up (driving the transitions is the supervisor's lifecycle support)."""
 
     is_lifecycle = True
-    needs = frozenset({"lifecycle"})  # the run attaches lifecycle driving (Plan.needs)
+    needs = LIFECYCLE  # the run attaches lifecycle driving (Plan.needs)
 
     def __init__(
         self,

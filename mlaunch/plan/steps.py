@@ -12,6 +12,8 @@ the first child starts. ``Record`` (mlaunch.plan.record) gives them a dataclass'
 
 from __future__ import annotations
 
+import enum  # re imports it: nothing more on the way to the first child
+
 from mlaunch.plan.record import Record
 
 # typing is imported by type checkers only (~4 ms at start-up); mypy treats this name as
@@ -348,21 +350,30 @@ class Handoff(Step):
     takes is said, never dropped in silence.
     """
 
-    needs: frozenset[str] = frozenset()
+    needs: frozenset[Need] = frozenset()
 
 
-# What a run may need attached besides the supervisor (Plan.needs): "lifecycle" driving.
-NO_NEEDS: frozenset[str] = frozenset()
+class Need(enum.Enum):
+    """What a run may need attached besides the supervisor (``Plan.needs``, a step's or an
+    entity's ``needs``): the part the application attaches for it."""
+
+    LIFECYCLE = "lifecycle"  # lifecycle driving (mlaunch.parts.lifecycle)
+    COMPONENTS = "components"  # the LoadNode driver (mlaunch.parts.components)
+
+
+NO_NEEDS: frozenset[Need] = frozenset()
+LIFECYCLE: frozenset[Need] = frozenset({Need.LIFECYCLE})
+COMPONENTS: frozenset[Need] = frozenset({Need.COMPONENTS})
 # The YAML/XML form of a LifecycleSequence: a launch argument listing the nodes.
 SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
 
 
-def step_needs(step: Step) -> frozenset[str]:
+def step_needs(step: Step) -> frozenset[Need]:
     """What a step needs attached to the run: a lifecycle node's spawn, a ChangeState, an
     OnStateTransition handler and a LifecycleSequence need lifecycle driving."""
     if isinstance(step, Spawn):
         node = step.spec.node if step.spec is not None else None
-        return frozenset({"lifecycle"}) if node is not None and node.lifecycle else NO_NEEDS
+        return LIFECYCLE if node is not None and node.lifecycle else NO_NEEDS
     if isinstance(step, AddHandler):
         return frozenset(getattr(step.handler, "needs", NO_NEEDS))
     if isinstance(step, EmitEvent):
@@ -410,13 +421,13 @@ class Plan(Record):
         arguments: dict[str, ArgumentInfo] | None = None,
         warnings: list[str] | None = None,
         temp_dir: str | None = None,
-        needs: set[str] | None = None,
+        needs: set[Need] | None = None,
     ) -> None:
         self.steps: list[Step] = [] if steps is None else steps
         self.arguments: dict[str, ArgumentInfo] = {} if arguments is None else arguments
         self.warnings: list[str] = [] if warnings is None else warnings
         self.temp_dir = temp_dir
-        self.needs: set[str] = set() if needs is None else needs
+        self.needs: set[Need] = set() if needs is None else needs
 
     def processes(self) -> list[ProcessSpec]:
         return [s.spec for s in self.steps if isinstance(s, Spawn) and s.spec is not None]

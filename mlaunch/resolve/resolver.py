@@ -22,7 +22,16 @@ from mlaunch.plan.errors import (
 )
 from mlaunch.plan.origin import user_location
 from mlaunch.plan.record import Record
-from mlaunch.plan.steps import ArgumentInfo, Deferred, Plan, ProcessSpec, Spawn, Step, step_needs
+from mlaunch.plan.steps import (
+    ArgumentInfo,
+    Deferred,
+    Need,
+    Plan,
+    ProcessSpec,
+    Spawn,
+    Step,
+    step_needs,
+)
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -254,7 +263,7 @@ class Resolver:
         return argv, None
 
 
-def _note_needs(entities: Iterable[Any], needs: set[str]) -> None:
+def _note_needs(entities: Iterable[Any], needs: set[Need]) -> None:
     """Add what ``entities`` (a timer's or handler's, not yet resolved) and theirs may need.
 
     An entity says so with a ``needs`` attribute (LifecycleNode, LifecycleSequence), or its
