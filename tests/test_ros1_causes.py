@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from test_roslaunch import by_label, package, params, plan_of, warnings_text, write
+from test_roslaunch import by_label, globals_of, package, params, plan_of, warnings_text, write
 
 
 def test_an_included_launch_xml_fragment_is_read_as_roslaunch_xml(tmp_path: Path) -> None:
@@ -132,3 +132,69 @@ def test_node_args_are_substituted_then_split_like_a_shell(tmp_path: Path) -> No
         "one word",
         "x",
     ]
+
+
+def test_names_are_rerooted_by_ros1_name_rules(tmp_path: Path) -> None:
+    (tmp_path / "ctrl.yaml").write_text(
+        "rrbot:\n  jsc:\n    type: joint_state_controller/JointStateController\n"
+        "    publish_rate: 50\n"
+    )
+    path = write(
+        tmp_path,
+        "sim.launch",
+        """
+        <launch>
+          <param name="gazebo/enable_ros_network" value="true"/>
+          <rosparam file="$(dirname)/ctrl.yaml" command="load"/>
+          <param name="shared" value="1"/>
+          <node pkg="mlaunch_demo" type="talker" name="gazebo"/>
+          <node pkg="mlaunch_demo" type="talker" name="urdf_spawner"/>
+          <group ns="rrbot">
+            <node pkg="mlaunch_demo" type="listener" name="controller_spawner"/>
+          </group>
+        </launch>
+        """,
+    )
+    nodes = {s.node.name: s for s in plan_of(path).processes() if s.node}
+    # /gazebo/x is node /gazebo's private ~x; /rrbot/... reaches /rrbot's nodes by relative name
+    assert globals_of(nodes["gazebo"]) == {"shared": "1", "enable_ros_network": "True"}
+    assert globals_of(nodes["urdf_spawner"]) == {"shared": "1"}
+    assert globals_of(nodes["controller_spawner"]) == {
+        "shared": "1",
+        "jsc.type": "joint_state_controller/JointStateController",
+        "jsc.publish_rate": "50",
+    }
+
+
+def test_a_global_set_in_an_included_file_reaches_the_includers_nodes(tmp_path: Path) -> None:
+    robot = '<robot name="bot"><link name="base"/></robot>'
+    (tmp_path / "bot.urdf").write_text(robot)
+    write(
+        tmp_path,
+        "inc/load_robot.launch",
+        """
+        <launch>
+          <param name="robot_description" textfile="$(dirname)/../bot.urdf"/>
+          <param name="rate_from_include" value="30"/>
+        </launch>
+        """,
+    )
+    path = write(
+        tmp_path,
+        "main.launch",
+        """
+        <launch>
+          <group ns="robot1">
+            <node pkg="mlaunch_demo" type="talker" name="before_include"/>
+          </group>
+          <include file="$(dirname)/inc/load_robot.launch"/>
+          <node pkg="robot_state_publisher" type="robot_state_publisher" name="rsp"/>
+        </launch>
+        """,
+    )
+    plan = plan_of(path)
+    nodes = {s.node.name: s for s in plan.processes() if s.node}
+    assert globals_of(nodes["rsp"]) == {"rate_from_include": "30", "robot_description": robot}
+    # roslaunch sets every parameter before any node starts: the order of tags does not matter
+    assert globals_of(nodes["before_include"]) == {"rate_from_include": "30"}
+    assert "gets no robot_description" not in warnings_text(plan)

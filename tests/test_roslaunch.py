@@ -460,7 +460,8 @@ def test_unconsumed_robot_description_and_starved_rsp_are_warnings(tmp_path: Pat
         "</launch>\n",
     )
     (node,) = reading.read(starved)
-    assert "robot_state_publisher gets no robot_description" in node.warnings[0]
+    # a note for conversions: a run gives the node what the parameter server holds
+    assert "robot_state_publisher gets no robot_description" in node.scope_notes[0]
 
 
 # --- nodes, scopes, includes ------------------------------------------------------------------

@@ -113,7 +113,8 @@ def comments(item: Item, source: Source) -> list[str]:
     notes = list(getattr(item, "notes", []))
     out = [f"{where}" + (f": {notes[0]}" if notes else "")]
     out += notes[1:]
-    out += [f"WARNING: {w}" for w in [*item.warnings, *format_warnings(item, source)]]
+    found = [*item.warnings, *item.scope_notes, *format_warnings(item, source)]
+    out += [f"WARNING: {w}" for w in found]
     if isinstance(item, Warn):
         out.append(f"WARNING: {item.message}")
     return out

@@ -10,11 +10,18 @@ from __future__ import annotations
 import shlex
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.launch.actions import Action
 from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
 from mlaunch.launch.substitutions import TextSubstitution, normalize, perform_substitutions
+from mlaunch.launch_ros import params
+from mlaunch.launch_ros.actions import SetParameter
 from mlaunch.launch_ros.node import Node
 from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 from mlaunch.plan.errors import MlaunchError
+from mlaunch.ros1 import config
+from mlaunch.ros1.model import rel_origin
+from mlaunch.ros1.params import flow_text, numeric_rows, ros2_problem
+from mlaunch.ros1.server import SERVER_KEY, Server, flat
 from mlaunch.ros1.values import convert_value
 
 if TYPE_CHECKING:
@@ -40,18 +47,155 @@ class RoslaunchValue(ParameterValue):
 
 
 class RoslaunchNode(Node):
-    """A ROS 1 node whose ``args`` has substitutions: substituted first, then split like a
-    shell, as roslaunch does (an argument that substitutes to nothing disappears)."""
+    """A node of a roslaunch file run on ROS 2.
 
-    def __init__(self, *, shell_args: Any, **kwargs: Any) -> None:
+    ``shell_args`` (``args`` with substitutions): substituted first, then split like a shell,
+    as roslaunch does (an argument that substitutes to nothing disappears). Its globals come
+    from the file's parameter server by ROS 1's name rules (``ros1.server``), before its own
+    parameters (``own_names``: those the mapping gave it, which win).
+    """
+
+    def __init__(
+        self, *, shell_args: Any = None, ros1_package: str = "", own_names: Any = (), **kwargs: Any
+    ) -> None:
         super().__init__(**kwargs)
-        self.shell_args = normalize(shell_args)
+        self.shell_args = None if shell_args is None else normalize(shell_args)
+        self.ros1_package = ros1_package
+        self.own_names = frozenset(own_names)
 
     def node_command(self, context: LaunchContext, *, remote: bool = False) -> NodeCommand:
-        text = perform_substitutions(context, self.shell_args)
-        try:
-            words = shlex.split(text)
-        except ValueError as e:
-            raise MlaunchError(f"node args {text!r} cannot be split like a shell: {e}")
-        self.arguments = [(TextSubstitution(text=w),) for w in words]
+        if self.shell_args is not None:
+            text = perform_substitutions(context, self.shell_args)
+            try:
+                words = shlex.split(text)
+            except ValueError as e:
+                raise MlaunchError(f"node args {text!r} cannot be split like a shell: {e}")
+            self.arguments = [(TextSubstitution(text=w),) for w in words]
         return super().node_command(context, remote=remote)
+
+    def _global_parameter_arguments(self, ctx: LaunchContext) -> list[str]:
+        out = super()._global_parameter_arguments(ctx)
+        server = server_for(ctx, _file(self.origin))
+        if server is None:
+            return out
+        names = self._names(ctx)
+        found = server.parameters_of(
+            names.name, names.namespace or "/", self.ros1_package, self.origin
+        )
+        for name, value in self.holdable(ctx, flat(found)).items():
+            out += ["-p", params.global_parameter_rule(name, value)]
+        return out
+
+    def holdable(self, context: LaunchContext, found: dict[str, Any]) -> dict[str, Any]:
+        """The values a ROS 2 parameter can hold; each other one is a warning."""
+        out: dict[str, Any] = {}
+        for name, value in found.items():
+            if name in self.own_names:
+                continue
+            if numeric_rows(value):
+                out[name] = flow_text(value)
+                continue
+            problem = ros2_problem(value)
+            if problem is None and isinstance(value, bytes):
+                problem = "binary data (binfile) has no ROS 2 parameter type"
+            if problem is not None:
+                where = rel_origin(self.origin)
+                context.planner.warn(f"{where}: parameter {name}: {problem}; it is not set")
+                continue
+            if isinstance(value, tuple):
+                value = list(value)
+            if isinstance(value, list) and any(isinstance(v, float) for v in value):
+                value = [float(v) for v in value]
+            elif not isinstance(value, (bool, int, float, str, list)):
+                value = str(value)
+            out[name] = value
+        return out
+
+
+class MappingWarning(Action):
+    """A warning about the ROS 1 -> ROS 2 mapping, reported where the file is resolved."""
+
+    def __init__(self, message: str, origin: str, condition: Any = None) -> None:
+        super().__init__(condition=condition)
+        self.message = message
+        self.origin = origin
+
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        planner.warn(f"{rel_origin(self.origin)}: {self.message}")
+
+    def describe_short(self) -> str:
+        return f"warning: {self.message}"
+
+
+class LoadParameterServer(Action):
+    """First action of a roslaunch file run on ROS 2: the file resolved as roslaunch resolves
+    it, whose parameter server the file's nodes take their globals from (``ros1.server``).
+
+    One server covers a file and everything it includes; a file that an enclosing roslaunch
+    file already covers adds nothing. Where roslaunch itself would refuse the file, the nodes
+    keep the globals of their scopes (SetParameter), with a warning saying why.
+    """
+
+    def __init__(self, path: str, arg_names: list[str]) -> None:
+        super().__init__()
+        self.path = path
+        self.arg_names = arg_names
+
+    def execute(self, context: LaunchContext) -> None:
+        servers: dict[str, Server | None] | None = context.locals.get(SERVER_KEY)
+        if servers is None:
+            servers = {}
+            context.extend_globals({SERVER_KEY: servers})
+        if server_for(context, self.path) is not None or self.path in servers:
+            return
+        configs = context.launch_configurations
+        args = {n: configs[n] for n in self.arg_names if isinstance(configs.get(n), str)}
+        from mlaunch.ros import packages
+
+        index = packages.for_context(context)
+        try:
+            found = config.load(self.path, args, environ=context.environment, index=index)
+        except MlaunchError as e:
+            context.planner.warn(
+                f"{rel_origin(self.path)}: roslaunch would refuse this file ({e}); its global"
+                " parameters go to the nodes of their scopes instead of by ROS 1's name rules"
+            )
+            servers[self.path] = None
+            return
+        servers[self.path] = Server.of(found)
+
+    def describe_short(self) -> str:
+        return "ROS 1 parameter server"
+
+
+def server_for(context: LaunchContext, path: str) -> Server | None:
+    """The parameter server that covers the roslaunch file at ``path``, if any."""
+    servers: dict[str, Server | None] = context.locals.get(SERVER_KEY) or {}
+    for server in servers.values():
+        if server is not None and path in server.config.files:
+            return server
+    return None
+
+
+class GlobalParameter(SetParameter):
+    """A roslaunch global parameter: given by the parameter server when its file has one,
+    else a SetParameter for the nodes of its scope."""
+
+    keep_in_scope = True  # ROS 1 global parameters belong to their group
+
+    def execute(self, context: LaunchContext) -> None:
+        if server_for(context, _file(self.origin)) is None:
+            super().execute(context)
+
+
+class ScopeNote(MappingWarning):
+    """A warning about the scope mapping of globals: moot where a parameter server maps them."""
+
+    def execute(self, context: LaunchContext) -> None:
+        if server_for(context, _file(self.origin)) is None:
+            super().execute(context)
+
+
+def _file(origin: str) -> str:
+    return origin.rsplit(":", 1)[0] if origin else ""

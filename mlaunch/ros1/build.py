@@ -4,9 +4,17 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.actions import Action, SetLaunchConfiguration
+from mlaunch.launch.actions import SetLaunchConfiguration
 from mlaunch.launch_ros.parameter_descriptions import ParameterValue
-from mlaunch.ros1.actions import RoslaunchNode, RoslaunchSource, RoslaunchValue
+from mlaunch.ros1.actions import (
+    GlobalParameter,
+    LoadParameterServer,
+    MappingWarning,
+    RoslaunchNode,
+    RoslaunchSource,
+    RoslaunchValue,
+    ScopeNote,
+)
 from mlaunch.ros1.eval import RoslaunchEval
 from mlaunch.ros1.model import (
     MACHINE_FIELDS,
@@ -37,26 +45,11 @@ from mlaunch.ros1.model import (
     Value,
     Warn,
     rel_origin,
+    static_text,
 )
 
 if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
-
-
-class MappingWarning(Action):
-    """A warning about the ROS 1 -> ROS 2 mapping, reported where the file is resolved."""
-
-    def __init__(self, message: str, origin: str, condition: Any = None) -> None:
-        super().__init__(condition=condition)
-        self.message = message
-        self.origin = origin
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        planner.warn(f"{rel_origin(self.origin)}: {self.message}")
-
-    def describe_short(self) -> str:
-        return f"warning: {self.message}"
 
 
 class ConstantArgument(SetLaunchConfiguration):
@@ -77,6 +70,22 @@ class ConstantArgument(SetLaunchConfiguration):
         super().execute(context)
 
 
+def description_actions(path: str, items: list[Item]) -> list[Any]:
+    """A whole roslaunch file's actions: its parameter server first, then the model's."""
+    return [LoadParameterServer(path, sorted(declared_args(items))), *to_actions(items)]
+
+
+def declared_args(items: list[Item]) -> set[str]:
+    """The names of the file's ``<arg>``s that take a value from outside (not constants)."""
+    found: set[str] = set()
+    for item in items:
+        if isinstance(item, DeclareArg):
+            found.add(item.name)
+        elif isinstance(item, Group):
+            found |= declared_args(item.items)
+    return found
+
+
 def to_actions(items: list[Item]) -> list[Any]:
     """The model as mlaunch's actions (the ROS 2 classes a converted file would use)."""
     out: list[Any] = []
@@ -86,6 +95,8 @@ def to_actions(items: list[Item]) -> list[Any]:
         messages = item.warnings[:1] if isinstance(item, Dropped) else item.warnings
         for message in messages:
             out.append(MappingWarning(message, item.origin, _condition(item.condition)))
+        for message in item.scope_notes:
+            out.append(ScopeNote(message, item.origin, _condition(item.condition)))
         action = _action(item)
         if action is None:
             continue
@@ -100,7 +111,7 @@ def _action(item: Item) -> Any:
     import mlaunch.launch_ros.actions as ros
 
     if isinstance(item, Warn):
-        return MappingWarning(item.message, item.origin, None)
+        return (ScopeNote if item.scope_note else MappingWarning)(item.message, item.origin, None)
     if isinstance(item, Dropped):
         return None
     if isinstance(item, DeclareArg):
@@ -109,9 +120,7 @@ def _action(item: Item) -> Any:
     if isinstance(item, SetArg):
         return ConstantArgument(item.name, subs(item.value))
     if isinstance(item, SetParam):
-        action = ros.SetParameter(name=subs(item.name), value=parameter_value(item.value))
-        action.keep_in_scope = True  # ROS 1 global parameters belong to their group
-        return action
+        return GlobalParameter(name=subs(item.name), value=parameter_value(item.value))
     if isinstance(item, SetRemap):
         remap = ros.SetRemap(src=subs(item.src), dst=subs(item.dst))
         remap.keep_in_scope = True  # ROS 1 remaps belong to their group
@@ -135,11 +144,18 @@ def _action(item: Item) -> Any:
         optional = {k: subs(getattr(item, k)) for k, _ in MACHINE_FIELDS if getattr(item, k)}
         return Machine(name=subs(item.name), address=subs(item.address), **optional)
     if isinstance(item, NodeItem):
+        keywords = node_keywords(item)
+        shell_args = None
         if item.shell_args is not None:
-            keywords = node_keywords(item)
             keywords.pop("arguments", None)
-            return RoslaunchNode(shell_args=subs(item.shell_args), **keywords)
-        return ros.Node(**node_keywords(item))
+            shell_args = subs(item.shell_args)
+        own = {static_text(name) for name, _ in item.parameters}
+        return RoslaunchNode(
+            shell_args=shell_args,
+            ros1_package=static_text(item.package) or "",
+            own_names={name for name in own if name},
+            **keywords,
+        )
     if isinstance(item, ProcessItem):
         return core.ExecuteProcess(cmd=[subs(c) for c in item.cmd], **process_keywords(item))
     raise TypeError(f"unknown item {item!r}")

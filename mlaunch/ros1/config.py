@@ -458,11 +458,13 @@ def load(
     find: Any = None,
     run_command: Any = None,
     core: bool = False,
+    index: Any = None,
 ) -> Config:
-    """The configuration roslaunch resolves ``path`` to with ``args`` (``name: value``)."""
+    """The configuration roslaunch resolves ``path`` to with ``args`` (``name: value``);
+    ``index``: the run's package search ($(find) after ROS_PACKAGE_PATH and /usr/share)."""
     from mlaunch.ros1 import lookup
 
     environ = dict(os.environ if environ is None else environ)
-    finder = find or lookup.package_finder(path, environ)
+    finder = find or lookup.package_finder(path, environ, index)
     command = run_command or lookup.command_runner(environ, os.path.abspath(path))
     return Loader(environ, finder, command).load(path, args, core)

@@ -13,6 +13,7 @@ import os
 import shlex
 import subprocess
 from collections.abc import Callable, Mapping
+from typing import Any
 
 from mlaunch.plan.errors import LaunchFileError
 from mlaunch.ros.packages import package_name
@@ -47,8 +48,11 @@ def _crawl(folder: str, found: dict[str, str], depth: int) -> None:
             _crawl(entry.path, found, depth - 1)
 
 
-def package_finder(launch_file: str, environ: Mapping[str, str]) -> Callable[[str], str]:
-    """``$(find pkg)`` for one resolution (the folders are scanned once)."""
+def package_finder(
+    launch_file: str, environ: Mapping[str, str], index: Any = None
+) -> Callable[[str], str]:
+    """``$(find pkg)`` for one resolution (the folders are scanned once); ``index``: the
+    run's package search, when there is one."""
     cache: dict[str, str] | None = None
 
     def find(name: str) -> str:
@@ -59,7 +63,8 @@ def package_finder(launch_file: str, environ: Mapping[str, str]) -> Callable[[st
             return cache[name]
         from mlaunch.ros import packages
 
-        package = packages.index(environ=environ, launch_files=[launch_file]).find(name)
+        search = index or packages.index(environ=environ, launch_files=[launch_file])
+        package = search.find(name)
         if package is not None:
             return str(package.share_directory)
         if name == "xacro":

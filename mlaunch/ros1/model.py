@@ -127,6 +127,9 @@ class Item:
     origin: str
     condition: Cond | None = None
     warnings: list[str] = field(default_factory=list)
+    # warnings about where ROS 2 puts a global parameter by the file's scopes: moot when
+    # mlaunch runs the file with its parameter server (ROS 1's name rules), kept in conversions
+    scope_notes: list[str] = field(default_factory=list)
 
 
 @dataclass(kw_only=True)
@@ -134,6 +137,7 @@ class Warn(Item):
     """A warning on its own (a skipped tag), shown where the file is resolved."""
 
     message: str
+    scope_note: bool = False
 
 
 @dataclass(kw_only=True)

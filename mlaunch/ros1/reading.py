@@ -60,7 +60,7 @@ class Reader(ParamReader, NodeMapper):
         self.land(out, scope)
         for consumer in out.consumers:
             if consumer.kind == "robot_description":
-                consumer.node.warnings.append(
+                consumer.node.scope_notes.append(
                     "robot_state_publisher gets no robot_description: in ROS 1 it read the global"
                     " parameter (set in another file?); in ROS 2 it must be the node's own"
                     " parameter"
@@ -112,7 +112,7 @@ class Reader(ParamReader, NodeMapper):
         if isinstance(item, Desc):
             self.desc_notes.setdefault(item.origin, []).append(message)
         else:
-            item.warnings.append(message)
+            item.scope_notes.append(message)
 
     def bind(self, pending: Pending, out: Out) -> None:
         """Give a robot_description / use_gui global to the nodes of this scope that read it."""
@@ -131,11 +131,11 @@ class Reader(ParamReader, NodeMapper):
             else:
                 node.gui = desc.value
             if not conds <= node_conds:
-                node.warnings.append(
+                node.scope_notes.append(
                     f"the global {desc.kind} of {rel} is set only under a condition this node"
                     f" does not share; in ROS 2 the node gets it whenever it runs"
                 )
-            node.warnings.extend(self.desc_notes.get(desc.origin, []))
+            node.scope_notes.extend(self.desc_notes.get(desc.origin, []))
         out.consumers = [c for c in out.consumers if c.kind != desc.kind]
         if takers:
             return
@@ -149,6 +149,7 @@ class Reader(ParamReader, NodeMapper):
             Warn(
                 origin=desc.origin,
                 condition=desc.own,
+                scope_note=True,
                 message="robot_description is set, but no robot_state_publisher of this file's"
                 " scope takes it: ROS 2 has no parameter server, so it reaches no node (give it"
                 " to the node that needs it as a parameter)",

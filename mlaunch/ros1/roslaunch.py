@@ -20,7 +20,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from mlaunch.ros1.build import to_actions
+from mlaunch.ros1.build import description_actions
 from mlaunch.ros1.reading import read
 
 
@@ -28,7 +28,7 @@ def load(path: str) -> Any:
     """The LaunchDescription of the roslaunch XML file at ``path``."""
     from mlaunch.launch.actions import LaunchDescription
 
-    description = LaunchDescription(to_actions(read(path)))
+    description = LaunchDescription(description_actions(os.path.abspath(path), read(path)))
     description.origin = f"{os.path.abspath(path)}:1"
     return description
 
