@@ -55,6 +55,24 @@ def _module_argv(module: str) -> list[str]:
     return [sys.executable, "-m", f"mlaunch.standins.{module}"]
 
 
+def pin_viewer_port(argv: tuple[str, ...] | list[str], env: dict[str, str]) -> None:
+    """Give a viewer stand-in that would take any free port a fixed free one, in its ``env``.
+
+    The viewer picks a port when it starts; restarted (``mlaunch ctl restart``, respawn) it
+    would pick another and the open tab would die. Chosen once here, the restarted viewer
+    listens where the page already looks.
+    """
+    from mlaunch.standins.viewer_config import PORT_ENV
+
+    if list(argv[:3]) != _module_argv("viewer") or env.get(PORT_ENV, "").strip() not in ("", "0"):
+        return
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        env[PORT_ENV] = str(probe.getsockname()[1])
+
+
 def standin_for(argv: list[str]) -> list[str] | None:
     """The stand-in command line for a program not found on PATH, or None."""
     name = os.path.basename(argv[0])

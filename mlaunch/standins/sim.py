@@ -400,11 +400,12 @@ class RosBridge:
         self.tf = tf_support()
         # The world for the viewer: latched, and only the newest one matters.
         self.world_pub = make_publisher(node, String, WORLD_TOPIC, latched())
+        self.run = f"{os.getpid()}-{os.urandom(4).hex()}"  # this start, for the viewer
         self.publish_world()
 
     def publish_world(self) -> None:
         """The world's shapes and where the robots' odometry frames start in it, for the viewer."""
-        text = world_message(self.sim.world, self.sim.robots.values())
+        text = world_message(self.sim.world, self.sim.robots.values(), self.run)
         self.world_pub.publish(self.String(data=text))
 
     # -- spawning

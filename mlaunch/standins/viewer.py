@@ -32,7 +32,7 @@ from mlaunch.standins.viewer_config import (
 )
 from mlaunch.standins.viewer_config import config_from_data as config_from_data
 from mlaunch.standins.viewer_http import PageServer as PageServer
-from mlaunch.standins.viewer_http import serve
+from mlaunch.standins.viewer_http import serve, twist_driver
 from mlaunch.standins.viewer_tf import DepthPicture, PlanarTf, compose, invert, planar, yaw_of
 from mlaunch.standins.world_topic import WORLD_TOPIC, WorldPicture
 
@@ -48,6 +48,7 @@ EXIT_FAILURE = 1
 TRAIL_MAX = 5000
 TRAIL_STEP = 0.02  # metres between trail points: enough for a smooth line, bounded memory
 PAGE_IDLE_S = 5.0  # a page that has not polled for this long is closed (the depth feed stops)
+LOST_S = 3.0  # odometry silent this long: the robot drawn is where it was, not where it is
 
 Pose2D = tuple[float, float, float]  # x, y, yaw
 # compose, invert, yaw_of and config_from_data are re-exported: tests know them from here.
@@ -94,6 +95,8 @@ class ViewerState:
     last_poll: float = -math.inf
     depth: DepthPicture = field(default_factory=DepthPicture)
     world: WorldPicture = field(default_factory=WorldPicture)
+    restarted_at: float | None = None  # when the simulator last came back (a new world run)
+    restarts: int = 0
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def __post_init__(self) -> None:
@@ -126,7 +129,10 @@ class ViewerState:
     def set_world(self, text: str, now: float) -> None:
         """The simulator's world (world_topic.py); a malformed one is shown on the page."""
         with self.lock:
-            self.world.set(text)
+            if self.world.set(text):  # a new simulator: the robot drawn so far is gone
+                self.pose, self.scan_points, self.restarted_at = None, [], now
+                self.trail.clear()
+                self.restarts += 1
             self._seen("world", now)
 
     def set_odom(self, frame: str, child: str, pose: Pose2D, now: float) -> None:
@@ -253,7 +259,8 @@ class ViewerState:
             if self.robot is not None:
                 robot = {"name": self.robot.name, "root": self.robot.root, "shapes": self._shapes()}
             current = self.pose
-            if current is None and self.robot is not None:  # no odometry: TF may place it
+            gone = self._gone()
+            if current is None and self.robot is not None and not gone:  # TF may place it
                 current = self._in_odom(self.base_frame or self.robot.root)
             pose = None if current is None else dict(zip(("x", "y", "yaw"), current, strict=True))
             return {
@@ -263,8 +270,9 @@ class ViewerState:
                 "robot_centric": self._link(fixed) is not None,
                 "odom_frame": self.odom_frame,
                 "base_frame": self.base_frame,
-                "robot": robot,
+                "robot": None if gone else robot,
                 "robot_error": self.robot_error,
+                "simulator": {"restarts": self.restarts, "robot": self._robot_status(now)},
                 "pose": pose,
                 "trail": [list(p) for p in self.trail],
                 "scan": {"frame": self.scan_frame, "points": [list(p) for p in self.scan_points]},
@@ -281,11 +289,40 @@ class ViewerState:
                 # The walls under the robot, in the frame everything else here is in.
                 "world": self.world.in_frame(self.odom_frame or fixed),
                 "warnings": [
+                    *self._status_lines(now),
                     *self.config.warnings,
                     *self.warnings.values(),
                     *((self.world.error,) if self.world.error else ()),
                 ],
             }
+
+    def _gone(self) -> bool:
+        """The simulator restarted and this robot has not been seen in the new one."""
+        odom = self.stats["odom"].last
+        return self.restarted_at is not None and (odom is None or odom < self.restarted_at)
+
+    def _robot_status(self, now: float) -> str:
+        """'gone' (not in the restarted simulator), 'lost' (odometry silent), 'live', 'waiting'."""
+        last = self.stats["odom"].last
+        if self._gone():
+            return "gone"
+        if last is None:
+            return "waiting"
+        return "lost" if now - last > LOST_S else "live"
+
+    def _status_lines(self, now: float) -> list[str]:
+        status, odom = self._robot_status(now), self.config.odom_topic
+        if status == "gone":
+            return [
+                f"the simulator restarted and the robot is not in it (nothing on {odom} since):"
+                " spawn it again"
+            ]
+        if status == "lost":
+            silent = now - (self.stats["odom"].last or now)
+            return [f"no odometry on {odom} for {silent:.0f} s: the robot is drawn where it was"]
+        if self.restarted_at is not None and now - self.restarted_at < 10:
+            return ["the simulator restarted: showing the new state"]
+        return []
 
 
 def _moved(transform: Pose2D, point: tuple[float, float]) -> list[float]:
@@ -400,20 +437,6 @@ class DepthFeed:
         self.state.set_depth(msg.width, msg.height, msg.encoding, msg.data, 0.0, time.monotonic())
 
 
-def driver(node: Node) -> Any:
-    """What the page's keys call: publish (linear m/s, angular rad/s) as a Twist on cmd_vel."""
-    from geometry_msgs.msg import Twist
-
-    publisher = node.create_publisher(Twist, "cmd_vel", 10)
-
-    def drive(linear: float, angular: float) -> None:
-        msg = Twist()
-        msg.linear.x, msg.angular.z = linear, angular
-        publisher.publish(msg)
-
-    return drive
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the viewer until shutdown; 1 with a one-line error when its input is unusable."""
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
@@ -440,7 +463,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             node.get_logger().warn(warning)
         state = ViewerState(config)
         subscribe(node, state)
-        server = serve(state, port, time.monotonic, driver(node))
+        server = serve(state, port, time.monotonic, twist_driver(node))
         node.get_logger().info(
             f"stand-in for rviz2: fixed frame {config.fixed_frame!r}, drawing "
             f"{config.description_topic}, {config.odom_topic}, {config.scan_topic}; the page's"

@@ -128,6 +128,20 @@ def make_handler(
     return Handler
 
 
+def twist_driver(node: Any) -> Drive:
+    """What the page's keys call: publish (linear m/s, angular rad/s) as a Twist on cmd_vel."""
+    from geometry_msgs.msg import Twist  # the viewer's process has rclpy; this module does not
+
+    publisher = node.create_publisher(Twist, "cmd_vel", 10)
+
+    def drive(linear: float, angular: float) -> None:
+        msg = Twist()
+        msg.linear.x, msg.angular.z = linear, angular
+        publisher.publish(msg)
+
+    return drive
+
+
 def _clamp(value: float, limit: float) -> float:
     return max(-limit, min(limit, value))
 

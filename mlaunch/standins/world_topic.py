@@ -49,11 +49,13 @@ def shape_json(shape: Shape) -> dict[str, Any]:
     return {"model": shape.model, "type": "polygon", "points": points, **span}
 
 
-def world_message(world: World, robots: Iterable[SimRobot]) -> str:
-    """The JSON text the simulator publishes for its world and its robots' odometry frames."""
+def world_message(world: World, robots: Iterable[SimRobot], run: str = "") -> str:
+    """The JSON text the simulator publishes for its world and its robots' odometry frames;
+    ``run`` names this start of the simulator (the viewer sees a restart when it changes)."""
     return json.dumps(
         {
             "name": world.name,
+            "run": run,
             "frame": WORLD_FRAME,
             "shapes": [shape_json(s) for s in world.shapes],
             # Not rounded: a yaw off by 1e-5 would move a wall 10 m away by 0.1 mm.
@@ -87,19 +89,24 @@ class WorldPicture:
         self.origins: dict[str, Pose2D] = {}
         self.error: str | None = None
         self.seen = False
+        self.run = ""  # the simulator start that published it
 
-    def set(self, text: str) -> None:
-        """Take a published document; a malformed one keeps the last good world and says why."""
+    def set(self, text: str) -> bool:
+        """Take a published document; a malformed one keeps the last good world and says why.
+
+        True when it comes from a new start of the simulator (the one before was restarted)."""
         try:
             data = json.loads(text)
             shapes = [_checked(s) for s in data["shapes"]]
             origins = {str(k): _pose(v) for k, v in data.get("origins", {}).items()}
-            name = str(data.get("name", ""))
+            name, run = str(data.get("name", "")), str(data.get("run", ""))
         except (ValueError, TypeError, KeyError, AttributeError) as exc:
             self.error = f"world from {WORLD_TOPIC} not understood: {type(exc).__name__}: {exc}"
-            return
+            return False
+        restarted = self.seen and run != self.run
         self.name, self.shapes, self.origins, self.error = name, shapes, origins, None
-        self.seen = True
+        self.seen, self.run = True, run
+        return restarted
 
     def in_frame(self, frame: str) -> dict[str, Any] | None:
         """The world's shapes in ``frame`` (an odometry frame the simulator named, else the
