@@ -375,7 +375,7 @@ def test_unknown_tag_with_did_you_mean(tmp_path: Path) -> None:
         (
             "<launch>\n<executable cmd='true'>\n  <remap from='a' to='b'/>\n</executable>\n</launch>",
             "3:3",
-            "unexpected tag inside <executable>; valid children: <env>",
+            "unexpected tag <remap>; valid children: <env>",
         ),
         (
             "<launch>\n<executable cmd='true'>\n  <env name='A'/>\n</executable>\n</launch>",

@@ -34,6 +34,14 @@ _YAML_FLOAT = "tag:yaml.org,2002:float"
 _YAML_NULL = "tag:yaml.org,2002:null"
 
 
+class MissingAttributeError(LaunchFileError, AttributeError):
+    """A required attribute is not there (an AttributeError, as upstream's Entity raises)."""
+
+
+class UnexpectedEntityError(LaunchFileError, ValueError):
+    """An attribute or nested tag nothing read (a ValueError, as upstream raises it)."""
+
+
 class Attr:
     """An attribute value and where its text starts (1-based line and column).
 
@@ -143,8 +151,14 @@ class Entity:
                 col += index
         return f"{self.path}:{line}:{col}"
 
-    def error(self, message: str, attr: Attr | None = None, index: int = 0) -> LaunchFileError:
-        return LaunchFileError(message, where=self.where(attr, index), what=self.what)
+    def error(
+        self,
+        message: str,
+        attr: Attr | None = None,
+        index: int = 0,
+        kind: type[LaunchFileError] = LaunchFileError,
+    ) -> LaunchFileError:
+        return kind(message, where=self.where(attr, index), what=self.what)
 
     # --- reading attributes ---------------------------------------------------------------------
 
@@ -153,7 +167,7 @@ class Entity:
         attr = self.attrs.get(name)
         if attr is None:
             if required:
-                raise self.error(self._missing(name))
+                raise self.error(self._missing(name), kind=MissingAttributeError)
             return None
         self._used.add(name)
         return attr
@@ -272,20 +286,27 @@ class Entity:
             return [c for c in self.children or () if c.tag not in self._sub_tags]
         return list(self.children or ())
 
+    def nested(self) -> list[Entity]:
+        """Every child entity, all of them counted as read (upstream's ``Entity.children``)."""
+        self._actions_read = True
+        return list(self.children or ())
+
     def finish(self) -> None:
         """Reject any attribute or child that no getter read."""
         for name, attr in self.attrs.items():
             if name not in self._used:
-                raise self.error(self._unknown_attribute(name), attr)
+                raise self.error(self._unknown_attribute(name), attr, kind=UnexpectedEntityError)
         if self.children is not None and not self._actions_read:
             if self.fmt == "yaml":
-                raise self.error(f"{self.tag} takes no child entities")
+                raise self.error(f"{self.tag} takes no child entities", kind=UnexpectedEntityError)
             for child in self.children:
                 if child.tag not in self._sub_tags:
                     valid = ", ".join(f"<{t}>" for t in self._sub_tags) or "none"
                     hint = _did_you_mean(child.tag, self._sub_tags)
-                    raise child.error(
-                        f"unexpected tag inside {self.what}{hint}; valid children: {valid}"
+                    raise UnexpectedEntityError(
+                        f"unexpected tag {child.what}{hint}; valid children: {valid}",
+                        where=child.where(),
+                        what=self.what,
                     )
 
     def _unknown_attribute(self, name: str) -> str:
@@ -327,7 +348,9 @@ class Entity:
         try:
             parts = parse_template(text)
         except TemplateError as e:
-            raise self.error(f"{e.message} in {_excerpt(text, e.index)}", attr, e.index)
+            if e.unknown is None or not _extensions_loaded():
+                raise self.error(f"{e.message} in {_excerpt(text, e.index)}", attr, e.index)
+            return self.template(attr, text)  # a package's extension may expose the name
         if len(parts) == 1 and isinstance(parts[0], str):
             return parts[0]
         return parts
@@ -350,6 +373,16 @@ class Entity:
         if isinstance(node, str) or type(node).__name__ != "ScalarNode" or node.tag not in tags:
             return None
         return self.yaml_construct(node)
+
+
+def _extensions_loaded() -> bool:
+    """Load the launch extensions (entry points) if that was not done yet; whether it was now.
+
+    Only a tag or substitution name outside the built-in tables pays for it.
+    """
+    from mlaunch.frontends.markup import load_extensions
+
+    return load_extensions()
 
 
 def _did_you_mean(name: str, options: Any) -> str:

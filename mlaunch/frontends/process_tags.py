@@ -10,8 +10,8 @@ import mlaunch.launch.actions as core
 from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
-from mlaunch.launch.substitutions import Substitution, to_bool
-from mlaunch.launch_ros.subst import Part, Parts
+from mlaunch.launch.frontend.cmdline import split_parts
+from mlaunch.launch.substitutions import to_bool
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.steps import OUTPUT_MODES
 
@@ -107,72 +107,9 @@ def split_command(e: Entity, name: str) -> list[Any]:
     value = e.text(name, required=True)
     assert value is not None
     try:
-        return _split(value if isinstance(value, list) else [value])
+        return split_parts(value if isinstance(value, list) else [value])
     except ValueError as err:
         raise e.error(f"attribute {name!r}: {err}", e.attrs[name])
-
-
-def _split(parts: Parts) -> list[Any]:
-    args: list[Any] = []
-    current: list[Part] = []
-    buf: list[str] = []
-    in_token = False
-    quote: str | None = None
-
-    def flush() -> None:
-        if buf:
-            text = "".join(buf)
-            buf.clear()
-            if current and isinstance(current[-1], str):
-                current[-1] += text
-            else:
-                current.append(text)
-
-    for part in parts:
-        if isinstance(part, Substitution):
-            flush()
-            current.append(part)
-            in_token = True
-            continue
-        i, n = 0, len(part)
-        while i < n:
-            c = part[i]
-            if quote == "'":
-                if c == "'":
-                    quote = None
-                else:
-                    buf.append(c)
-            elif quote == '"':
-                if c == '"':
-                    quote = None
-                elif c == "\\" and i + 1 < n and part[i + 1] in '"\\':
-                    buf.append(part[i + 1])
-                    i += 1
-                else:
-                    buf.append(c)
-            elif c.isspace():
-                if in_token:
-                    flush()
-                    args.append(current[0] if len(current) == 1 else list(current))
-                    current.clear()
-                    in_token = False
-            elif c in "'\"":
-                quote = c
-                in_token = True
-            elif c == "\\" and i + 1 < n:
-                buf.append(part[i + 1])
-                in_token = True
-                i += 1
-            else:
-                buf.append(c)
-                in_token = True
-            i += 1
-    if quote is not None:
-        raise ValueError(f"the quote {quote} is not closed")
-    if in_token:
-        flush()
-        args.append(current[0] if len(current) == 1 else (list(current) or ""))
-    return args
 
 
 # --- launch_ros tags -------------------------------------------------------------------------

@@ -32,29 +32,37 @@ TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~
 if TYPE_CHECKING:
     from typing import Any
 
+    from mlaunch.launch.frontend.parser import Parser
     from mlaunch.launch.launch_description import LaunchDescription
 
 
 # --- the dispatcher --------------------------------------------------------------------------
 
 
-def build_description(root: Entity) -> LaunchDescription:
-    """The LaunchDescription of a root ``launch`` entity."""
+def build_description(root: Entity, parser: Parser | None = None) -> LaunchDescription:
+    """The LaunchDescription of a root ``launch`` entity (``parser``: the one tags a package
+    exposed are parsed with, when the description is parsed from Python)."""
     if root.tag != "launch":
         raise root.error(f"the root must be 'launch', not {root.tag!r}")
     reason = root.literal("deprecated")
-    actions = [build_action(child) for child in root.actions()]
+    actions = [build_action(child, parser) for child in root.actions()]
     root.finish()
     description = core.LaunchDescription(actions, deprecated_reason=reason)
     description.origin = root.origin
     return description
 
 
-def build_action(e: Entity) -> Any:
-    """One action tag: its builder, then condition, origin and the completeness check."""
+def build_action(e: Entity, parser: Parser | None = None) -> Any:
+    """One action tag: its builder, then condition, origin and the completeness check.
+
+    A tag outside the table is built by the parse method a package exposed for it
+    (``launch.frontend.expose_action``), which reads its own condition.
+    """
     builder = ACTIONS.get(e.tag)
     if builder is None:
-        raise e.error(_unknown_tag(e.tag))
+        from mlaunch.frontends.markup import build_exposed
+
+        return build_exposed(e, parser, _unknown_tag)
     if e.fmt == "yaml" and e.children is not None and e.tag not in TAKES_ACTIONS:
         raise e.error(f"{e.tag} takes no child entities (only {', '.join(TAKES_ACTIONS)} do)")
     when = e.condition_text("if")
@@ -84,8 +92,11 @@ def _unknown_tag(tag: str) -> str:
         return f"the ROS 2 tag {tag!r} is not supported by mlaunch ({UNSUPPORTED[tag]})"
     if tag in MISPLACED:
         return f"{tag!r} is not an action here; {MISPLACED[tag]}"
-    hint = did_you_mean(tag, ACTIONS)
-    return f"unknown tag {tag!r}{hint}; valid tags: {', '.join(sorted(ACTIONS))}"
+    from mlaunch.launch.frontend.expose import action_parse_methods
+
+    known = {*ACTIONS, *action_parse_methods}  # with the tags packages exposed
+    hint = did_you_mean(tag, known)
+    return f"unknown tag {tag!r}{hint}; valid tags: {', '.join(sorted(known))}"
 
 
 # --- core tags -------------------------------------------------------------------------------

@@ -37,6 +37,11 @@ def read_root(path: str) -> Entity:
             data = f.read()
     except OSError as e:
         raise LaunchFileError(f"cannot read launch file: {e.strerror}", where=path)
+    return parse_root(data, path)
+
+
+def parse_root(data: bytes, path: str) -> Entity:
+    """The root Entity of XML text, its errors located in ``path``."""
     root = _TreeBuilder(path, data).parse()
     for name in [n for n in root.attrs if _ROOT_IGNORED.match(n)]:
         del root.attrs[name]

@@ -46,6 +46,11 @@ def read_root(path: str) -> Entity:
             data = f.read()
     except OSError as e:
         raise LaunchFileError(f"cannot read launch file: {e.strerror}", where=path)
+    return parse_root(data, path)
+
+
+def parse_root(data: bytes, path: str) -> Entity:
+    """The root ``launch`` Entity of YAML text, its errors located in ``path``."""
     return _Reader(path).root(data)
 
 

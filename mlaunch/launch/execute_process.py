@@ -309,6 +309,14 @@ class ExecuteProcess(Action):
             required = True
         return planner.defer(entities, self.origin), required
 
+    @classmethod
+    def _parse_cmdline(cls, cmd: str, parser: Any) -> list[Any]:
+        """A markup command line as argv items, each a list of substitutions (what the parse
+        methods of exposed process tags call, as upstream's)."""
+        from mlaunch.launch.frontend.cmdline import parse_cmdline
+
+        return parse_cmdline(cmd, parser)
+
     def describe_short(self) -> str:
         return "ExecuteProcess(" + " ".join(describe(c) for c in self.cmd) + ")"
 

@@ -47,6 +47,23 @@ class Action(LaunchDescriptionEntity):
     def get_sub_entities(self) -> list[Any]:
         return []
 
+    @staticmethod
+    def parse(entity: Any, parser: Any) -> tuple[type[Action], dict[str, Any]]:
+        """What every tag a package exposes shares (``launch.frontend``): its ``if`` or
+        ``unless`` condition, as keyword arguments; subclasses' ``parse`` add their own."""
+        from mlaunch.launch.conditions import IfCondition, UnlessCondition
+
+        when = entity.get_attr("if", optional=True)
+        unless = entity.get_attr("unless", optional=True)
+        if when is not None and unless is not None:
+            raise RuntimeError("if and unless conditions can't be used simultaneously")
+        kwargs: dict[str, Any] = {}
+        if when is not None:
+            kwargs["condition"] = IfCondition(parser.parse_substitution(when))
+        if unless is not None:
+            kwargs["condition"] = UnlessCondition(parser.parse_substitution(unless))
+        return Action, kwargs
+
 
 class LaunchDescription(LaunchDescriptionEntity):
     """An ordered list of entities; what generate_launch_description() returns."""
