@@ -115,3 +115,22 @@ def test_allow_exit_codes_are_parsed_and_checked() -> None:
         parse_settings(["--allow-exit", "talker:3,FOO"])
     with pytest.raises(UsageError, match="a process label first"):
         parse_settings(["--allow-exit", ":3"])
+
+
+@pytest.mark.parametrize("flag", ["--junit", "--junit-xml"])
+def test_both_junit_flags_work_for_launch_files_and_launch_testing_files(
+    tmp_path: Path, flag: str
+) -> None:
+    """--junit was for launch files and --junit-xml for launch_testing files: the other one
+    failed with the main usage text. Both work for both, also as --flag=FILE."""
+    from procutil import REPO
+
+    launch = _launch(tmp_path, REQUIRED, end="sys.exit(0)")
+    launch_test = str(REPO / "tests" / "launch_testing" / "failing.test.py")
+    for path, status, more in ((launch, 0, ["--hold", "0"]), (launch_test, 1, [])):
+        for form in ([flag, str(tmp_path / "a.xml")], [f"{flag}={tmp_path / 'b.xml'}"]):
+            report = Path(form[-1].split("=")[-1])
+            report.unlink(missing_ok=True)
+            done = run_mlaunch("test", path, *more, *form, env=clean_env(), timeout=120)
+            assert done.returncode == status, done.stdout + done.stderr
+            assert ET.parse(report).getroot().tag == "testsuites", (path, form)

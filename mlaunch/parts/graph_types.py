@@ -123,6 +123,14 @@ class TopicWatch:
             return 0.0
         return (len(recent) - 1) / (recent[-1] - recent[0])
 
+    def recent(self, window: float = 2.0) -> tuple[int, float]:
+        """(messages, seconds from the first to the last of them) of the last `window` seconds:
+        what a rate from `rate(window)` rests on."""
+        since = time.monotonic() - window
+        with self._cond:
+            recent = [t for t in self._stamps if t >= since]
+        return len(recent), (recent[-1] - recent[0]) if recent else 0.0
+
     def wait_count(self, n: int, timeout: float) -> bool:
         """Wait until at least `n` messages arrived; False at the deadline or on close."""
         with self._cond:

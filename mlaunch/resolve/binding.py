@@ -65,7 +65,9 @@ def _walk(obj: Any, uses: _Uses, seen: set[int], depth: int = 0) -> None:
             _walk(value, uses, seen, depth + 1)
         return
     if callable(obj) and not hasattr(obj, "visit") and not hasattr(obj, "perform"):
-        uses.code = True  # launch-file code (OpaqueFunction's function, a handler lambda)
+        # launch-file code (OpaqueFunction's function, a handler lambda); mlaunch's own
+        # callbacks (launch_testing's bookkeeping) read no launch configuration
+        uses.code = uses.code or launch_file_code(obj)
         return
     module = type(obj).__module__
     if not module.startswith("mlaunch.") or type(obj).__name__ == "LaunchContext":
@@ -97,7 +99,7 @@ def differences(
     """What the body would see differently with the values captured where it was written."""
     uses = _Uses()
     _walk(entities, uses, set())
-    uses.code = uses.code or callback is not None
+    uses.code = uses.code or (callback is not None and launch_file_code(callback))
     then, now = captured.launch_configurations, live.launch_configurations
     out = []
     for name in sorted(uses.configs):
@@ -126,6 +128,26 @@ def differences(
     return out
 
 
+def launch_file_code(fn: Any) -> bool:
+    """Whether ``fn`` is code of the user's (a launch file's function or lambda), not mlaunch's
+    own or a builtin: only such code can read launch configurations when it fires."""
+    from mlaunch.plan.origin import is_mlaunch_file
+
+    for _ in range(10):  # partials of bound methods of partials ...
+        inner = getattr(fn, "func", None) or getattr(fn, "__func__", None)
+        if inner is None:
+            break
+        fn = inner
+    code = getattr(fn, "__code__", None)
+    if code is not None:
+        return not is_mlaunch_file(code.co_filename)
+    # A callable object: where its class is written (a builtin's module has no file).
+    import sys
+
+    filename = getattr(sys.modules.get(type(fn).__module__), "__file__", None)
+    return isinstance(filename, str) and not is_mlaunch_file(filename)
+
+
 def _show(value: Any) -> str:
     return "unset" if value is None else repr(value)
 
@@ -133,13 +155,17 @@ def _show(value: Any) -> str:
 _WARNED: set[int] = set()
 
 
-def warn_once(captured: LaunchContext, origin: str, diffs: list[str]) -> str | None:
-    """The warning for a body that resolves differently, once per timer or handler."""
+def warn_once(
+    captured: LaunchContext, origin: str, diffs: list[str], subject: str = ""
+) -> str | None:
+    """The warning for a body that resolves differently, once per timer or handler;
+    ``subject`` says what the body does (its actions, or the function it calls)."""
     if not diffs or id(captured) in _WARNED:
         return None
     _WARNED.add(id(captured))  # captured lives as long as its Deferred: the id stays unique
+    what = f"{subject}: " if subject else ""
     return (
-        f"{origin}: resolved when it fires, as ros2 launch does, and {'; '.join(diffs)}"
+        f"{origin}: {what}resolved when it fires, as ros2 launch does, and {'; '.join(diffs)}"
         f" (--capture-at-definition, or a comment '{PRAGMA}' in the file, uses the values"
         " from where it was written)"
     )

@@ -351,7 +351,7 @@ def resolve_deferred(
         from mlaunch.resolve.binding import differences, warn_once
 
         diffs = differences(captured, context, deferred.entities, deferred.callback)
-        message = warn_once(captured, deferred.origin, diffs)
+        message = warn_once(captured, deferred.origin, diffs, deferred.describe())
         if message:
             plan.warnings.append(message)
     # the live context's locals (and planner) are the event's only now

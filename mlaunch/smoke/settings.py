@@ -97,6 +97,7 @@ VALUE_FLAGS = (
     "--timeout",
     "--hold",
     "--junit",
+    "--junit-xml",
     "--allow-exit",
 )
 
@@ -149,7 +150,13 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"stay up S seconds after ready, watching for crashes (default {DEFAULT_HOLD:g};"
         " 0 skips it)",
     )
-    parser.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
+    parser.add_argument(
+        "--junit",
+        "--junit-xml",  # launch_testing's name for it: both work for either kind of file
+        metavar="FILE",
+        dest="junit",
+        help="write a JUnit XML report",
+    )
     parser.add_argument(
         "--allow-exit",
         action="append",

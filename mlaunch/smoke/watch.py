@@ -27,6 +27,8 @@ STARTUP_GRACE = 2.0
 RING_LINES = 20
 # A topic given with a rate passes at this fraction of it (publishers jitter, CI machines lag).
 RATE_TOLERANCE = 0.9
+# ... and is measured over at least this long (a 30 Hz topic passed on 0.3 s of messages).
+MIN_RATE_SPAN = 1.0
 # The graph is looked at this often; deadlines are checked this often.
 GRAPH_PERIOD = 0.2
 TICK = 0.1
@@ -453,11 +455,19 @@ class GraphProbe:
             return True, f"{_messages(watch.count)} received"
         window = max(2.0, 5.0 / e.rate)
         measured = watch.rate(window)
+        count, span = watch.recent(window)
         wanted = e.rate * RATE_TOLERANCE
-        seen = f"{measured:.1f} Hz over the last {window:g} s ({_messages(watch.count)})"
-        # A rate from a handful of arrivals is mostly jitter: it passes only from a few more.
-        if watch.count < max(3, min(10, int(e.rate))):
-            return False, f"still measuring: {seen}, wanted >= {wanted:.1f} Hz"
+        seen = f"{measured:.1f} Hz over {span:.1f} s ({_messages(count)})"
+        # A rate from a handful of arrivals, or from a fraction of a second, is mostly jitter:
+        # it is judged only once enough of both came.
+        need_count = max(3, min(10, int(e.rate)))
+        need_span = max(MIN_RATE_SPAN, (need_count - 1) / e.rate)
+        total = (watch.last_at or 0.0) - (watch.first_at or 0.0)
+        if watch.count < need_count or total < need_span:
+            return False, (
+                f"too little data: {_messages(watch.count)} over {total:.1f} s; a rate needs"
+                f" {need_count} over {need_span:g} s or more (wanted >= {wanted:.1f} Hz)"
+            )
         if measured >= wanted:
             return True, seen
         return False, f"too slow: {seen}, wanted >= {wanted:.1f} Hz"
