@@ -38,7 +38,10 @@ def fixture(
         def launch_fixture(*f_args: Any, **f_kwargs: Any) -> Iterator[Any]:
             value = function(*f_args, **f_kwargs)
             run = LaunchRun.start(
-                value, shutdown_when_idle=shutdown_when_idle, auto_shutdown=auto_shutdown
+                value,
+                name=function.__name__,
+                shutdown_when_idle=shutdown_when_idle,
+                auto_shutdown=auto_shutdown,
             )
             try:
                 yield value

@@ -15,6 +15,7 @@ from __future__ import annotations
 import asyncio
 import inspect
 import threading
+from collections.abc import Sequence
 
 import pytest
 
@@ -61,18 +62,13 @@ class LaunchRun:
         return self._loop.run_until_complete(coroutine)
 
     @classmethod
-    def start(cls, value: Any, *, shutdown_when_idle: bool, auto_shutdown: bool) -> LaunchRun:
-        description = value[0] if isinstance(value, tuple) else value
-        if not isinstance(description, LaunchDescription):
-            raise TypeError(
-                "a launch_pytest fixture must return a LaunchDescription (or a tuple starting"
-                f" with one), not {type(description).__name__}"
-            )
+    def start(
+        cls, value: Any, *, name: str, shutdown_when_idle: bool, auto_shutdown: bool
+    ) -> LaunchRun:
+        """Launch what the fixture ``name`` returned, in a thread; wait for its ReadyToTest."""
+        description = _description_of(value, name)
         run = cls(value, LaunchService(), auto_shutdown)
-        ready = next(iter_ready_to_test(description.entities), None)
-        if ready is None:
-            ready = ReadyToTest()
-            description.add_action(ready)
+        ready = _the_ready_to_test(description)
         ready._add_callback(run.ready.set)
         recorders.register(run.service.context, run)
         run.service.include_launch_description(run.recording(description))
@@ -152,6 +148,36 @@ class _Recorders:
 recorders = _Recorders()
 
 
+def _description_of(value: Any, fixture_name: str) -> LaunchDescription:
+    """The LaunchDescription a launch fixture returned: the value, or the first item of the
+    sequence it returned; anything else is an error naming the fixture (as launch_pytest's)."""
+    description = value
+    if isinstance(value, Sequence):
+        description = value[0] if len(value) else None
+    if not isinstance(description, LaunchDescription):
+        raise TypeError(
+            f"When running launch_pytest fixture '{fixture_name}': return value must be either a"
+            " launch description or a sequence which first item is a launch description"
+            f" (got {type(value).__name__})"
+        )
+    return description
+
+
+def _the_ready_to_test(description: LaunchDescription) -> ReadyToTest:
+    """The one ReadyToTest of ``description`` (one is added at its end when it has none)."""
+    found = list(iter_ready_to_test(description.entities))
+    if len(found) > 1:
+        raise RuntimeError(
+            "launch_pytest fixtures must return a LaunchDescription containing only one"
+            f" ReadyToTest action (this one has {len(found)})"
+        )
+    if found:
+        return found[0]
+    ready = ReadyToTest()
+    description.add_action(ready)
+    return ready
+
+
 # --- markers and fixtures ---------------------------------------------------------------------
 
 
@@ -163,23 +189,49 @@ def pytest_configure(config: pytest.Config) -> None:
     )
 
 
+class LaunchTestWarning(pytest.PytestWarning):
+    """A launch test written in a way launch_pytest cannot run."""
+
+
+NO_FIXTURE = '"fixture" keyword argument is required in a pytest.mark.launch() decorator'
+
+
 def _launch_marker(item: Any) -> Any:
+    """The item's ``launch`` mark, when it names a fixture (without one the item is skipped)."""
     marker = item.get_closest_marker("launch")
-    if marker is None:
+    if marker is None or marker.kwargs.get("fixture") is None:
         return None
-    if "fixture" not in marker.kwargs:
-        raise pytest.UsageError(
-            f"{item.nodeid}: @pytest.mark.launch needs fixture=<a launch_pytest fixture>"
-        )
     return marker
+
+
+def _skip_without_fixture(item: Any) -> None:
+    """A ``launch`` mark without ``fixture=``: warned about and skipped, as in launch_pytest."""
+    marker = item.get_closest_marker("launch")
+    if marker is not None and marker.kwargs.get("fixture") is None:
+        item.warn(LaunchTestWarning(NO_FIXTURE))
+        item.add_marker(pytest.mark.skip(reason=NO_FIXTURE))
+
+
+def fixture_marker(fixture: Any) -> Any:
+    """pytest's FixtureFunctionMarker (scope, name, params) of a fixture, or None.
+
+    pytest 8.4 and later return a FixtureFunctionDefinition from ``@pytest.fixture``, holding it
+    as ``_fixture_function_marker``; earlier ones (7.4, what ROS 2 Jazzy runs, included) return
+    the function itself with the marker as ``_pytestfixturefunction``.
+    """
+    for attribute in ("_fixture_function_marker", "_pytestfixturefunction"):
+        marker = getattr(fixture, attribute, None)
+        if marker is not None:
+            return marker
+    return None
 
 
 def _fixture_name(marker: Any) -> str:
     fixture = marker.kwargs["fixture"]
-    name = getattr(fixture, "name", None) or getattr(fixture, "__name__", None)
-    if not isinstance(name, str):
+    definition = fixture_marker(fixture)
+    if definition is None:
         raise pytest.UsageError(f"@pytest.mark.launch(fixture={fixture!r}) is not a fixture")
-    return name
+    return str(definition.name or fixture.__name__)
 
 
 def _run_of(request: pytest.FixtureRequest) -> LaunchRun:
@@ -217,7 +269,7 @@ def pytest_pycollect_makeitem(collector: Any, name: str, obj: Any) -> Any:
     if not collector.funcnamefilter(name) or not callable(obj):
         return None
     marks = [m for m in getattr(obj, "pytestmark", []) if m.name == "launch"]
-    if not marks or not (inspect.isgeneratorfunction(obj) or inspect.isasyncgenfunction(obj)):
+    if not marks or not _is_generator(obj):
         return None
     items = list(collector._genfunctions(name, obj))
     if _scope_of(marks[0].kwargs.get("fixture")) != "function":
@@ -228,11 +280,12 @@ def pytest_pycollect_makeitem(collector: Any, name: str, obj: Any) -> Any:
     return items
 
 
+def _is_generator(function: Any) -> bool:
+    return inspect.isgeneratorfunction(function) or inspect.isasyncgenfunction(function)
+
+
 def _scope_of(fixture: Any) -> str:
-    marker = getattr(fixture, "_fixture_function_marker", None) or getattr(
-        fixture, "_pytestfixturefunction", None
-    )
-    return str(getattr(marker, "scope", "function"))
+    return str(getattr(fixture_marker(fixture), "scope", "function"))
 
 
 def _is_shutdown_item(item: Any) -> bool:
@@ -246,6 +299,7 @@ def pytest_collection_modifyitems(session: Any, config: Any, items: list[Any]) -
     after the shutdown move after the others (each group keeps its own order)."""
     groups: dict[tuple[Any, ...], list[Any]] = {}
     for item in items:
+        _skip_without_fixture(item)
         marker = _launch_marker(item)
         if marker is None:
             continue
@@ -287,6 +341,12 @@ def pytest_pyfunc_call(pyfuncitem: Any) -> Any:
     marker = _launch_marker(pyfuncitem)
     if marker is None:
         return None
+    if marker.kwargs.get("shutdown", False) and _is_generator(pyfuncitem.obj):
+        pytest.fail(
+            "generator or async generator based launch test items cannot be marked with"
+            " shutdown=True",
+            pytrace=False,
+        )
     run = LaunchRun.of(pyfuncitem.funcargs[_fixture_name(marker)])
     try:
         first_half = getattr(pyfuncitem, "_launch_pytest_shutdown_of", None)
@@ -340,9 +400,15 @@ async def _first(agen: Any) -> None:
 
 async def _rest(agen: Any) -> None:
     async for _ in agen:
-        raise RuntimeError("a launch test may yield only once")
+        pytest.fail(
+            "launch tests using an async gen function must stop iteration after yielding once",
+            pytrace=False,
+        )
 
 
 def _finish(gen: Any) -> None:
     for _ in gen:
-        raise RuntimeError("a launch test may yield only once")
+        pytest.fail(
+            "launch tests using a generator function must stop iteration after yielding once",
+            pytrace=False,
+        )
