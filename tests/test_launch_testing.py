@@ -105,7 +105,7 @@ def test_not_a_launch_test_is_a_clear_error(tmp_path: Path) -> None:
     plain = tmp_path / "plain.py"
     plain.write_text("x = 1\n")
     done = subprocess.run(
-        [sys.executable, "-m", "mlaunch.launch_testing.launch_test", str(plain)],
+        [sys.executable, "-m", "mlaunch.cli.launch_test", str(plain)],
         capture_output=True,
         text=True,
         env=clean_env(),

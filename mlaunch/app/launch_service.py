@@ -60,9 +60,6 @@ class LaunchService:
         self.noninteractive = noninteractive
         self.debug = debug
         self.screen = screen
-        from mlaunch import compat
-
-        compat.install()  # the descriptions it includes may be Python launch files
         self._context = LaunchContext(environment=os.environ, argv=tuple(self.argv))
         for item in self.argv:
             name, sep, value = item.partition(":=")

@@ -81,10 +81,8 @@ def load_target(opts: Options) -> tuple[str, LaunchDescription]:
     given = os.path.abspath(opts.target) if opts.second is None else None
     with searching(package_search(opts, given if given and os.path.exists(given) else None)):
         path = find_launch_file(opts)
-    from mlaunch import compat, readers
+    from mlaunch import readers
     from mlaunch.frontends.python import set_launch_argv
-
-    compat.install()  # launch files import the ROS 2 names (launch, launch_ros ...)
 
     set_launch_argv(opts.target, opts.second, opts.launch_argv)
     # Launch-file code run while loading (get_package_share_directory) sees the same search.

@@ -27,6 +27,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """``mlaunch ...`` and its subcommands: the one place errors are caught and printed."""
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or "-d" in args
+    from mlaunch import compat
+
+    compat.install()  # launch files import the ROS 2 names (launch, launch_ros ...)
     try:
         sub = subcommands().get(args[0]) if args and not os.path.isfile(args[0]) else None
         if sub is not None:  # each parses its own options and runs through mlaunch.app

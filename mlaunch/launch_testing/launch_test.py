@@ -83,10 +83,8 @@ def parse_arguments() -> tuple[argparse.ArgumentParser, argparse.Namespace]:
 
 
 def load_module(name: str, path: str) -> ModuleType:
-    """Import the test file as module ``name``, with the ROS 2 names served by mlaunch."""
-    from mlaunch import compat
-
-    compat.install()
+    """Import the test file as module ``name`` (the program that runs it serves the ROS 2 names:
+    mlaunch.cli.launch_test, mlaunch test)."""
     spec = importlib.util.spec_from_file_location(name, path)
     if spec is None or spec.loader is None:
         raise ValueError(f"{path}: cannot be loaded as a Python module")
@@ -149,9 +147,5 @@ def main(argv: Sequence[str] | None = None, prog: str = "launch_test") -> int:
 
 
 def program() -> None:
-    """The ``launch_test`` program."""
+    """The ``launch_test`` program, once the ROS 2 names are served (mlaunch.cli.launch_test)."""
     sys.exit(main())
-
-
-if __name__ == "__main__":
-    program()

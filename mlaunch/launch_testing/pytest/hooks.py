@@ -23,6 +23,7 @@ from mlaunch.launch_testing.pytest import hookspecs
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
     from typing import Any
 
@@ -87,15 +88,25 @@ def pytest_configure(config: pytest.Config) -> None:
 
 
 def pytest_pycollect_makemodule(module_path: Path, parent: Any) -> Any:
+    return collect_module(module_path, parent)
+
+
+def collect_module(
+    module_path: Path, parent: Any, serve_names: Callable[[], None] | None = None
+) -> Any:
+    """A LaunchTestModule for a launch test file, else None (pytest collects it itself).
+
+    ``serve_names`` serves the ROS 2 module names from the first test module that imports one
+    of them on (mlaunch.cli.pytest_launch_testing, the installed plugin, passes mlaunch's).
+    """
     try:
         source = module_path.read_bytes()
     except OSError:
         return None
     if not _ROS_IMPORT.search(source):
         return None
-    from mlaunch import compat
-
-    compat.install()
+    if serve_names is not None:
+        serve_names()
     # Only files that may be launch tests are imported here (pytest imports the others itself).
     if not _LAUNCH_TEST_MARK.search(source) or b"generate_test_description" not in source:
         return None
