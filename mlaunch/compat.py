@@ -33,14 +33,6 @@ ROOTS: dict[str, str] = {
 # Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per
 # module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.launch_description``).
 SYNONYMS: dict[str, str] = {
-    "launch.action": "mlaunch.launch.launch_description",
-    "launch.launch_description_entity": "mlaunch.launch.launch_description",
-    "launch.some_substitutions_type": "mlaunch.launch.substitution",
-    "launch.condition": "mlaunch.launch.conditions",
-    "launch.event_handler": "mlaunch.launch.event_handlers",
-    "launch.event": "mlaunch.launch.events",
-    "launch.events.process": "mlaunch.launch.events",
-    "launch.utilities": "mlaunch.launch",
     "launch.launch_service": "mlaunch.app.launch_service",
     "launch_xml.launch_description_sources": "mlaunch.launch.launch_description_sources",
     "launch_xml.parser": "mlaunch.frontends.launch_xml",
@@ -48,9 +40,6 @@ SYNONYMS: dict[str, str] = {
     "launch_yaml.launch_description_sources": "mlaunch.launch.launch_description_sources",
     "launch_yaml.parser": "mlaunch.frontends.launch_yaml",
     "launch_yaml.entity": "mlaunch.frontends.launch_yaml",
-    "launch_ros.event_handlers": "mlaunch.launch_ros.events",
-    "launch_ros.events.lifecycle": "mlaunch.launch_ros.events",
-    "launch_ros.utilities": "mlaunch.launch_ros",
     "ament_index_python.packages": "mlaunch.ros.ament_index",
 }
 

@@ -142,8 +142,8 @@ def test_if_else(ctx: LaunchContext) -> None:
     assert perform(ctx, IfElseSubstitution(LaunchConfiguration("flag"), "a", "b")) == "a"
     assert perform(ctx, IfElseSubstitution("false", "a", "b")) == "b"
     assert perform(ctx, IfElseSubstitution("false", if_value="a")) == ""
-    with pytest.raises(TypeError):
-        IfElseSubstitution("true")
+    with pytest.raises(RuntimeError, match="One of if_value and else_value"):
+        IfElseSubstitution("true")  # launch raises RuntimeError, not TypeError
 
 
 def test_conditions_are_strict(ctx: LaunchContext) -> None:

@@ -15,9 +15,12 @@ if TYPE_CHECKING:
     from mlaunch.launch.conditions import Condition
     from mlaunch.launch.event_handlers import EventHandler
     from mlaunch.launch.events import Event
+    from mlaunch.launch.invalid_launch_file_error import InvalidLaunchFileError
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
     from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+    from mlaunch.launch.launch_introspector import LaunchIntrospector
+    from mlaunch.launch.some_entities_type import SomeEntitiesType, SomeEntitiesType_types_tuple
     from mlaunch.launch.substitutions import (
         SomeSubstitutionsType,
         SomeSubstitutionsType_types_tuple,
@@ -31,6 +34,16 @@ _NAMES: dict[str, tuple[str, str]] = {
     "LaunchDescription": ("mlaunch.launch.launch_description", "LaunchDescription"),
     "LaunchDescriptionEntity": ("mlaunch.launch.launch_description", "LaunchDescriptionEntity"),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
+    "InvalidLaunchFileError": (
+        "mlaunch.launch.invalid_launch_file_error",
+        "InvalidLaunchFileError",
+    ),
+    "LaunchIntrospector": ("mlaunch.launch.launch_introspector", "LaunchIntrospector"),
+    "SomeEntitiesType": ("mlaunch.launch.some_entities_type", "SomeEntitiesType"),
+    "SomeEntitiesType_types_tuple": (
+        "mlaunch.launch.some_entities_type",
+        "SomeEntitiesType_types_tuple",
+    ),
     "LaunchContext": ("mlaunch.launch.launch_context", "LaunchContext"),
     "EventHandler": ("mlaunch.launch.event_handlers", "EventHandler"),
     "Event": ("mlaunch.launch.events", "Event"),
@@ -50,6 +63,10 @@ _NAMES: dict[str, tuple[str, str]] = {
 
 _SUBMODULES = (
     "actions",
+    "descriptions",
+    "frontend",
+    "logging",
+    "utilities",
     "substitutions",
     "conditions",
     "event_handlers",
@@ -87,11 +104,15 @@ __all__ = [
     "Condition",
     "Event",
     "EventHandler",
+    "InvalidLaunchFileError",
     "LaunchContext",
     "LaunchDescription",
     "LaunchDescriptionEntity",
     "LaunchDescriptionSource",
+    "LaunchIntrospector",
     "LaunchService",
+    "SomeEntitiesType",
+    "SomeEntitiesType_types_tuple",
     "SomeSubstitutionsType",
     "SomeSubstitutionsType_types_tuple",
     "Substitution",

@@ -163,13 +163,14 @@ class IfElseSubstitution(Substitution):
     """``if_value`` when the condition holds, else ``else_value``."""
 
     def __init__(
-        self, condition: SomeSubstitutionsType, if_value: Any = None, else_value: Any = None
+        self, condition: SomeSubstitutionsType, if_value: Any = "", else_value: Any = ""
     ) -> None:
-        if if_value is None and else_value is None:
-            raise TypeError("IfElseSubstitution needs at least one of if_value and else_value")
+        if if_value == else_value == "":
+            # launch's error type and words (a RuntimeError, not a TypeError)
+            raise RuntimeError("One of if_value and else_value must be specified")
         self.condition = normalize(condition)
-        self.if_value = normalize("" if if_value is None else if_value)
-        self.else_value = normalize("" if else_value is None else else_value)
+        self.if_value = normalize(if_value)
+        self.else_value = normalize(else_value)
 
     def perform(self, context: LaunchContext) -> str:
         chosen = evaluate_condition_expression(perform_substitutions(context, self.condition))

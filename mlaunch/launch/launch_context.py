@@ -11,7 +11,7 @@ import os
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable, Mapping
+    from collections.abc import Callable, Mapping, Sequence
     from typing import Any
 
     from mlaunch.plan.planner import Planner
@@ -35,6 +35,9 @@ class Locals:
         except KeyError:
             raise AttributeError(name) from None
 
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"locals are read-only; use context.extend_locals({{{name!r}: ...}})")
+
     def __contains__(self, name: str) -> bool:
         return name in self._values or name in self._globals
 
@@ -51,7 +54,8 @@ class LaunchContext:
         self,
         *,
         environment: Mapping[str, str] | None = None,
-        argv: tuple[str, ...] = (),
+        argv: Sequence[str] | None = None,
+        noninteractive: bool = False,
         log_dir: str = "",
         warn: Callable[[str], None] | None = None,
         planner: Planner | None = None,
@@ -62,9 +66,16 @@ class LaunchContext:
             environment if environment is not None else os.environ
         )
         self.initial_environment: dict[str, str] = dict(self.environment)
-        self.argv = argv
+        self.argv: list[str] = list(argv or ())
+        self.noninteractive = noninteractive
         self.log_dir = log_dir
         self._locals: dict[str, Any] = {}
+        self._locals_stack: list[dict[str, Any]] = []
+        self._configurations_stack: list[dict[str, Any]] = []
+        # Handlers registered through this context (upstream's list: newest first).
+        self._event_handlers: list[Any] = []
+        self._asyncio_loop: Any = None
+        self._is_shutdown = False
         # One run's globals: shared (not copied) by every snapshot, so what a deferred action
         # adds (launch_ros's count of node names) is seen by the whole run.
         self._globals: dict[str, Any] = {}
@@ -114,6 +125,71 @@ class LaunchContext:
         from mlaunch.launch.substitutions import perform
 
         return perform(self, substitution)
+
+    def _push_locals(self) -> None:
+        self._locals_stack.append(dict(self._locals))
+
+    def _pop_locals(self) -> None:
+        if not self._locals_stack:
+            raise RuntimeError("locals stack unexpectedly empty")
+        self._locals = self._locals_stack.pop()
+
+    def _push_launch_configurations(self) -> None:
+        self._configurations_stack.append(dict(self.launch_configurations))
+
+    def _pop_launch_configurations(self) -> None:
+        if not self._configurations_stack:
+            raise RuntimeError("launch configurations stack unexpectedly empty")
+        self.launch_configurations = self._configurations_stack.pop()
+
+    # --- events, handlers, the loop (their effect is a plan step: mlaunch.launch.planning) --
+
+    @property
+    def asyncio_loop(self) -> Any:
+        """The loop of the run when one is running it, else None (as upstream's bare context)."""
+        return self._asyncio_loop
+
+    def _set_asyncio_loop(self, loop: Any) -> None:
+        self._asyncio_loop = loop
+
+    @property
+    def is_shutdown(self) -> bool:
+        return self._is_shutdown
+
+    def register_event_handler(self, event_handler: Any, append: bool = False) -> None:
+        """Listen with ``event_handler`` from now on (first in line unless ``append``)."""
+        from mlaunch.launch.event_handlers import handler_step
+
+        if append:
+            self._event_handlers.append(event_handler)
+        else:
+            self._event_handlers.insert(0, event_handler)
+        step = handler_step(event_handler, self.planner, getattr(event_handler, "origin", ""))
+        if step is not None:
+            self.planner.add(step)
+
+    def unregister_event_handler(self, event_handler: Any) -> None:
+        """Stop ``event_handler``; ValueError when it was not registered here."""
+        from mlaunch.plan.steps import RemoveHandler
+
+        self._event_handlers.remove(event_handler)  # ValueError when absent, as upstream
+        self.planner.add(RemoveHandler(origin="", handler=event_handler))
+
+    def would_handle_event(self, event: Any) -> bool:
+        """Whether a handler registered here matches ``event``."""
+        return any(handler.matches(event) for handler in self._event_handlers)
+
+    def emit_event_sync(self, event: Any) -> None:
+        """Emit ``event`` when the plan reaches this point (a Shutdown shuts the run down)."""
+        from mlaunch.launch.actions import emit_event_entities
+
+        more = emit_event_entities(self, event, "")
+        if more:
+            self.planner.visit_all(more)
+
+    async def emit_event(self, event: Any) -> None:
+        """``emit_event_sync`` for coroutines, as upstream's awaitable spelling."""
+        self.emit_event_sync(event)
 
     @property
     def current_launch_file_path(self) -> str | None:

@@ -28,6 +28,24 @@ class LaunchDescriptionEntity:
     def describe_short(self) -> str:
         return type(self).__name__
 
+    # --- introspection, as launch's (LaunchIntrospector reads these) ------------------------
+
+    def describe(self) -> str:
+        raise NotImplementedError(f"{type(self).__name__} does not describe itself")
+
+    def describe_sub_entities(self) -> list[Any]:
+        """The entities this one always contains."""
+        return []
+
+    def describe_conditional_sub_entities(self) -> list[tuple[str, Iterable[Any]]]:
+        """(why, entities) for the entities this one contains only under a condition."""
+        return []
+
+    def get_asyncio_future(self) -> Any:
+        """A future done when this entity's activity ends; mlaunch's entities have none (the
+        engine, not an asyncio loop, carries out what they planned)."""
+        return None
+
 
 class Action(LaunchDescriptionEntity):
     """Base of every action: an optional condition and where it was written."""
@@ -64,6 +82,17 @@ class Action(LaunchDescriptionEntity):
             kwargs["condition"] = UnlessCondition(parser.parse_substitution(unless))
         return Action, kwargs
 
+    def describe(self) -> str:
+        return repr(self)
+
+    def describe_sub_entities(self) -> list[Any]:
+        return self.get_sub_entities() if self.condition is None else []
+
+    def describe_conditional_sub_entities(self) -> list[tuple[str, Iterable[Any]]]:
+        if self.condition is None:
+            return []
+        return [(f"Conditionally included by {self.describe()}", self.get_sub_entities())]
+
 
 class LaunchDescription(LaunchDescriptionEntity):
     """An ordered list of entities; what generate_launch_description() returns."""
@@ -83,6 +112,13 @@ class LaunchDescription(LaunchDescriptionEntity):
 
     def describe_sub_entities(self) -> list[Any]:
         return list(self.entities)
+
+    def describe(self) -> str:
+        return repr(self)
+
+    @property
+    def deprecated(self) -> bool:
+        return self.deprecated_reason is not None
 
     def visit(self, context: LaunchContext) -> list[Any] | None:
         if self.deprecated_reason:

@@ -101,9 +101,17 @@ class StandalonePlanner:
         built = getattr(source, "launch_description", None)
         if built is not None:
             return built
+        locate = getattr(source, "get_launch_file_location", None)
+        path = locate(self.context) if locate is not None else None
+        if path is not None and path.endswith(".py"):
+            from mlaunch.launch.launch_description_sources.python_launch_file_utilities import (
+                get_launch_description_from_python_launch_file,
+            )
+
+            return get_launch_description_from_python_launch_file(path)
         raise MlaunchError(
-            "an include of a launch file is loaded when a run visits it"
-            " (LaunchService, mlaunch FILE), not by a standalone LaunchContext",
+            f"{path!r}: a standalone LaunchContext loads Python launch files; other formats"
+            " are loaded when a run visits them (LaunchService, mlaunch FILE)",
             where=origin,
         )
 

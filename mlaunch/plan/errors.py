@@ -107,8 +107,8 @@ class SubstitutionFailure(MlaunchError):
     """A substitution cannot be performed (unset configuration, failing command, ...)."""
 
 
-class InvalidConditionExpressionError(SubstitutionFailure):
-    """An if/unless expression is not one of true, false, 1, 0."""
+class InvalidConditionExpressionError(SubstitutionFailure, ValueError):
+    """An if/unless expression is not one of true, false, 1, 0 (a ValueError, as launch's)."""
 
 
 class LaunchArgumentError(MlaunchError):

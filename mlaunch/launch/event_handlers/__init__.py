@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from mlaunch.plan.origin import caller_origin
+from mlaunch.plan.steps import AddHandler
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -68,9 +69,81 @@ class EventHandler:
     def describe_short(self) -> str:
         return type(self).__name__
 
+    # --- upstream's handler API (launch.event_handler), for code that calls handlers itself --
+
+    def event_type(self) -> type | None:
+        """The event class this handler's kind listens for (None: only its matcher decides)."""
+        return None
+
+    def matches(self, event: Any) -> bool:
+        """Whether this handler handles ``event``: its matcher, or its kind and target."""
+        if self.custom_matcher is not None:
+            return bool(self.custom_matcher(event))
+        event_type = self.event_type()
+        if event_type is None or not isinstance(event, event_type):
+            return False
+        target = self.target_action
+        if target is None:
+            return True
+        action = getattr(event, "action", None)
+        if callable(target) and not hasattr(target, "visit"):
+            return bool(target(action))
+        return action is target
+
+    def handle(self, event: Any, context: Any) -> list[Any] | None:
+        """``event`` becomes ``context.locals.event``; the entities to visit for it."""
+        context.extend_locals({"event": event})
+        if self.handle_once:
+            context.unregister_event_handler(self)
+        if self.callback is not None:
+            return returned_entities(self.callback(event, context))
+        return list(self.entities)
+
+    @property
+    def handler_description(self) -> str | None:
+        return None
+
+    @property
+    def matcher_description(self) -> str | None:
+        return None
+
+    def describe(self) -> tuple[str, list[Any]]:
+        """launch's description: a line about the handler, then its entities."""
+        text = (
+            f"{type(self).__name__}(matcher='{self.matcher_description}',"
+            f" handler='{self.handler_description}', handle_once={self.handle_once})"
+        )
+        return text, list(self.entities)
+
+
+def handler_step(handler: Any, planner: Any, origin: str) -> AddHandler | None:
+    """The plan step that registers ``handler``, or None for a handler of no kind mlaunch runs."""
+    kind = getattr(handler, "kind", "")
+    if not kind:
+        return None
+    return AddHandler(
+        origin=origin,
+        kind=kind,
+        matcher=handler.process_matcher() if hasattr(handler, "process_matcher") else None,
+        body=planner.defer(handler.entities, origin, callback=handler.callback),
+        io_callbacks=dict(getattr(handler, "io_callbacks", {})),
+        once=handler.handle_once,
+        handler=handler,
+    )
+
+
+def event_named(name: str) -> Callable[[Any], bool]:
+    """A matcher of the events called ``name``."""
+    return lambda event: getattr(event, "name", None) == name
+
 
 class OnProcessStart(EventHandler):
     kind = "process_start"
+
+    def event_type(self) -> type:
+        from mlaunch.launch import events
+
+        return events.ProcessStarted
 
     def __init__(self, *, target_action: Any = None, on_start: Any, handle_once: bool = False):
         super().__init__(target_action=target_action, entities=on_start, handle_once=handle_once)
@@ -78,6 +151,11 @@ class OnProcessStart(EventHandler):
 
 class OnProcessExit(EventHandler):
     kind = "process_exit"
+
+    def event_type(self) -> type:
+        from mlaunch.launch import events
+
+        return events.ProcessExited
 
     def __init__(self, *, target_action: Any = None, on_exit: Any, handle_once: bool = False):
         super().__init__(target_action=target_action, entities=on_exit, handle_once=handle_once)
@@ -87,6 +165,11 @@ class OnProcessIO(EventHandler):
     """Callables receive the ProcessIO event (bytes in ``event.text``), as in ROS 2."""
 
     kind = "process_io"
+
+    def event_type(self) -> type:
+        from mlaunch.launch import events
+
+        return events.ProcessIO
 
     def __init__(
         self,
@@ -106,6 +189,11 @@ class OnProcessIO(EventHandler):
 class OnShutdown(EventHandler):
     kind = "shutdown"
 
+    def event_type(self) -> type:
+        from mlaunch.launch import events
+
+        return events.Shutdown
+
     def __init__(self, *, on_shutdown: Any, handle_once: bool = False) -> None:
         super().__init__(entities=on_shutdown, handle_once=handle_once)
 
@@ -116,6 +204,11 @@ class OnExecutionComplete(EventHandler):
 
     kind = "execution_complete"
 
+    def event_type(self) -> type:
+        from mlaunch.launch import events
+
+        return events.ExecutionComplete
+
     def __init__(
         self, *, target_action: Any = None, on_completion: Any, handle_once: bool = False
     ) -> None:
@@ -124,12 +217,41 @@ class OnExecutionComplete(EventHandler):
         )
 
 
+class OnIncludeLaunchDescription(EventHandler):
+    """Visits the description an IncludeLaunchDescription event carries."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        from mlaunch.launch import events
+
+        super().__init__(
+            matcher=lambda event: isinstance(event, events.IncludeLaunchDescription),
+            entities=lambda event, context: [event.launch_description],
+            **kwargs,
+        )
+
+    @property
+    def handler_description(self) -> str:
+        return "returns the launch_description in the event"
+
+    @property
+    def matcher_description(self) -> str:
+        return "event issubclass of launch.events.IncludeLaunchDescription"
+
+
+# launch's base classes, by the names extensions import.
+BaseEventHandler = EventHandler
+OnActionEventBase = EventHandler
+
 __all__ = [
+    "BaseEventHandler",
     "EventHandler",
+    "OnActionEventBase",
     "OnExecutionComplete",
+    "OnIncludeLaunchDescription",
     "OnProcessExit",
     "OnProcessIO",
     "OnProcessStart",
     "OnShutdown",
+    "event_named",
     "returned_entities",
 ]

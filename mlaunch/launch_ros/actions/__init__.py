@@ -187,24 +187,36 @@ def ros_log_dir(environ: Mapping[str, str]) -> str:
     return os.path.join(home, ".ros", "log")
 
 
-def __getattr__(name: str) -> Any:
-    # The composition actions live in their own module (which imports this one).
-    if name in ("ComposableNodeContainer", "LoadComposableNodes"):
-        from mlaunch.launch_ros import composition
+# Actions in modules that import this one, loaded on first use: name -> module.
+_LAZY = {
+    "ComposableNodeContainer": "mlaunch.launch_ros.composition",
+    "LoadComposableNodes": "mlaunch.launch_ros.composition",
+    "LifecycleTransition": "mlaunch.launch_ros.actions.lifecycle_transition",
+    "ROSTimer": "mlaunch.launch_ros.actions.ros_timer",
+    "RosTimer": "mlaunch.launch_ros.actions.ros_timer",
+}
 
-        return getattr(composition, name)
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = [
-    "ComposableNodeContainer",  # noqa: F822 (module __getattr__)
+    "ComposableNodeContainer",
     "LifecycleNode",
-    "LoadComposableNodes",  # noqa: F822 (module __getattr__)
+    "LifecycleTransition",
+    "LoadComposableNodes",
     "Node",
     "NodeCommand",
     "NodeNames",
     "PushROSNamespace",
     "PushRosNamespace",
+    "ROSTimer",
+    "RosTimer",
     "SetParameter",
     "SetParametersFromFile",
     "SetROSLogDir",

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from mlaunch.launch.substitutions import (
     describe,
-    evaluate_condition_expression,
     normalize,
     perform_substitutions,
 )
@@ -25,8 +24,9 @@ class Condition:
         self._predicate = predicate
 
     def evaluate(self, context: LaunchContext) -> bool:
+        """The predicate's answer; False without a predicate, as launch."""
         if self._predicate is None:
-            return True
+            return False
         return bool(self._predicate(context))
 
     def describe(self) -> str:
@@ -41,7 +41,7 @@ class IfCondition(Condition):
         self.expression = normalize(predicate_expression)
 
     def evaluate(self, context: LaunchContext) -> bool:
-        return evaluate_condition_expression(perform_substitutions(context, self.expression))
+        return evaluate_condition_expression(context, list(self.expression))
 
     def describe(self) -> str:
         return f"if {describe(self.expression)}"
@@ -84,10 +84,19 @@ class LaunchConfigurationNotEquals(LaunchConfigurationEquals):
         return f"{self.name} != {describe(self.expected) if self.expected else 'unset'}"
 
 
+from mlaunch.launch.conditions.evaluate_condition_expression_impl import (  # noqa: E402
+    evaluate_condition_expression,
+)
+from mlaunch.launch.conditions.invalid_condition_expression_error import (  # noqa: E402
+    InvalidConditionExpressionError,
+)
+
 __all__ = [
     "Condition",
     "IfCondition",
+    "InvalidConditionExpressionError",
     "LaunchConfigurationEquals",
     "LaunchConfigurationNotEquals",
     "UnlessCondition",
+    "evaluate_condition_expression",
 ]

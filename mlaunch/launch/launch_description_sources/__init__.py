@@ -36,6 +36,16 @@ class LaunchDescriptionSource:
     def describe(self) -> str:
         return describe(self.location)
 
+    def get_launch_description(self, context: LaunchContext) -> Any:
+        """The description: the one given, or the file's, loaded by the context's planner."""
+        if self.launch_description is None:
+            self.launch_description = context.planner.load_source(self, "")
+        return self.launch_description
+
+    def try_get_launch_description_without_context(self) -> Any:
+        """The description when it was given (a file needs a context to be located)."""
+        return self.launch_description
+
 
 class AnyLaunchDescriptionSource(LaunchDescriptionSource):
     """A launch file of any format, chosen by its suffix."""
@@ -67,6 +77,26 @@ def source_for(value: Any) -> LaunchDescriptionSource:
     if isinstance(value, LaunchDescription):
         return LaunchDescriptionSource(launch_description=value)
     return AnyLaunchDescriptionSource(value)
+
+
+_LOADERS = {
+    "InvalidPythonLaunchFileError",
+    "get_launch_description_from_python_launch_file",
+    "load_python_launch_file_as_module",
+}
+
+
+def __getattr__(name: str) -> Any:
+    # The loaders import importlib's file machinery: only when a caller asks for them.
+    if name in _LOADERS:
+        from mlaunch.launch.launch_description_sources import python_launch_file_utilities
+
+        return getattr(python_launch_file_utilities, name)
+    if name == "InvalidLaunchFileError":
+        from mlaunch.launch.invalid_launch_file_error import InvalidLaunchFileError
+
+        return InvalidLaunchFileError
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 __all__ = [

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 
+from mlaunch.launch.event_handlers import handler_step
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
@@ -23,7 +24,6 @@ from mlaunch.launch.substitutions import (
 from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError
 from mlaunch.plan.origin import caller_origin
 from mlaunch.plan.steps import (
-    AddHandler,
     ArgumentInfo,
     Log,
     RemoveHandler,
@@ -401,25 +401,14 @@ class RegisterEventHandler(Action):
         self.event_handler = event_handler
 
     def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
         handler = self.event_handler
-        kind = getattr(handler, "kind", "")
-        if not kind:
+        step = handler_step(handler, context.planner, self.origin)
+        if step is None:
             raise LaunchFileError(
                 f"event handler {type(handler).__name__} is not supported by mlaunch",
                 where=self.origin,
             )
-        planner.add(
-            AddHandler(
-                origin=self.origin,
-                kind=kind,
-                matcher=handler.process_matcher() if hasattr(handler, "process_matcher") else None,
-                body=planner.defer(handler.entities, self.origin, callback=handler.callback),
-                io_callbacks=dict(getattr(handler, "io_callbacks", {})),
-                once=handler.handle_once,
-                handler=handler,
-            )
-        )
+        context.planner.add(step)
 
 
 class UnregisterEventHandler(Action):
@@ -438,17 +427,21 @@ class EmitEvent(Action):
         self.event = event
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
-        planner = context.planner
-        from mlaunch.launch.events import IncludeLaunchDescription
-        from mlaunch.launch.events import Shutdown as ShutdownEvent
+        return emit_event_entities(context, self.event, self.origin)
 
-        if isinstance(self.event, ShutdownEvent):
-            planner.add(RequestShutdown(origin=self.origin, reason=self.event.reason))
-        elif isinstance(self.event, IncludeLaunchDescription):
-            return [self.event.launch_description]
-        else:
-            planner.add(EmitEventStep(origin=self.origin, event=self.event))
-        return None
+
+def emit_event_entities(context: LaunchContext, event: Any, origin: str) -> list[Any] | None:
+    """Plan the emission of ``event``; the entities to visit now for an include event."""
+    from mlaunch.launch.events import IncludeLaunchDescription
+    from mlaunch.launch.events import Shutdown as ShutdownEvent
+
+    if isinstance(event, ShutdownEvent):
+        context.planner.add(RequestShutdown(origin=origin, reason=event.reason))
+    elif isinstance(event, IncludeLaunchDescription):
+        return [event.launch_description]
+    else:
+        context.planner.add(EmitEventStep(origin=origin, event=event))
+    return None
 
 
 class Shutdown(Action):

@@ -6,7 +6,6 @@ show themselves as dataclasses do, through ``mlaunch.plan.record.Record``.
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Callable
 
 from mlaunch.plan.record import Record
@@ -19,10 +18,11 @@ if TYPE_CHECKING:
 class Event:
     """Base of everything the supervisor announces or a launch file emits."""
 
-    name = "launch.events.Event"
+    name = "launch.Event"
 
 
 class Shutdown(Record, Event):
+    name = "launch.events.Shutdown"
     _fields = ("reason", "due_to_sigint")
 
     def __init__(self, reason: str = "reason not given", due_to_sigint: bool = False) -> None:
@@ -37,10 +37,21 @@ class ExecutionComplete(Record, Event):
     action was visited.
     """
 
+    name = "launch.events.ExecutionComplete"
     _fields = ("action",)
 
     def __init__(self, action: Any = None) -> None:
         self.action = action
+
+
+class TimerEvent(Record, Event):
+    """A TimerAction's period ran out (launch emits it, then visits the timer's actions)."""
+
+    name = "launch.events.TimerEvent"
+    _fields = ("timer_action",)
+
+    def __init__(self, *, timer_action: Any) -> None:
+        self.timer_action = timer_action
 
 
 class ProcessEvent(Record, Event):
@@ -122,6 +133,13 @@ class ProcessIO(ProcessEvent):
         return self.fd == 2
 
 
+class ProcessStdin(ProcessIO):
+    """Text written to a process's stdin (fd 0), as launch names it."""
+
+    def __init__(self, *, text: bytes, **kwargs: Any) -> None:
+        super().__init__(text=text, fd=0, **kwargs)
+
+
 class ProcessStdout(ProcessIO):
     pass
 
@@ -145,23 +163,33 @@ else:  # the same at run time, without typing.Any
     ProcessMatcher = Callable[[object], bool]
 
 
-class ShutdownProcess(Record, Event):
-    """Run the stop ladder on the processes the matcher selects."""
+class ProcessTargetedEvent(Record, Event):
+    """An event aimed at the running processes its matcher selects (launch's base class)."""
 
-    _fields = ("process_matcher",)
+    name = "launch.events.process.ProcessTargetedEvent"
+    _fields: tuple[str, ...] = ("process_matcher",)
 
-    def __init__(self, process_matcher: ProcessMatcher | None = None) -> None:
+    def __init__(self, *, process_matcher: ProcessMatcher | None = None) -> None:
         self.process_matcher = process_matcher
 
 
-class SignalProcess(Record, Event):
+class ShutdownProcess(ProcessTargetedEvent):
+    """Run the stop ladder on the processes the matcher selects."""
+
+    name = "launch.events.process.ShutdownProcess"
+
+    def __init__(self, process_matcher: ProcessMatcher | None = None) -> None:
+        super().__init__(process_matcher=process_matcher)
+
+
+class SignalProcess(ProcessTargetedEvent):
     _fields = ("signal_number", "process_matcher")
 
     def __init__(
         self, signal_number: int = 2, process_matcher: ProcessMatcher | None = None
     ) -> None:
+        super().__init__(process_matcher=process_matcher)
         self.signal_number = signal_number
-        self.process_matcher = process_matcher
 
 
 def matches_action(target_action: Any) -> ProcessMatcher:
@@ -184,22 +212,31 @@ def matches_executable(executable_name: str) -> ProcessMatcher:
     return match
 
 
-# ROS 2 keeps process events in launch.events.process; both spellings resolve here.
-process = sys.modules[__name__]
+# launch keeps the process events in the subpackage launch.events.process (also served
+# from here, where the rest of mlaunch imports them).
+RunningProcessEvent = ProcessEvent
+
+from mlaunch.launch.events import process  # noqa: E402 (the subpackage imports the names above)
 
 __all__ = [
     "Event",
+    "ExecutionComplete",
     "IncludeLaunchDescription",
     "ProcessExited",
     "ProcessIO",
     "ProcessStarted",
     "ProcessStderr",
+    "ProcessStdin",
     "ProcessStdout",
+    "ProcessTargetedEvent",
+    "RunningProcessEvent",
     "Shutdown",
     "ShutdownProcess",
     "SignalProcess",
+    "TimerEvent",
     "matches_action",
     "matches_executable",
     "matches_name",
     "matches_pid",
+    "process",
 ]

@@ -1,0 +1,5 @@
+"""``launch.actions.group_action``, where upstream defines it."""
+
+from mlaunch.launch.actions import GroupAction
+
+__all__ = ["GroupAction"]

@@ -1,0 +1,5 @@
+"""``launch.actions.pop_launch_configurations``, where upstream defines it."""
+
+from mlaunch.launch.actions import PopLaunchConfigurations
+
+__all__ = ["PopLaunchConfigurations"]

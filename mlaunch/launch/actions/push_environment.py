@@ -1,0 +1,5 @@
+"""``launch.actions.push_environment``, where upstream defines it."""
+
+from mlaunch.launch.actions import PushEnvironment
+
+__all__ = ["PushEnvironment"]

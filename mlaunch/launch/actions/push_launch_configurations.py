@@ -1,0 +1,5 @@
+"""``launch.actions.push_launch_configurations``, where upstream defines it."""
+
+from mlaunch.launch.actions import PushLaunchConfigurations
+
+__all__ = ["PushLaunchConfigurations"]

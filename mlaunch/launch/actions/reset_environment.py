@@ -1,0 +1,5 @@
+"""``launch.actions.reset_environment``, where upstream defines it."""
+
+from mlaunch.launch.actions import ResetEnvironment
+
+__all__ = ["ResetEnvironment"]

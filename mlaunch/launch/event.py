@@ -1,0 +1,5 @@
+"""``launch.event``, where upstream defines it."""
+
+from mlaunch.launch.events import Event
+
+__all__ = ["Event"]

@@ -1,0 +1,31 @@
+"""``launch.utilities``: the helpers that custom actions and substitutions import from launch.
+
+Each lives in the submodule upstream names (``class_tools_impl``, ``ensure_argument_type_impl``
+...); this package re-exports them as upstream's does.
+"""
+
+from mlaunch.launch.utilities.class_tools_impl import is_a, is_a_subclass, isclassinstance
+from mlaunch.launch.utilities.ensure_argument_type_impl import ensure_argument_type
+from mlaunch.launch.utilities.normalize_to_list_of_entities_impl import (
+    normalize_to_list_of_entities,
+)
+from mlaunch.launch.utilities.normalize_to_list_of_substitutions_impl import (
+    normalize_to_list_of_substitutions,
+)
+from mlaunch.launch.utilities.perform_substitutions_impl import perform_substitutions
+from mlaunch.launch.utilities.signal_management import AsyncSafeSignalManager
+from mlaunch.launch.utilities.visit_all_entities_and_collect_futures_impl import (
+    visit_all_entities_and_collect_futures,
+)
+
+__all__ = [
+    "AsyncSafeSignalManager",
+    "ensure_argument_type",
+    "is_a",
+    "is_a_subclass",
+    "isclassinstance",
+    "normalize_to_list_of_entities",
+    "normalize_to_list_of_substitutions",
+    "perform_substitutions",
+    "visit_all_entities_and_collect_futures",
+]

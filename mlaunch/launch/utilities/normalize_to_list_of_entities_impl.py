@@ -1,0 +1,19 @@
+"""``normalize_to_list_of_entities``: entities and iterables of entities, flattened once."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from mlaunch.launch.launch_description import LaunchDescriptionEntity
+
+
+def normalize_to_list_of_entities(entities: Iterable[Any]) -> list[LaunchDescriptionEntity]:
+    """One flat list: an entity stays, an iterable of entities is spliced in."""
+    flat: list[LaunchDescriptionEntity] = []
+    for entity in entities:
+        if isinstance(entity, LaunchDescriptionEntity):
+            flat.append(entity)
+        else:
+            flat.extend(entity)
+    return flat

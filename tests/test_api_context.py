@@ -1,0 +1,160 @@
+"""LaunchContext, handlers, events and descriptions as actions written against upstream use
+them (issue 25: gaps 1, 6, 7, 8, 12)."""
+
+from __future__ import annotations
+
+import pytest
+
+from mlaunch.app import compat
+from mlaunch.plan.steps import AddHandler, EmitEvent, RemoveHandler, RequestShutdown
+
+
+@pytest.fixture(autouse=True)
+def served() -> None:
+    compat.install()
+
+
+def test_a_bare_context_takes_argv_and_noninteractive() -> None:
+    from launch import LaunchContext
+
+    assert LaunchContext().argv == [] and not LaunchContext().noninteractive
+    context = LaunchContext(argv=["a", "b"], noninteractive=True)
+    assert context.argv == ["a", "b"] and context.noninteractive
+    assert context.asyncio_loop is None
+
+
+def test_locals_are_read_only_and_scoped() -> None:
+    from launch import LaunchContext
+
+    context = LaunchContext()
+    context.extend_locals({"foo": 1})
+    with pytest.raises(AttributeError):
+        context.locals.foo = 2
+    context._push_locals()
+    context.extend_locals({"foo": 2, "bar": 3})
+    context._pop_locals()
+    assert context.locals.foo == 1 and "bar" not in context.locals
+    with pytest.raises(RuntimeError):
+        context._pop_locals()
+
+
+def test_handlers_registered_through_the_context_become_plan_steps() -> None:
+    from launch import LaunchContext
+    from launch.actions import LogInfo
+    from launch.event_handlers import OnProcessExit
+
+    context = LaunchContext()
+    handler = OnProcessExit(on_exit=[LogInfo(msg="gone")])
+    context.register_event_handler(handler)
+    context.unregister_event_handler(handler)
+    with pytest.raises(ValueError):
+        context.unregister_event_handler(handler)
+    steps = context.planner.plan.steps
+    assert [type(s) for s in steps] == [AddHandler, RemoveHandler]
+    assert steps[0].kind == "process_exit" and steps[1].handler is handler
+
+
+def test_emitted_events_become_plan_steps() -> None:
+    from launch import LaunchContext
+    from launch.events import Shutdown
+    from launch.events.process import ShutdownProcess
+
+    context = LaunchContext()
+    context.emit_event_sync(ShutdownProcess(process_matcher=lambda p: True))
+    context.emit_event_sync(Shutdown(reason="done"))
+    first, second = context.planner.plan.steps
+    assert isinstance(first, EmitEvent) and isinstance(first.event, ShutdownProcess)
+    assert isinstance(second, RequestShutdown) and second.reason == "done"
+
+
+def test_event_handler_matches_and_handles_as_upstream() -> None:
+    from launch import EventHandler, LaunchContext, LaunchDescriptionEntity
+    from launch.event_handlers import OnProcessStart
+    from launch.events.process import ProcessStarted
+
+    entity = LaunchDescriptionEntity()
+    handler = EventHandler(matcher=lambda event: True, entities=[entity], handle_once=True)
+    context = LaunchContext()
+    context.register_event_handler(handler)
+    event = object()
+    assert handler.matches(event)
+    assert handler.handle(event, context) == [entity]
+    assert context.locals.event is event
+    with pytest.raises(ValueError):  # handled once: it unregistered itself
+        handler.handle(event, context)
+
+    target = object()
+    on_start = OnProcessStart(target_action=target, on_start=[])
+    assert on_start.matches(ProcessStarted(action=target))
+    assert not on_start.matches(ProcessStarted(action=object()))
+    text, entities = on_start.describe()
+    assert text.startswith("OnProcessStart(") and entities == []
+
+
+def test_event_names_and_bare_condition_as_upstream() -> None:
+    from launch import Condition, Event, LaunchContext
+    from launch.events import ExecutionComplete, TimerEvent
+
+    assert Event().name == "launch.Event"
+    assert TimerEvent(timer_action=None).name == "launch.events.TimerEvent"
+    assert ExecutionComplete(action=None).name == "launch.events.ExecutionComplete"
+    assert Condition().evaluate(LaunchContext()) is False
+    assert Condition(predicate=lambda context: True).evaluate(LaunchContext()) is True
+
+
+def test_executable_prepares_its_final_values() -> None:
+    from launch import LaunchContext
+    from launch.descriptions import Executable
+    from launch.substitutions import EnvironmentVariable
+
+    context = LaunchContext(environment={"WHERE": "here", "PATH": "/bin"})
+    context.launch_configurations["launch-prefix"] = "nice -n 5"
+    exe = Executable(cmd=["ls", "-l"], cwd=EnvironmentVariable("WHERE"), env={"A": "1"})
+    exe.prepare(context, None)
+    assert exe.final_cmd == ["nice", "-n", "5", "ls", "-l"]
+    # launch names it after the first word of the final command, the prefix included
+    assert exe.final_name is not None and exe.final_name.startswith("nice-")
+    assert exe.final_cwd == "here" and exe.final_env == {"A": "1"}
+    context.launch_configurations["launch-prefix-filter"] = "cat"
+    exe.prepare(context, None)
+    assert exe.final_cmd == ["ls", "-l"]  # the filter excludes ls
+
+
+def test_lifecycle_transition_registers_then_emits() -> None:
+    from launch import LaunchContext
+    from launch.actions import EmitEvent as EmitEventAction
+    from launch.actions import RegisterEventHandler
+    from launch_ros.actions import LifecycleTransition
+
+    with pytest.raises(ValueError):
+        LifecycleTransition(lifecycle_node_names=["talker"], transition_ids=[])
+    with pytest.raises(ValueError):
+        LifecycleTransition(lifecycle_node_names=[], transition_ids=[1])
+    actions = LifecycleTransition(lifecycle_node_names=["talker"], transition_ids=["1", 3]).execute(
+        LaunchContext()
+    )
+    kinds = [type(a) for a in actions]
+    assert kinds == [RegisterEventHandler] * 3 + [EmitEventAction]
+    assert actions[-1].event.transition_id == 1
+
+
+def test_introspector_draws_a_tree() -> None:
+    from launch import LaunchDescription, LaunchIntrospector
+    from launch.actions import LogInfo
+
+    text = LaunchIntrospector().format_launch_description(
+        LaunchDescription([LogInfo(msg="a"), LogInfo(msg="b")])
+    )
+    assert text.splitlines()[1:] == ["├── LogInfo('a')", "└── LogInfo('b')"]
+
+
+def test_an_action_describes_its_sub_entities() -> None:
+    from launch.actions import GroupAction, LogInfo
+    from launch.conditions import IfCondition
+
+    inner = LogInfo(msg="x")
+    assert GroupAction([inner]).describe_sub_entities() == [inner]
+    conditional = GroupAction([inner], condition=IfCondition("true"))
+    assert conditional.describe_sub_entities() == []
+    ((why, entities),) = conditional.describe_conditional_sub_entities()
+    assert why.startswith("Conditionally included by") and list(entities) == [inner]
