@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from mlaunch.app import compat
+from mlaunch import compat
 from mlaunch.plan.steps import AddHandler, EmitEvent, RemoveHandler, RequestShutdown
 
 

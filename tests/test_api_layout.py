@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from mlaunch.app import compat
+from mlaunch import compat
 
 
 @pytest.fixture(autouse=True)
