@@ -7,14 +7,48 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
+from mlaunch.plan.errors import InvalidConditionExpressionError as _PlanError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Sequence
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitutions import SomeSubstitutionsType
+
+
+VALID_TRUE_EXPRESSIONS = ["true", "1"]
+VALID_FALSE_EXPRESSIONS = ["false", "0"]
+
+
+class InvalidConditionExpressionError(_PlanError):
+    """A condition expression that is not true, false, 1 or 0 (a ValueError, as launch's):
+    what it performed to, what it was written as, and the valid values."""
+
+    def __init__(
+        self,
+        expression: str,
+        unexpanded_expression: Sequence[Any],
+        valid_expressions: Sequence[str],
+    ) -> None:
+        written = " + ".join(str(sub) for sub in unexpanded_expression)
+        super().__init__(
+            f"invalid condition expression, expected one of [{', '.join(valid_expressions)}]"
+            f" but got '{expression}', expanded from '{written}'"
+        )
+
+
+def evaluate_condition_expression(context: Any, expression: Sequence[Any]) -> bool:
+    """True for 'true'/'1', False for 'false'/'0' (case and spaces ignored), else an error."""
+    text = perform_substitutions(context, expression).strip().lower()
+    if text in VALID_TRUE_EXPRESSIONS:
+        return True
+    if text in VALID_FALSE_EXPRESSIONS:
+        return False
+    raise InvalidConditionExpressionError(
+        text, expression, VALID_TRUE_EXPRESSIONS + VALID_FALSE_EXPRESSIONS
+    )
 
 
 class Condition:
@@ -83,13 +117,6 @@ class LaunchConfigurationNotEquals(LaunchConfigurationEquals):
     def describe(self) -> str:
         return f"{self.name} != {describe(self.expected) if self.expected else 'unset'}"
 
-
-from mlaunch.launch.conditions.evaluate_condition_expression_impl import (  # noqa: E402
-    evaluate_condition_expression,
-)
-from mlaunch.launch.conditions.invalid_condition_expression_error import (  # noqa: E402
-    InvalidConditionExpressionError,
-)
 
 __all__ = [
     "Condition",

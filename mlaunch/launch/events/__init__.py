@@ -216,7 +216,15 @@ def matches_executable(executable_name: str) -> ProcessMatcher:
 # from here, where the rest of mlaunch imports them).
 RunningProcessEvent = ProcessEvent
 
-from mlaunch.launch.events import process  # noqa: E402 (the subpackage imports the names above)
+
+def __getattr__(name: str) -> Any:
+    # ``launch.events.process`` loads on first use (it imports the names above).
+    if name == "process":
+        import importlib
+
+        return importlib.import_module("mlaunch.launch.events.process")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "Event",
