@@ -53,6 +53,24 @@ class Shout(Action):
     def execute(self, context):
         text = perform_substitutions(context, self.text)
         return [ExecuteProcess(cmd=["echo"] + [text] * self.times, name="shout")]
+
+
+@expose_action("wrap")
+class Wrap(Action):
+    \"\"\"Its child actions, built-in or not, parsed by the parser it is given.\"\"\"
+
+    def __init__(self, *, actions, **kwargs):
+        super().__init__(**kwargs)
+        self.actions = actions
+
+    @classmethod
+    def parse(cls, entity, parser):
+        _, kwargs = super().parse(entity, parser)
+        kwargs["actions"] = [parser.parse_action(child) for child in entity.children]
+        return cls, kwargs
+
+    def execute(self, context):
+        return list(self.actions)
 """
 
 XML = """\
@@ -133,6 +151,47 @@ def test_import_in_a_python_launch_file_registers_them(tmp_path: Path) -> None:
         )
     )
     assert "argv:    echo 'hi WORLD' 'hi WORLD'" in printed(path, env)
+
+
+WRAPPED = {
+    "w.launch.xml": """\
+<launch>
+  <wrap>
+    <executable cmd="echo $(upper in)" name="inner"/>
+    <shout text="x"/>
+  </wrap>
+</launch>
+""",
+    "w.launch.yaml": """\
+launch:
+- wrap:
+  - executable: {cmd: "echo $(upper in)", name: inner}
+  - shout: {text: x}
+""",
+}
+
+
+@pytest.mark.parametrize("name", sorted(WRAPPED))
+def test_an_exposed_tag_holds_built_in_and_exposed_children(tmp_path: Path, name: str) -> None:
+    (tmp_path / "site").mkdir()
+    env = extension(tmp_path / "site", entry_point=True)
+    path = tmp_path / name
+    path.write_text(WRAPPED[name])
+    out = printed(path, env)
+    assert "argv:    echo IN" in out and "argv:    echo x" in out
+    assert f"inner-1   {path}:3" in out
+
+
+def test_check_accepts_what_installed_packages_expose(tmp_path: Path) -> None:
+    (tmp_path / "site").mkdir()
+    env = extension(tmp_path / "site", entry_point=True)
+    path = tmp_path / "s.launch.xml"
+    path.write_text(XML)
+    done = run_mlaunch(str(path), "--check", env=env)
+    assert done.returncode == 0, done.stdout + done.stderr
+    done = run_mlaunch(str(path), "--check", env=clean_env())
+    assert done.returncode == 1
+    assert f"{path}:4:5: Jazzy has no tag 'shout'" in done.stdout
 
 
 def test_without_the_package_the_tag_is_unknown(tmp_path: Path) -> None:

@@ -113,7 +113,8 @@ class _Walker:
     def action(self, e: Entity) -> None:
         table = jazzy.ACTIONS.get(e.tag)
         if table is None:
-            self.add(e, f"Jazzy has no tag {e.tag!r}: ros2 launch rejects the file")
+            if e.tag not in exposed()[0]:  # a package's tag is that package's to check
+                self.add(e, f"Jazzy has no tag {e.tag!r}: ros2 launch rejects the file")
             return
         if e.tag in jazzy.BROKEN_ACTIONS:
             self.add(e, f"Jazzy's {e.tag} is broken: {jazzy.BROKEN_ACTIONS[e.tag]}")
@@ -201,7 +202,7 @@ class _Walker:
             broken = jazzy.BROKEN_SUBSTITUTIONS.get(match.group(1))
             if broken:
                 self.add(e, f"Jazzy's $({match.group(1)} ...) is broken: {broken}", attr)
-            elif match.group(1) not in jazzy.SUBSTITUTIONS:
+            elif match.group(1) not in jazzy.SUBSTITUTIONS and match.group(1) not in exposed()[1]:
                 self.add(
                     e,
                     f"Jazzy has no substitution $({match.group(1)} ...): ros2 launch rejects it",
@@ -243,6 +244,18 @@ class _Walker:
         text = text.replace("$(dirname)", here)
         if "$(" not in text:
             self.includes.append(os.path.join(here, text))
+
+
+def exposed() -> tuple[dict[str, Any], dict[str, Any]]:
+    """The tags and the substitutions installed packages expose (``launch.frontend``), which
+    ros2 launch accepts as it does its own; the extensions are loaded on the first question."""
+    from mlaunch import compat
+    from mlaunch.frontends.markup import load_extensions
+    from mlaunch.launch.frontend.expose import action_parse_methods, substitution_parse_methods
+
+    compat.install()  # the extensions import the ROS 2 names
+    load_extensions()
+    return action_parse_methods, substitution_parse_methods
 
 
 def _type_message(name: str, node: Any, kind: str) -> str:
