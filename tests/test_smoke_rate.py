@@ -20,7 +20,8 @@ class Graph:
         for at in sorted(arrivals, reverse=True):  # seconds before now, oldest first
             self.watch._stamps.append(now - at)
         self.watch.count = len(arrivals)
-        self.watch.first_at, self.watch.last_at = now - max(arrivals), now - min(arrivals)
+        if arrivals:
+            self.watch.first_at, self.watch.last_at = now - max(arrivals), now - min(arrivals)
 
     def watch_topic(self, topic: str) -> TopicWatch:
         return self.watch

@@ -59,11 +59,24 @@ def find_launch_file(opts: Options) -> str:
 
     if opts.second is None:
         if not os.path.exists(opts.target):
-            raise LaunchFileError(f"launch file {opts.target!r} does not exist")
+            raise LaunchFileError(f"launch file {opts.target!r} does not exist{_near(opts.target)}")
         return os.path.abspath(opts.target)
     from mlaunch.ros import packages
 
     return packages.find_launch_file(opts.target, opts.second)
+
+
+def _near(path: str) -> str:
+    """A did-you-mean among the files of the folder ``path`` names."""
+    from mlaunch.plan.errors import closest
+
+    folder, name = os.path.split(path)
+    try:
+        entries = sorted(os.listdir(folder or "."))
+    except OSError:
+        return ""
+    close = closest(name, entries)
+    return f" (did you mean {os.path.join(folder, close)!r}?)" if close else ""
 
 
 def package_search(opts: Options, launch_file: str | None) -> PackageSearch:

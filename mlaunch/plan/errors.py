@@ -9,6 +9,10 @@ from __future__ import annotations
 
 import sys
 
+TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
 # --- exit statuses ---------------------------------------------------------------------------
 
 EXIT_OK = 0  # every process ended and nothing required failed; a smoke run or test passed
@@ -68,6 +72,26 @@ def is_own_module(name: str | None) -> bool:
 
 
 # --- the hierarchy -----------------------------------------------------------------------------
+
+
+# Names a "did you mean" compares against at most (each comparison is microseconds).
+CLOSE_NAMES_LIMIT = 20_000
+
+
+def closest(name: str, names: Iterable[str]) -> str | None:
+    """The one of ``names`` closest to ``name``, if any is close (difflib's measure)."""
+    import difflib  # only on an error: it costs start-up time otherwise
+    import itertools
+
+    candidates = [n for n in itertools.islice(names, CLOSE_NAMES_LIMIT) if n != name]
+    close = difflib.get_close_matches(name, candidates, n=1)
+    return close[0] if close else None
+
+
+def did_you_mean(name: str, names: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` when one of ``names`` is close to ``name``, else empty."""
+    close = closest(name, names)
+    return f" (did you mean {close!r}?)" if close else ""
 
 
 class MlaunchError(Exception):

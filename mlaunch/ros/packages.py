@@ -181,7 +181,10 @@ class PackageIndex:
         """The package, or a PackageNotFoundError saying where it was looked for."""
         package = self.find(name)
         if package is None:
-            raise PackageNotFoundError(f"package {name!r} not found ({self.searched()})")
+            from mlaunch.plan.errors import did_you_mean
+
+            hint = did_you_mean(name, self.all_packages())
+            raise PackageNotFoundError(f"package {name!r} not found{hint} ({self.searched()})")
         return package
 
     def all_packages(self) -> dict[str, Package]:
@@ -423,16 +426,18 @@ def find_launch_file(package: str, file_name: str) -> str:
     found = index(from_cwd=True).get(package)
     share = found.share_directory
     matches: list[str] = []
+    names: set[str] = set()  # every file name, for a did-you-mean
     for root, dirs, files in os.walk(share):
         if not found.installed:  # a checkout: leave out build trees and hidden folders
             dirs[:] = sorted(d for d in dirs if not d.startswith(".") and d not in SKIPPED_DIRS)
         else:
             dirs.sort()
         matches.extend(os.path.join(root, f) for f in sorted(files) if f == file_name)
+        names.update(files)
     if not matches:
         raise errors.LaunchFileError(
             f"file {file_name!r} was not found in the share directory of package {package!r}"
-            f" which is at {share!r}"
+            f" which is at {share!r}{errors.did_you_mean(file_name, sorted(names))}"
         )
     if len(matches) > 1:
         raise errors.LaunchFileError(

@@ -448,7 +448,10 @@ class GraphProbe:
             return False, watch.error
         if watch.count == 0:
             if e.target not in topics:
-                return False, "not in the graph (no publisher or subscriber)"
+                from mlaunch.plan.errors import did_you_mean
+
+                hint = did_you_mean(e.target, topics)
+                return False, f"not in the graph (no publisher or subscriber){hint}"
             types = ", ".join(topics[e.target])
             return False, f"in the graph ({types}) but no message received"
         if e.rate is None:

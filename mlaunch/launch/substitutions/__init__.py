@@ -68,7 +68,10 @@ class LaunchConfiguration(Substitution):
             return value if isinstance(value, str) else str(value)
         if self.default is not None:
             return perform_substitutions(context, self.default)
-        raise SubstitutionFailure(f"launch configuration {name!r} does not exist")
+        from mlaunch.plan.errors import did_you_mean
+
+        hint = did_you_mean(name, (k for k in configs if isinstance(k, str)))
+        raise SubstitutionFailure(f"launch configuration {name!r} does not exist{hint}")
 
     def describe(self) -> str:
         name = "".join(s.describe().strip("'") for s in self.variable_name)
