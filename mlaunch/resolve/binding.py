@@ -15,13 +15,12 @@ file:line of the timer or handler, saying what differs.
 
 from __future__ import annotations
 
+from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.plan.pragmas import PRAGMA
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
-
-    from mlaunch.launch.launch_context import LaunchContext
 
 # The launch configurations launch_ros keeps the pushed namespace, parameters and remaps in.
 _ROS_STATE = {
@@ -51,6 +50,19 @@ def _text(parts: Any) -> str | None:
     return "".join(str(t) for t in texts) if all(isinstance(t, str) for t in texts) else None
 
 
+def _reads(entities: list[Any], uses: _Uses) -> None:
+    """What the body reads: each entity the walk of the description meets (mlaunch.launch.walk),
+    and the values it holds (substitutions, callbacks, entities the walk does not enter, such as
+    a process's on_exit actions)."""
+    from mlaunch.launch.walk import walk
+
+    visits = list(walk(entities))
+    walked = {id(v.entity) for v in visits}
+    for visit in visits:
+        walked.discard(id(visit.entity))  # scanned now; its own entities are scanned as met
+        _walk(visit.entity, uses, walked)
+
+
 def _walk(obj: Any, uses: _Uses, seen: set[int], depth: int = 0) -> None:
     if depth > 60 or id(obj) in seen or obj is None or isinstance(obj, (str, bytes, int, float)):
         return
@@ -70,7 +82,7 @@ def _walk(obj: Any, uses: _Uses, seen: set[int], depth: int = 0) -> None:
         uses.code = uses.code or launch_file_code(obj)
         return
     module = type(obj).__module__
-    if not module.startswith("mlaunch.") or type(obj).__name__ == "LaunchContext":
+    if not module.startswith("mlaunch.") or isinstance(obj, LaunchContext):
         return
     from mlaunch.launch.actions import ExecuteProcess
     from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
@@ -98,7 +110,7 @@ def differences(
 ) -> list[str]:
     """What the body would see differently with the values captured where it was written."""
     uses = _Uses()
-    _walk(entities, uses, set())
+    _reads(entities, uses)
     uses.code = uses.code or (callback is not None and launch_file_code(callback))
     then, now = captured.launch_configurations, live.launch_configurations
     out = []

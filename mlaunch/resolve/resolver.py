@@ -270,24 +270,15 @@ def _note_needs(entities: Iterable[Any], needs: set[Need]) -> None:
     event or event handler does (ChangeState, OnStateTransition). A handler written as a
     function is opaque until it runs; the pipeline watches for what it starts instead.
     """
-    stack = list(entities)
-    seen: set[int] = set()
-    while stack:
-        entity = stack.pop()
-        if id(entity) in seen:
-            continue  # a handler may list itself among what it registers
-        seen.add(id(entity))
+    from mlaunch.launch.walk import walk
+
+    for visit in walk(entities):
+        entity = visit.entity
         handler = getattr(entity, "event_handler", None)
         for owner in (entity, getattr(entity, "event", None), handler):
             found = getattr(owner, "needs", None)
             if found:
                 needs.update(found)
-        get = getattr(entity, "get_sub_entities", None)
-        if get is not None:
-            stack.extend(get())
-        stack.extend(getattr(entity, "entities", None) or ())
-        if handler is not None:
-            stack.extend(getattr(handler, "entities", None) or ())
 
 
 def _short(entity: Any) -> str:
@@ -430,59 +421,51 @@ def collect_arguments(
     Conditional declarations (under a condition, in a timer or handler) are marked; nothing is
     spawned and no command substitution beyond what an include path needs is run.
     """
-    from mlaunch.launch.actions import (
-        DeclareLaunchArgument,
-        GroupAction,
-        IncludeLaunchDescription,
-        LaunchDescription,
-        TimerAction,
-    )
+    from mlaunch.launch.actions import DeclareLaunchArgument
+    from mlaunch.launch.walk import walk
 
     found: dict[str, ArgumentInfo] = {}
     context = LaunchContext(environment=environ)
     context.launch_configurations.update(arguments)
     seen: set[str] = set()
 
-    def walk(entities: Iterable[Any], conditional: bool) -> None:
-        for entity in entities:
-            cond = conditional or getattr(entity, "condition", None) is not None
-            if isinstance(entity, DeclareLaunchArgument):
-                info = entity.argument_info(cond)
-                found.setdefault(info.name, info)
-                if info.name not in context.launch_configurations and entity.default_value:
-                    try:
-                        context.launch_configurations[info.name] = perform_substitutions(
-                            context, entity.default_value
-                        )
-                    except MlaunchError:
-                        pass
-            elif isinstance(entity, LaunchDescription):
-                walk(entity.entities, cond)
-            elif isinstance(entity, (GroupAction, TimerAction)):
-                walk(entity.actions, cond or isinstance(entity, TimerAction))
-            elif isinstance(entity, IncludeLaunchDescription):
-                include(entity, cond)
+    def declare(roots: list[object], conditional: bool) -> None:
+        for visit in walk(roots, include=include):
+            entity = visit.entity
+            if not isinstance(entity, DeclareLaunchArgument):
+                continue
+            info = entity.argument_info(conditional or visit.conditional)
+            found.setdefault(info.name, info)
+            if info.name not in context.launch_configurations and entity.default_value:
+                try:
+                    context.launch_configurations[info.name] = perform_substitutions(
+                        context, entity.default_value
+                    )
+                except MlaunchError:
+                    pass
 
-    def include(entity: Any, conditional: bool) -> None:
-        source = entity.launch_description_source
+    def include(entity: object, conditional: bool) -> list[object]:
+        """Declare what a statically found include declares, with its file's locals; the walk
+        goes on after it (so the order of declarations is the file's)."""
+        source = entity.launch_description_source  # type: ignore[attr-defined]
         if source.launch_description is not None:
-            walk([source.launch_description], conditional)
-            return
+            return [source.launch_description]
         try:
             location = source.get_launch_file_location(context)
         except (MlaunchError, SubstitutionFailure):
-            return
+            return []
         if location in seen or not os.path.exists(location):
-            return
+            return []
         seen.add(location)
         from mlaunch import readers
 
         with context.file_locals(location):
-            walk([readers.load(location, source.format_hint)], conditional)
+            declare([readers.load(location, source.format_hint)], conditional)
+        return []
 
     if path is None:
-        walk([description], False)
+        declare([description], False)
     else:
         with context.file_locals(path):
-            walk([description], False)
+            declare([description], False)
     return list(found.values())
