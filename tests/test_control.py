@@ -60,7 +60,7 @@ def test_stop_is_said_as_a_user_stop_and_respawn_leaves_it_down() -> None:
         stopped.append(info)
         h.sup.schedule(0.0, h.shutdown)
 
-    h.when(b"ready-worker", lambda *_: h.sup.control.stop("worker", by="ctl", done=after_stop))
+    h.when(b"ready-worker", lambda *_: h.control().stop("worker", by="ctl", done=after_stop))
     assert h.run() == 0  # Ctrl-C-less shutdown: nothing failed
     worker = h.messages("worker")
     assert "stop asked by the user (mlaunch ctl)" in worker
@@ -82,7 +82,7 @@ def test_start_after_a_stop_and_restart_keep_the_label_without_backoff() -> None
 
     def on_up(label: str, line: bytes) -> None:
         ups[0] += 1
-        control = h.sup.control
+        control = h.control()
         if ups[0] == 1:  # the first instance: stop it, then start it again
             control.stop("worker", done=lambda info: control.start("worker", done=infos.append))
         elif ups[0] in (2, 3):
@@ -125,7 +125,7 @@ def test_user_restarts_do_not_use_up_respawn_retries() -> None:
     def on_up(label: str, line: bytes) -> None:
         ups[0] += 1
         if ups[0] <= 2:
-            h.sup.control.restart("w")
+            h.control().restart("w")
             h.when(b"ready", on_up)
         else:
             h.sup.schedule(0.0, h.shutdown)
@@ -156,12 +156,12 @@ def test_mute_keeps_output_off_the_screen_but_in_the_log(tmp_path: Path) -> None
     tails: list[list[str]] = []
 
     def mute(label: str, line: bytes) -> None:
-        assert h.sup.control.mute("talker", by="keys").muted
+        assert h.control().mute("talker", by="keys").muted
         one.touch()
 
     def unmute(label: str, line: bytes) -> None:
-        tails.append(h.sup.control.logs("talker", 2))
-        assert not h.sup.control.unmute("talker").muted
+        tails.append(h.control().logs("talker", 2))
+        assert not h.control().unmute("talker").muted
         two.touch()
 
     h.when(b"first line", mute)
@@ -183,7 +183,7 @@ def test_a_user_stop_of_a_required_process_does_not_end_or_fail_the_run() -> Non
     boss_gone = [False]
 
     def stop(*_: object) -> None:
-        h.sup.control.stop("boss", done=lambda info: boss_gone.__setitem__(0, True))
+        h.control().stop("boss", done=lambda info: boss_gone.__setitem__(0, True))
 
     h.when(b"ready-boss", stop)
 
@@ -211,7 +211,7 @@ def test_a_launch_whose_processes_the_user_stopped_stays_up() -> None:
     def stopped(info: ProcessInfo) -> None:
         h.sup.schedule(0.0, check)
 
-    h.when(b"ready", lambda *_: h.sup.control.stop("only", done=stopped))
+    h.when(b"ready", lambda *_: h.control().stop("only", done=stopped))
     assert h.run() == 0
     assert seen == [False]
     assert "shutting down: test" in h.text
@@ -235,7 +235,7 @@ def test_on_process_exit_handlers_see_a_user_stop(tmp_path: Path) -> None:
         """,
     )
     h = Harness(plan_from(path, tmp_path))
-    h.when(b"ready", lambda label, line: h.sup.control.stop(label))
+    h.when(b"ready", lambda label, line: h.control().stop(label))
     assert h.run() == 0  # the handler's Shutdown ends the launch, without a failure
     assert "exit seen" in h.text
     assert "shutting down: worker is gone" in h.text
@@ -248,10 +248,10 @@ def test_a_stop_cancels_a_pending_respawn() -> None:
 
     def on_exit(event: Event) -> None:
         if isinstance(event, RespawnScheduled):
-            pending = h.sup.control.info("crash")
+            pending = h.control().info("crash")
             assert pending.restart_in is not None and 29 < pending.restart_in <= 30
             assert pending.uptime is None and pending.state == "restarting"
-            h.sup.control.stop("crash", done=infos.append)
+            h.control().stop("crash", done=infos.append)
             h.sup.schedule(0.0, h.shutdown)
 
     h.sup.events.subscribe(on_exit)
@@ -266,7 +266,7 @@ def test_bad_requests_are_clear_errors_and_change_nothing() -> None:
     errors: list[str] = []
 
     def ask(label: str, line: bytes) -> None:
-        control = h.sup.control
+        control = h.control()
         for request in (
             lambda: control.stop("talkr"),
             lambda: control.start("talker"),
@@ -305,7 +305,7 @@ def test_list_shows_every_label() -> None:
         if h.sup.records.get("b") is None or h.sup.records["b"].state == RUNNING:
             h.sup.schedule(0.02, listing)
             return
-        rows.extend(info.as_dict() for info in h.sup.control.processes())
+        rows.extend(info.as_dict() for info in h.control().processes())
         h.shutdown()
 
     h.sup.schedule(0.02, listing)

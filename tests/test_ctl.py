@@ -263,7 +263,7 @@ def test_a_log_folder_that_takes_no_socket_sends_it_to_the_runtime_folder(tmp_pa
     runtime = tmp_path / "runtime"
     runtime.mkdir(mode=0o700)
     h = Harness([make_spec("only", 'import time; print("ready", flush=True); time.sleep(60)')])
-    server = ControlSocket(h.sup, str(logs), {"XDG_RUNTIME_DIR": str(runtime)})
+    server = ControlSocket(h.sup, h.control, str(logs), {"XDG_RUNTIME_DIR": str(runtime)})
     answers: list[tuple[str, dict[str, object]]] = []
 
     def client() -> None:

@@ -215,7 +215,7 @@ def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> 
     from mlaunch.plan.events import LaunchEvent
 
     h = Harness(Plan())
-    run = pipeline.Run(Options("x.launch.py"), h.sup.plan, h.sup)
+    run = pipeline.Run(Options("x.launch.py"), h.sup.plan, h.sup, h.printer)
     watch = pipeline.lifecycle(run)
     assert run.lifecycle is None
     event = ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=3)
@@ -225,6 +225,4 @@ def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> 
         assert "has no handler" not in h.text
         assert "matched no running lifecycle node" in h.text  # the manager took it
     finally:
-        close = getattr(watch, "close", None)
-        assert close is not None
-        close()
+        watch.close()

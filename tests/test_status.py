@@ -132,7 +132,7 @@ def test_exit_summary_after_a_run_reports_each_process() -> None:
         ]
     )
     assert h.run() == 0
-    ExitSummary(h.sup).close()
+    ExitSummary(h.sup.process_records, h.sup.events.emit).close()
     text = h.text
     assert "Summary: 2 processes, 1 failed" in text
     ok_row = next(line for line in text.splitlines() if line.startswith("  ok "))
@@ -144,7 +144,7 @@ def test_exit_summary_after_a_run_reports_each_process() -> None:
 def test_one_clean_process_prints_no_summary() -> None:
     h = Harness([make_spec("only", "pass")])
     assert h.run() == 0
-    ExitSummary(h.sup).close()
+    ExitSummary(h.sup.process_records, h.sup.events.emit).close()
     assert "Summary" not in h.text
 
 
@@ -169,7 +169,15 @@ def test_status_view_keeps_the_scrollback_clean() -> None:
             make_spec("crasher", "import sys; sys.exit(2)", respawn=policy),
         ]
     )
-    view = StatusView(h.sup, size=lambda: (110, 40), color=False, period=0.05, sampler=fake_usage)
+    view = StatusView(
+        h.sup,
+        h.printer,
+        h.control,
+        size=lambda: (110, 40),
+        color=False,
+        period=0.05,
+        sampler=fake_usage,
+    )
     assert h.run() == 0
     assert view.frames > 5  # redrawn while it ran, not just once
     term = Terminal()
@@ -195,7 +203,9 @@ def test_status_view_keeps_the_scrollback_clean() -> None:
 
 def test_status_rows_show_state_usage_and_the_last_line_without_colours() -> None:
     h = Harness([make_spec("talker", "print('\\x1b[32mgreen hello\\x1b[0m')\nprint('bye')")])
-    view = StatusView(h.sup, size=lambda: (120, 40), color=False, sampler=fake_usage)
+    view = StatusView(
+        h.sup, h.printer, h.control, size=lambda: (120, 40), color=False, sampler=fake_usage
+    )
     running: list[str] = []
 
     def snapshot(what: str, process: object) -> None:
@@ -217,7 +227,9 @@ def test_status_rows_show_state_usage_and_the_last_line_without_colours() -> Non
 
 def test_status_view_keeps_failing_rows_when_there_is_no_room() -> None:
     h = Harness([])
-    view = StatusView(h.sup, size=lambda: (100, 16), color=False, sampler=fake_usage)
+    view = StatusView(
+        h.sup, h.printer, h.control, size=lambda: (100, 16), color=False, sampler=fake_usage
+    )
     for i in range(20):
         h.sup.records[f"n{i}-{i}"] = record(f"n{i}-{i}", RUNNING, pid=1000 + i)
     h.sup.records["bad-99"] = record("bad-99", FAILED, failed=True)
@@ -229,7 +241,7 @@ def test_status_view_keeps_failing_rows_when_there_is_no_room() -> None:
 
 def test_status_view_samples_real_processes_with_psutil() -> None:
     h = Harness([make_spec("worker", "import time; print('up', flush=True); time.sleep(30)")])
-    view = StatusView(h.sup, size=lambda: (120, 40), color=False)
+    view = StatusView(h.sup, h.printer, h.control, size=lambda: (120, 40), color=False)
     usage: list[dict[int, tuple[float, int]]] = []
 
     def sample_then_stop(label: str, line: bytes) -> None:
@@ -251,7 +263,7 @@ def test_status_view_needs_a_terminal(tmp_path: object) -> None:
     saved = os.dup(1)
     try:
         os.dup2(w, 1)  # stdout is a pipe here, as under CI
-        assert attach_status_view(h.sup) is None
+        assert attach_status_view(h.sup, h.printer, h.control) is None
     finally:
         os.dup2(saved, 1)
         for fd in (r, w, saved):
@@ -261,7 +273,15 @@ def test_status_view_needs_a_terminal(tmp_path: object) -> None:
 
 def test_status_refresh_never_keeps_an_idle_launch_alive() -> None:
     h = Harness([make_spec("quick", "pass")])
-    StatusView(h.sup, size=lambda: (80, 24), color=False, period=0.05, sampler=fake_usage)
+    StatusView(
+        h.sup,
+        h.printer,
+        h.control,
+        size=lambda: (80, 24),
+        color=False,
+        period=0.05,
+        sampler=fake_usage,
+    )
     started = time.monotonic()
     assert h.run() == 0
     assert time.monotonic() - started < 5

@@ -90,7 +90,9 @@ def test_guard_line_carries_the_settings_back() -> None:
 
 def test_selection_moves_and_the_pane_shows_the_selected_process(tmp_path: Path) -> None:
     h = Harness([], log_dir=str(tmp_path))
-    view = StatusView(h.sup, size=lambda: (100, 30), color=False, sampler=fake_usage)
+    view = StatusView(
+        h.sup, h.printer, h.control, size=lambda: (100, 30), color=False, sampler=fake_usage
+    )
     keys = view.enable_keys()
     for name in ("a-1", "b-2", "c-3"):
         h.sup.records[name] = record(name, "running", pid=1)
@@ -122,7 +124,9 @@ def test_selection_moves_and_the_pane_shows_the_selected_process(tmp_path: Path)
 def test_a_request_that_cannot_be_done_says_why_in_place_of_the_help(tmp_path: Path) -> None:
     now = [100.0]
     h = Harness([], log_dir=str(tmp_path), clock=lambda: now[0])
-    view = StatusView(h.sup, size=lambda: (120, 30), color=False, sampler=fake_usage)
+    view = StatusView(
+        h.sup, h.printer, h.control, size=lambda: (120, 30), color=False, sampler=fake_usage
+    )
     keys = view.enable_keys()
     keys.press("x")  # nothing to act on yet: nothing happens
     assert view.render().splitlines()[-1] == TABLE_HELP
@@ -475,7 +479,9 @@ def test_a_closed_terminal_window_is_a_sighup_shutdown(run: PtyRun) -> None:
 def test_a_narrow_terminal_drops_whole_columns_instead_of_cutting_numbers() -> None:
     h = Harness([])
     width = [80]
-    view = StatusView(h.sup, size=lambda: (width[0], 30), color=False, sampler=fake_usage)
+    view = StatusView(
+        h.sup, h.printer, h.control, size=lambda: (width[0], 30), color=False, sampler=fake_usage
+    )
     view.enable_keys()
     h.sup.records["robot_state_publisher-1"] = record(
         "robot_state_publisher-1", "running", pid=12345

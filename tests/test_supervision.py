@@ -34,6 +34,7 @@ from mlaunch.engine.records import FAILED, FINISHED, GAVE_UP
 from mlaunch.engine.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.engine.screen import Screen
 from mlaunch.engine.supervisor import Supervisor
+from mlaunch.parts.control import Control
 from mlaunch.plan.events import Event, Exited, Output, Started
 from mlaunch.plan.steps import Plan, ProcessSpec, RespawnPolicy, Spawn
 
@@ -100,6 +101,13 @@ class Harness:
         self.sup.events.subscribe(self._saw)
         self.elapsed = 0.0
         self.timed_out = False
+        self._control: Control | None = None
+
+    def control(self) -> Control:
+        """The run's runtime control, made on first use (as mlaunch.app.pipeline.Run does)."""
+        if self._control is None:
+            self._control = Control(self.sup, self.printer)
+        return self._control
 
     def when(self, needle: bytes, action: Callable[[str, bytes], None]) -> None:
         """Run ``action(label, line)`` in the loop the first time a child prints ``needle``."""

@@ -26,6 +26,7 @@ from collections import deque
 from mlaunch.launch.actions import LaunchDescription
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.plan.errors import MlaunchError
+from mlaunch.plan.events import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -215,7 +216,6 @@ class LaunchService:
             guard = Guard.start(run_id, temp_dir=temp_dir)
             color = self.screen is None and stdout_is_color_terminal(os.environ)
             printer = Printer(out=self.screen, color=color, log_dir=log_dir)
-            printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
             supervisor = Supervisor(
                 plan,
                 printer,
@@ -226,6 +226,8 @@ class LaunchService:
                 # A script may have children of its own: the run's are found by their marker.
                 adopt=False,
             )
+            said = Said("INFO", "launch", f"All log files can be found below {log_dir}")
+            supervisor.events.emit(said)
             wake_r, self._wake_w = os.pipe()
             os.set_blocking(wake_r, False)
             os.set_blocking(self._wake_w, False)
@@ -237,13 +239,12 @@ class LaunchService:
             if self._calls:
                 self._wake()
             # Composable nodes are loaded by the same part as in ``mlaunch FILE``.
-            components = components_part(plan, supervisor)
+            attach = lambda: components_part(plan, supervisor)  # noqa: E731
+            supervisor.reactor.attach("the LoadNode driver", attach)
             try:
                 code = supervisor.run()
             finally:
-                close = getattr(components, "close", None)
-                if close is not None:
-                    close()
+                supervisor.reactor.close_all()
             if self._error and code == 0:
                 code = 1
             return code
@@ -333,12 +334,12 @@ class LaunchService:
         try:
             plan = self._resolve(description)
         except MlaunchError as e:
-            supervisor.printer.message("ERROR", "launch", str(e))
+            supervisor.events.emit(Said("ERROR", "launch", str(e)))
             self._error = True
             supervisor.begin_shutdown("an included launch description failed")
             return
         for warning in plan.warnings:
-            supervisor.printer.message("WARNING", "launch", warning)
+            supervisor.events.emit(Said("WARNING", "launch", warning))
         supervisor.execute(plan.steps)
 
     def _shutdown_now(self) -> None:

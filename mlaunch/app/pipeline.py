@@ -2,12 +2,13 @@
 
 ``mlaunch FILE``, ``mlaunch test FILE`` and ``mlaunch export`` go through here; none reaches
 into another. What attaches to a run is a list of functions the caller passes to ``launch`` or
-``supervise``: each is called with the Run (after the supervisor exists, before it starts) and
-returns a part that subscribes to the supervisor's event stream, or None; parts with a
-``close()`` are closed in list order when the run ends. ``standard_parts`` is what every run
-gets: lifecycle driving (when the plan needs it, as resolve noted), the ``--status`` view (when
-asked for) and the exit summary. Nothing here imports rclpy, rich or psutil unless a part that
-needs them is attached.
+``supervise``: a ``PartMaker`` names a part and makes it from the Run (after the supervisor
+exists, before it starts); the part (mlaunch.engine.reactor.Part) subscribes to the supervisor's
+event stream, and is closed, in list order, when the run ends. Each part is behind a wall: if it
+raises, the run says so, detaches it and goes on (mlaunch.engine.reactor). ``standard_parts``
+is what every run gets: lifecycle driving (when the plan needs it, as resolve noted), the
+``--status`` view (when asked for) and the exit summary. Nothing here imports rclpy, rich or
+psutil unless a part that needs them is attached.
 """
 
 from __future__ import annotations
@@ -16,38 +17,77 @@ import os
 from collections.abc import Callable, Sequence
 
 from mlaunch.app.options import Options
-from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Started
+from mlaunch.engine.part import Part
+from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Said, Started
 from mlaunch.plan.steps import Need, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Any
-
     from mlaunch.engine.lifeline import Lifeline
+    from mlaunch.engine.output import Printer
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.launch.launch_description import LaunchDescription, LaunchDescriptionEntity
+    from mlaunch.parts.components import ComponentDriver
+    from mlaunch.parts.control import Control
+    from mlaunch.parts.control_socket import ControlSocket
     from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.parts.remote import Spawner
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
     from mlaunch.ros.search import PackageSearch
 
 
 class Run:
-    """What an attached part sees of the run: the command line, the plan and the supervisor.
+    """What an attached part sees of the run: the command line, the plan, the supervisor and
+    the printer.
 
     ``lifecycle`` is the LifecycleManager once lifecycle driving is attached (the smoke checks
-    share its ROS graph), else None.
+    share its ROS graph), else None. ``control`` is the run's runtime control, made on first
+    use (a run that is never controlled imports nothing for it).
     """
 
-    __slots__ = ("lifecycle", "opts", "plan", "supervisor")
+    __slots__ = ("_control", "lifecycle", "opts", "plan", "printer", "supervisor")
 
-    def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor) -> None:
+    def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor, printer: Printer) -> None:
         self.opts = opts
         self.plan = plan
         self.supervisor = supervisor
+        self.printer = printer
         self.lifecycle: LifecycleManager | None = None
+        self._control: Control | None = None
+
+    def control(self) -> Control:
+        """Stop, start, restart, mute, unmute a process by label, list them, read their last
+        lines (mlaunch.parts.control); loop thread only."""
+        if self._control is None:
+            from mlaunch.parts.control import Control, ControlError
+
+            # A part of its own, whichever part first asks for it (the socket, the keys).
+            make = lambda: Control(self.supervisor, self.printer)  # noqa: E731
+            control = self.supervisor.reactor.attach("runtime control", make)
+            if not isinstance(control, Control):
+                raise ControlError("runtime control failed when it was made (said above)")
+            self._control = control
+        return self._control
 
 
-Attach = Callable[[Run], object]
+class PartMaker:
+    """One entry of what attaches to a run: its name (errors name it), how to make it from the
+    Run (None: nothing to attach), and whether the run can go on without it."""
+
+    __slots__ = ("essential", "make", "name")
+
+    def __init__(
+        self, name: str, make: Callable[[Run], Part | None], *, essential: bool = False
+    ) -> None:
+        self.name = name
+        self.make = make
+        self.essential = essential
+
+    def attach(self, run: Run) -> Part | None:
+        """Made behind the run's wall (mlaunch.engine.reactor): a failure is said, not raised."""
+        return run.supervisor.reactor.attach(
+            self.name, lambda: self.make(run), essential=self.essential
+        )
 
 
 # --- load and resolve ---------------------------------------------------------------------------
@@ -142,7 +182,7 @@ def resolve_for_run(
 # --- the whole pipeline --------------------------------------------------------------------------
 
 
-def launch(opts: Options, attach: Sequence[Attach]) -> int:
+def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
     """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it."""
     from mlaunch.engine.lifeline import Lifeline, write_stdout
 
@@ -208,7 +248,7 @@ def supervise(
     labels: LabelCounter,
     log_dir: str,
     life: Lifeline,
-    attach: Sequence[Attach],
+    attach: Sequence[PartMaker],
 ) -> int:
     """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts."""
     from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
@@ -236,7 +276,6 @@ def supervise(
         rotate_bytes=rotate,
         rotate_keep=DEFAULT_ROTATE_KEEP if opts.log_keep is None else opts.log_keep,
     )
-    printer.message("INFO", "launch", f"All log files can be found below {log_dir}")
     spawner = _remote_spawner(labels, run_id)
     supervisor = Supervisor(
         plan,
@@ -247,25 +286,20 @@ def supervise(
         run_id=run_id,
         spawner=Process if spawner is None else spawner,
     )
-    run = Run(opts, plan, supervisor)
-    parts: list[object] = []
+    supervisor.events.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
+    run = Run(opts, plan, supervisor, printer)
     try:
         if spawner is not None:
             spawner.connect(plan.processes())
-        for part in attach:
-            attached = part(run)
-            if attached is not None:
-                parts.append(attached)
+        for maker in attach:
+            maker.attach(run)
         life.block()  # until the supervisor's own handlers are in
         try:
             code = supervisor.run()
         finally:
             life.hand_over()
     finally:
-        for attached in parts:
-            close = getattr(attached, "close", None)
-            if close is not None:
-                close()
+        supervisor.reactor.close_all()
         if spawner is not None:
             spawner.close()
         printer.close()
@@ -275,7 +309,7 @@ def supervise(
     return code
 
 
-def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
+def _remote_spawner(labels: LabelCounter, run_id: str) -> Spawner | None:
     """The remote-process spawner when the launch declared other machines, else None."""
     if not labels.run_state.get("machines"):
         return None  # no Machine in the launch: mlaunch.machines is never imported
@@ -292,20 +326,24 @@ def _remote_spawner(labels: LabelCounter, run_id: str) -> Any:
 # --- what every run attaches ---------------------------------------------------------------------
 
 
-def standard_parts(opts: Options) -> list[Attach]:
+def standard_parts(opts: Options) -> list[PartMaker]:
     """Lifecycle driving, composable node loading, the control socket, the ``--status`` view if
     asked for, then the exit summary.
 
     Closed in this order at the end: the status view leaves the screen before the summary.
     """
-    parts: list[Attach] = [lifecycle, components, control_socket]
+    parts = [
+        PartMaker("lifecycle driving", lifecycle),
+        PartMaker("the LoadNode driver", components),
+        PartMaker("the control socket", control_socket),
+    ]
     if opts.status:
-        parts.append(status_view)
-    parts.append(exit_summary)
+        parts.append(PartMaker("the status view", status_view))
+    parts.append(PartMaker("the exit summary", exit_summary))
     return parts
 
 
-def lifecycle(run: Run) -> object:
+def lifecycle(run: Run) -> Part:
     """Lifecycle (managed) node driving: at once when the plan needs it, else on demand.
 
     Resolve records in ``plan.needs`` whatever the description says about lifecycle nodes;
@@ -328,7 +366,7 @@ def lifecycle(run: Run) -> object:
     return _LifecycleWatch(run)
 
 
-class _LifecycleWatch:
+class _LifecycleWatch(Part):
     """Attaches lifecycle driving the moment the run turns out to need it.
 
     Until then it only looks at each record's class: a process of a lifecycle node starting,
@@ -360,12 +398,12 @@ class _LifecycleWatch:
             self.run.lifecycle.close()
 
 
-def components(run: Run) -> object:
+def components(run: Run) -> Part:
     """Composable node loading (``components_part``)."""
     return components_part(run.plan, run.supervisor)
 
 
-def components_part(plan: Plan, supervisor: Supervisor) -> object:
+def components_part(plan: Plan, supervisor: Supervisor) -> Part:
     """The LoadNode driver: at once when the plan needs it, else on demand.
 
     Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
@@ -380,7 +418,7 @@ def components_part(plan: Plan, supervisor: Supervisor) -> object:
     return _ComponentsWatch(supervisor)
 
 
-class _ComponentsWatch:
+class _ComponentsWatch(Part):
     """Attaches the LoadNode driver at the first LoadComponents step handed over.
 
     Until then it only looks at each record's class; the record that triggered it is handed to
@@ -389,7 +427,7 @@ class _ComponentsWatch:
 
     def __init__(self, supervisor: Supervisor) -> None:
         self.supervisor = supervisor
-        self.driver: Any = None
+        self.driver: ComponentDriver | None = None
         supervisor.events.subscribe(self._on_event)
 
     def _on_event(self, event: Event) -> None:
@@ -398,8 +436,8 @@ class _ComponentsWatch:
         from mlaunch.parts.components import ComponentDriver
 
         self.supervisor.events.unsubscribe(self._on_event)
-        self.driver = ComponentDriver(self.supervisor)
-        self.driver.on_event(event)
+        driver = self.driver = ComponentDriver(self.supervisor)
+        driver.on_event(event)
 
     def close(self) -> None:
         self.supervisor.events.unsubscribe(self._on_event)
@@ -407,49 +445,49 @@ class _ComponentsWatch:
             self.driver.close()
 
 
-def control_socket(run: Run) -> object:
+def control_socket(run: Run) -> Part | None:
     """``mlaunch ctl``'s socket in the run's log folder (mlaunch.parts.control_socket)."""
-    log_dir = run.supervisor.printer.log_dir
-    return _ControlSocketPart(run.supervisor, log_dir) if log_dir else None
+    log_dir = run.printer.log_dir
+    return _ControlSocketPart(run, log_dir) if log_dir else None
 
 
-class _ControlSocketPart:
+class _ControlSocketPart(Part):
     """Opens the control socket on the loop's first turn, and removes it at close.
 
     After the first children have started: ``socket`` and ``json`` cost milliseconds, which
     opening it at attach time would spend before the first child.
     """
 
-    def __init__(self, supervisor: Supervisor, log_dir: str) -> None:
-        self.supervisor = supervisor
+    def __init__(self, run: Run, log_dir: str) -> None:
+        self.run = run
         self.log_dir = log_dir
-        self.server: Any = None
-        supervisor.schedule(0.0, self._open, keeps_alive=False)
+        self.server: ControlSocket | None = None
+        run.supervisor.schedule(0.0, self._open, keeps_alive=False)
 
     def _open(self) -> None:
         from mlaunch.parts.control_socket import ControlSocket
-        from mlaunch.plan.events import Said
 
-        server = ControlSocket(self.supervisor, self.log_dir)
+        supervisor = self.run.supervisor
+        server = ControlSocket(supervisor, self.run.control, self.log_dir)
         if server.open():
             self.server = server
         else:
             text = f"{server.error}; mlaunch ctl cannot reach this run"
-            self.supervisor.events.emit(Said("WARNING", "launch", text))
+            supervisor.events.emit(Said("WARNING", "launch", text))
 
     def close(self) -> None:
         if self.server is not None:
             self.server.close()
 
 
-def status_view(run: Run) -> object:
+def status_view(run: Run) -> Part | None:
     """``--status``: the live table pinned below the output (rich and psutil, only then)."""
     from mlaunch.parts.status import attach_status_view
 
-    return attach_status_view(run.supervisor)
+    return attach_status_view(run.supervisor, run.printer, run.control)
 
 
-class _ExitSummary:
+class _ExitSummary(Part):
     """Prints mlaunch.parts.summary's exit summary at close, importing it only then.
 
     Importing it costs start-up time that attaching before the run would spend before the first
@@ -463,9 +501,10 @@ class _ExitSummary:
     def close(self) -> None:
         from mlaunch.parts.summary import ExitSummary
 
-        ExitSummary(self.supervisor, quiet=self.quiet).close()
+        supervisor = self.supervisor
+        ExitSummary(supervisor.process_records, supervisor.events.emit, quiet=self.quiet).close()
 
 
-def exit_summary(run: Run) -> object:
+def exit_summary(run: Run) -> Part:
     """The table of every process at the end (more than one process, or any failure)."""
     return _ExitSummary(run.supervisor, quiet=run.opts.quiet)

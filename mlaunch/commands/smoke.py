@@ -206,12 +206,14 @@ def supervise(
 
     runs: list[SmokeRun] = []
 
-    def attach(run: pipeline.Run) -> SmokeRun:
+    def smoke_checks(run: pipeline.Run) -> SmokeRun:
         smoke = SmokeRun(run.supervisor, expectations, settings, lifecycle=run.lifecycle)
         runs.append(smoke)
         return smoke
 
-    parts = [*pipeline.standard_parts(opts), attach]
+    # Without its checks the run proves nothing: if they fail, the run ends (exit status 70).
+    checks = pipeline.PartMaker("the smoke checks", smoke_checks, essential=True)
+    parts = [*pipeline.standard_parts(opts), checks]
     code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
     if not runs:
         return code

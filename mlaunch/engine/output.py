@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile, tail_lines
 from mlaunch.engine.sayings import SAYINGS, VIEWER_ADDRESS, Sayings
 from mlaunch.engine.screen import Screen
-from mlaunch.plan.events import Event, Output
+from mlaunch.plan.events import Event, Output, Summary
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -102,8 +102,8 @@ class Printer(Sayings):
         self._launch_log_full = False
         self._own: dict[str, LogFile] = {}
         self._prefix: dict[str, bytes] = {}
-        # Labels whose output the user muted (mlaunch.parts.control): kept off the screen only.
-        self.muted: set[str] = set()
+        # Labels whose output the user muted (``mute``): kept off the screen only.
+        self._muted: set[str] = set()
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
@@ -181,6 +181,18 @@ class Printer(Sayings):
             self._launch_log.write(b"%.7f " % self.clock() + line)
             self._dirty.add(self._launch_log)
 
+    def mute(self, label: str, muted: bool = True) -> None:
+        """Keep ``label``'s output off the screen (its log file still gets every line), or
+        show it again; at once, whoever asks (runtime control, from any loop callback)."""
+        if muted:
+            self._muted.add(label)
+        else:
+            self._muted.discard(label)
+
+    def is_muted(self, label: str) -> bool:
+        """Whether the user keeps ``label``'s output off the screen (its log still gets it)."""
+        return label in self._muted
+
     def block(self, text: str) -> None:
         """Lines of launch's own (the exit summary) as they are, on screen and in launch.log."""
         data = text.encode("utf-8", "replace")
@@ -213,7 +225,7 @@ class Printer(Sayings):
         if (
             stream in SCREEN_STREAMS.get(mode, ())
             and (not self.quiet or stream == "stderr")
-            and label not in self.muted
+            and label not in self._muted
         ):
             if self._write is self._screen:
                 # Counted per process, for per-process flow control (Screen.holding).
@@ -286,6 +298,9 @@ class Printer(Sayings):
         if method is not None:
             method(self, event)
 
+    def _summary(self, event: Summary) -> None:
+        self.block(event.text)
+
     def _output(self, event: Output) -> None:
         process = event.process
         if (
@@ -332,4 +347,8 @@ def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
 
 # Which words each record of the event stream becomes (records not listed are not said): a
 # process's output here, everything else mlaunch.engine.sayings'.
-_SAYS: dict[type, Callable[[Printer, Any], None]] = {Output: Printer._output, **SAYINGS}
+_SAYS: dict[type, Callable[[Printer, Any], None]] = {
+    **SAYINGS,
+    Output: Printer._output,
+    Summary: Printer._summary,
+}

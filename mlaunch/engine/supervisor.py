@@ -30,7 +30,8 @@ import itertools
 import os
 import selectors
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from types import MappingProxyType
 
 from mlaunch.engine import guard as guards
 from mlaunch.engine import proctable
@@ -39,17 +40,17 @@ from mlaunch.engine.ladder import StopLadder
 from mlaunch.engine.output import Printer
 from mlaunch.engine.pipes import Pipes
 from mlaunch.engine.process import Process, describe_status
+from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
 from mlaunch.engine.records import GAVE_UP, RESTARTING, RUNNING, STOPPED, ProcessRecord
 from mlaunch.engine.respawn import GIVE_UP, NO_RESTART, next_restart
 from mlaunch.engine.signals import SignalWatch
 from mlaunch.engine.stopping import Stopping
 from mlaunch.engine.strays import STRAY_GRACE, Strays
 from mlaunch.engine.timers import Timer, Timers
-from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK, EXIT_USAGE, MlaunchError
 from mlaunch.plan.events import (
     Completed,
     Event,
-    EventStream,
     Exited,
     FailedToStart,
     GaveUp,
@@ -87,7 +88,6 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.engine.cgroup import RunCgroup
-    from mlaunch.parts.control import Control
 
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
 POLL = 0.05
@@ -131,7 +131,9 @@ class Supervisor(Stopping):
         self.run_id = run_id or guards.new_run_id()
         # Makes the Process for a spec: remote machines plug in here (mlaunch.parts.remote).
         self.spawner = spawner
-        self.selector = selectors.DefaultSelector()
+        # The loop's selector; parts register through ``selector``, which makes what they
+        # register theirs (mlaunch.engine.reactor), the children's pipes and signals go here.
+        self._selector = selectors.DefaultSelector()
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
@@ -139,23 +141,26 @@ class Supervisor(Stopping):
         self.timers = Timers(clock)
         # Pending respawns by label: a user's stop or start cancels the one waiting.
         self.respawn_timers: dict[str, Timer] = {}
-        self._control: Control | None = None
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
             self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
         )
-        self.pipes = Pipes(self.selector, printer, self._deliver)
+        self.pipes = Pipes(self._selector, printer, self._deliver)
         self.launch_handlers = LaunchHandlers(self)
-        self.events = EventStream()
+        self.events = RunEvents()
         # Its steps outlive the shutdown's cancellation of timers.
         self.ladder = StopLadder(
-            lambda delay, step: self.schedule(delay, step, cancel_on_shutdown=False),
+            lambda delay, step: self.timers.add(delay, step, cancel_on_shutdown=False),
             self.events.emit,
             self.records,
         )
         self.events.subscribe(self._react)
         self.events.subscribe(printer)
         self.events.subscribe(self.launch_handlers)
+        # What attaches to the run from here on is a part, behind a wall (reactor.py).
+        self.reactor = Reactor(self.events, self._selector, self.part_failed)
+        self.events.reactor = self.reactor
+        self.selector = PartSelector(self._selector, self.reactor)
         self._index = itertools.count()
         self.shutting_down = False
         self._held: set[Process] = set()
@@ -171,16 +176,10 @@ class Supervisor(Stopping):
         self._work: set[object] = set()
 
     @property
-    def control(self) -> Control:
-        """Runtime control of this run (mlaunch.parts.control), made on first use; loop thread only.
-
-        Stop, start, restart, mute, unmute a process by label, list them, read their last lines.
-        """
-        if self._control is None:
-            from mlaunch.parts.control import Control
-
-            self._control = Control(self)
-        return self._control
+    def process_records(self) -> Mapping[str, ProcessRecord]:
+        """What the run knows of each label, read-only (the status view, the exit summary,
+        runtime control and the smoke checks read it; only the supervisor writes it)."""
+        return MappingProxyType(self.records)
 
     @property
     def handlers(self) -> list[AddHandler]:
@@ -190,7 +189,7 @@ class Supervisor(Stopping):
     # --- the loop ------------------------------------------------------------------------------
 
     def run(self) -> int:
-        self.signals.start(self.selector)
+        self.signals.start(self._selector)
         try:
             self.execute(self.plan.steps, self.plan.warnings)
             if self.guard is not None:
@@ -209,7 +208,7 @@ class Supervisor(Stopping):
         finally:
             self.strays.release()
             self.signals.stop()
-            self.selector.close()
+            self._selector.close()
             self.pipes.forget_terminal()
             self.printer.flush()
         return self.exit_code
@@ -222,7 +221,7 @@ class Supervisor(Stopping):
             self.guard.flush()  # this turn's +pgid/-pgid lines, in one write
         if self.pipes.before_wait() or self.signals.polling:
             timeout = POLL if timeout is None else min(timeout, POLL)
-        ready = self.selector.select(timeout)
+        ready = self._selector.select(timeout)
         for key, _ in ready:
             key.data(key.fd)
         self._handle_signals()
@@ -282,17 +281,29 @@ class Supervisor(Stopping):
     def schedule(
         self,
         delay: float,
-        callback: Callable[[], None],
+        callback: Callable[[], object],
         *,
         keeps_alive: bool = True,
         cancel_on_shutdown: bool = True,
     ) -> Timer:
-        """Call ``callback`` from the loop after ``delay`` seconds.
+        """Call ``callback`` from the loop after ``delay`` seconds (a part's, when a part asks).
 
         ``keeps_alive`` False: the timer alone does not keep an idle launch running (a status
         refresh); ``cancel_on_shutdown`` False: it still fires while shutting down (the ladder).
         """
+        callback = self.reactor.own(callback)
         return self.timers.add(delay, callback, keeps_alive, cancel_on_shutdown)
+
+    def part_failed(self, name: str, error: BaseException, essential: bool) -> None:
+        """An attached part raised (mlaunch.engine.reactor detached it): say so in one line;
+        a part the run cannot go on without ends it through the stop ladder (exit status 70)."""
+        text = f"{name} failed and was detached: {type(error).__name__}: {error}"
+        if essential:
+            text += "; the run cannot go on without it"
+            self.exit_code = max(self.exit_code, EXIT_INTERNAL)
+        self.events.emit(Said("ERROR", "launch", text))
+        if essential:
+            self.begin_shutdown(f"{name} failed")
 
     # --- plan steps ------------------------------------------------------------------------------
 
@@ -364,7 +375,7 @@ class Supervisor(Stopping):
             if awaited:
                 self.events.emit(Completed(action))
 
-        self.schedule(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
+        self.timers.add(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
 
     def fire(self, body: Deferred, event: Any) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
@@ -495,7 +506,7 @@ class Supervisor(Stopping):
         attempt = record.restarts + 1
         self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
         record.state, record.restart_at = RESTARTING, self.clock() + delay
-        self.respawn_timers[process.label] = self.schedule(
+        self.respawn_timers[process.label] = self.timers.add(
             delay, lambda: self._respawn(process, attempt)
         )
 
@@ -504,6 +515,15 @@ class Supervisor(Stopping):
         self.respawn_timers.pop(old.label, None)
         self._forget(old)
         self.start(old.spec, restarts=attempt)
+
+    def cancel_respawn(self, label: str, outcome: str) -> None:
+        """The respawn ``label`` waits for does not happen: it stays down, ``outcome`` says why
+        (runtime control's stop of a crashed process)."""
+        timer = self.respawn_timers.pop(label, None)
+        if timer is not None:
+            timer.cancelled = True
+        record = self.records[label]
+        record.state, record.restart_at, record.outcome = STOPPED, None, outcome
 
     def start_again(self, old: Process) -> Process | None:
         """Start ``old``'s spec again now, as the user asked (mlaunch.parts.control).

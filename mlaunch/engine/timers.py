@@ -20,7 +20,7 @@ class Timer:
         self,
         when: float,
         seq: int,
-        callback: Callable[[], None],
+        callback: Callable[[], object],
         keeps_alive: bool = True,
         cancel_on_shutdown: bool = True,
     ) -> None:
@@ -46,7 +46,7 @@ class Timers:
     def add(
         self,
         delay: float,
-        callback: Callable[[], None],
+        callback: Callable[[], object],
         keeps_alive: bool = True,
         cancel_on_shutdown: bool = True,
     ) -> Timer:

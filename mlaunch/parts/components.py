@@ -22,6 +22,7 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 
+from mlaunch.engine.part import Part
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.launch_ros.node import same_name_warning
@@ -267,7 +268,7 @@ class ComponentLoader:
 # --- attached to a run ---------------------------------------------------------------------
 
 
-class ComponentDriver:
+class ComponentDriver(Part):
     """The pipeline's components part: loads each LoadComponents step the supervisor hands over.
 
     It subscribes to the run's event stream: a ``HandedOff`` LoadComponents starts its loads,

@@ -1,7 +1,8 @@
 """Runtime control of a running launch: list, stop, start, restart, mute, unmute, logs.
 
 The core of ``mlaunch ctl`` (through the control socket, mlaunch.parts.control_socket) and of the
-``--status`` keys. ``Supervisor.control`` makes one Control per run on first use. Every method
+``--status`` keys. The run (``mlaunch.app.pipeline.Run.control``) makes one Control on first
+use; it asks the printer for what only the printer knows (mutes, log tails). Every method
 runs on the supervisor's loop thread and never blocks: call it from a selector callback, a timer
 (``Supervisor.schedule``) or an event subscriber. Another thread must hand its request to the
 loop (the control socket is read by the loop's own selector, so it needs no hand-over).
@@ -40,11 +41,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from mlaunch.engine.part import Part
 from mlaunch.engine.process import Process
 from mlaunch.engine.records import (
     RESTARTING,
     RUNNING,
-    STOPPED,
     STOPPING,
     USER_STOPPED,
     ProcessRecord,
@@ -54,6 +55,7 @@ from mlaunch.plan.events import Controlled, Event, Exited, FailedToStart, NotSta
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from mlaunch.engine.output import Printer
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.plan.events import ProcessView
 
@@ -144,15 +146,16 @@ class ProcessInfo:
 Done = Callable[[ProcessInfo], None]
 
 
-class Control:
+class Control(Part):
     """Stop, start, restart, mute and read one process of a running Supervisor (loop thread).
 
     ``by`` in every request says through what the user asked ("ctl", "keys"); the printer
     names it.
     """
 
-    def __init__(self, supervisor: Supervisor) -> None:
+    def __init__(self, supervisor: Supervisor, printer: Printer) -> None:
         self.supervisor = supervisor
+        self.printer = printer
         # (process, what, callback): "exit" calls back when it exits, "restart" when its
         # label's next instance has started.
         self._waits: list[tuple[Process, str, Done]] = []
@@ -162,7 +165,7 @@ class Control:
 
     def labels(self) -> list[str]:
         """Every process label of the run so far, in the order they first started."""
-        return list(self.supervisor.records)
+        return list(self.supervisor.process_records)
 
     def resolve(self, name: str) -> str:
         """The label ``name`` means: a label, else the one label of that name (``talker`` for
@@ -170,7 +173,7 @@ class Control:
 
         UnknownLabel (with the valid labels and the close ones) or AmbiguousLabel otherwise.
         """
-        records = self.supervisor.records
+        records = self.supervisor.process_records
         if name in records:
             return name
         named = [label for label, record in records.items() if name in _names(record)]
@@ -182,7 +185,7 @@ class Control:
 
     def record(self, label: str) -> ProcessRecord:
         """The record of the label ``label`` means (``resolve``)."""
-        return self.supervisor.records[self.resolve(label)]
+        return self.supervisor.process_records[self.resolve(label)]
 
     def info(self, label: str) -> ProcessInfo:
         record = self.record(label)
@@ -207,14 +210,14 @@ class Control:
         return [self.info(label) for label in self.labels()]
 
     def is_muted(self, label: str) -> bool:
-        return label in self.supervisor.printer.muted
+        return self.printer.is_muted(label)
 
     def logs(self, label: str, lines: int = DEFAULT_LINES) -> list[str]:
         """The last ``lines`` lines of the label's output, oldest first, from its log file."""
         label = self.resolve(label)
         if lines < 0:
             raise ControlError(f"lines is {lines}; valid: 0 or more", what="logs")
-        tail = self.supervisor.printer.log_tail(label, lines)
+        tail = self.printer.log_tail(label, lines)
         if tail is None:
             raise ControlError("this run writes no log files: no lines kept", what="logs")
         return [line.decode("utf-8", "replace") for line in tail]
@@ -240,10 +243,7 @@ class Control:
             raise ControlError(f"{label} is not running ({record.outcome or record.state})")
         # Crashed and waiting for its respawn: the respawn is cancelled.
         supervisor.events.emit(Controlled(label, "stop", by))
-        timer = supervisor.respawn_timers.pop(label, None)
-        if timer is not None:
-            timer.cancelled = True
-        record.state, record.restart_at, record.outcome = STOPPED, None, USER_STOPPED
+        supervisor.cancel_respawn(label, USER_STOPPED)
         if done is not None:
             done(self.info(label))
 
@@ -276,7 +276,7 @@ class Control:
         """Keep the label's output off the screen (its log file still gets every line)."""
         label = self.resolve(label)
         if not self.is_muted(label):
-            self.supervisor.printer.muted.add(label)
+            self.printer.mute(label)
             self.supervisor.events.emit(Controlled(label, "mute", by))
         return self.info(label)
 
@@ -284,7 +284,7 @@ class Control:
         """Show the label's output on the screen again."""
         label = self.resolve(label)
         if self.is_muted(label):
-            self.supervisor.printer.muted.discard(label)
+            self.printer.mute(label, False)
             self.supervisor.events.emit(Controlled(label, "unmute", by))
         return self.info(label)
 
@@ -318,6 +318,11 @@ class Control:
         if done is not None:
             done(self.info(label))
 
+    def close(self) -> None:
+        """Stop following the run (its waiting callbacks are dropped)."""
+        self.supervisor.events.unsubscribe(self._on_event)
+        self._waits.clear()
+
     def _on_event(self, event: Event) -> None:
         """Calls back those waiting for an exit, or for the start that follows a restart."""
         if not self._waits:
@@ -336,7 +341,7 @@ class Control:
                 continue
             # A restart's new instance is started before this record is handed out (the exit
             # is held until the supervisor has acted on it); else it is still to come.
-            if what == "exit" or self.supervisor.records[process.label].state != RESTARTING:
+            if what == "exit" or self.supervisor.process_records[process.label].state != RESTARTING:
                 self._waits.remove(wait)
                 done(self.info(process.label))
 

@@ -28,7 +28,7 @@ import os
 import selectors
 import socket
 import stat
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
 
@@ -144,9 +144,15 @@ class ControlSocket:
     """
 
     def __init__(
-        self, supervisor: Supervisor, log_dir: str, environ: Mapping[str, str] = os.environ
+        self,
+        supervisor: Supervisor,
+        control: Callable[[], Control],
+        log_dir: str,
+        environ: Mapping[str, str] = os.environ,
     ) -> None:
         self.supervisor = supervisor
+        # The run's Control, made when the first request needs it.
+        self.control = control
         self.path = socket_path(log_dir)
         self.log_dir = log_dir
         self.environ = environ
@@ -388,7 +394,7 @@ class _Client:
     def carry_out(self, request: dict[str, object]) -> None:
         from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
 
-        control = self.server.supervisor.control
+        control = self.server.control()
         op, label = request.get("op"), request.get("label")
         if op not in OPERATIONS:
             raise BadRequest(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")

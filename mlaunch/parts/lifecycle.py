@@ -34,6 +34,7 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+from mlaunch.engine.part import Part
 from mlaunch.launch_ros.lifecycle_sequence import (
     DEFAULT_TIMEOUT,
     LifecycleSequence,
@@ -116,7 +117,7 @@ class Outcome(Event):
         self.shutdown_on_failure = shutdown_on_failure
 
 
-class LifecycleManager:
+class LifecycleManager(Part):
     """Drives the launch's managed nodes; lives in the supervisor's loop thread."""
 
     def __init__(

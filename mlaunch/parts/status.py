@@ -19,6 +19,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 
+from mlaunch.engine.part import Part
 from mlaunch.engine.records import (
     FAILED,
     GAVE_UP,
@@ -29,7 +30,7 @@ from mlaunch.engine.records import (
     ProcessRecord,
 )
 from mlaunch.parts.summary import format_bytes, format_duration
-from mlaunch.plan.events import Event, Output
+from mlaunch.plan.events import Event, Output, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -38,6 +39,9 @@ if TYPE_CHECKING:
     from rich.console import Console
 
     from mlaunch.engine.keyboard import Keyboard
+    from mlaunch.engine.output import Printer
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.control import Control
     from mlaunch.parts.status_keys import StatusKeys
 
 REFRESH = 0.5
@@ -78,7 +82,7 @@ def terminal_size(fd: int = 1) -> tuple[int, int]:
     return size.columns or 80, size.lines or 24
 
 
-class StatusView:
+class StatusView(Part):
     """The live table. Seams: ``size`` (columns, lines), ``color``, ``period``, ``sampler``.
 
     ``sampler(pids_by_group) -> {pgid: (cpu_percent, rss)}``; the default uses psutil.
@@ -86,7 +90,9 @@ class StatusView:
 
     def __init__(
         self,
-        supervisor: Any,
+        supervisor: Supervisor,
+        printer: Printer,
+        control: Callable[[], Control],
         *,
         size: Callable[[], tuple[int, int]] = terminal_size,
         color: bool = True,
@@ -95,7 +101,8 @@ class StatusView:
         wall_clock: Callable[[], float] = time.time,
     ) -> None:
         self.supervisor = supervisor
-        self.printer = supervisor.printer
+        self.printer = printer
+        self.control = control  # the run's runtime control, made when a key first needs it
         self.size = size
         self.color = color
         self.period = period
@@ -180,9 +187,9 @@ class StatusView:
 
         supervisor = self.supervisor
         self.keys = StatusKeys(
-            lambda: list(supervisor.records),
+            lambda: list(supervisor.process_records),
             self.redraw,
-            lambda: supervisor.control,
+            self.control,
             supervisor.clock,
         )
         return self.keys
@@ -192,7 +199,7 @@ class StatusView:
         from mlaunch.engine.keyboard import Keyboard
 
         keys = self.keys or self.enable_keys()
-        guard = getattr(self.supervisor, "guard", None)
+        guard = self.supervisor.guard
         self.keyboard = Keyboard(
             self.supervisor.selector,
             keys.press,
@@ -272,7 +279,7 @@ class StatusView:
         """(record, state, pid, uptime, cpu, memory, last line) for each process, as text."""
         now = self.supervisor.clock()
         out = []
-        for record in self.supervisor.records.values():
+        for record in self.supervisor.process_records.values():
             running = record.state in (RUNNING, STOPPING)
             cpu, rss = self.usage.get(record.pid, (0.0, 0)) if running else (0.0, 0)
             if running:
@@ -344,7 +351,7 @@ class StatusView:
             hidden = len(rows) - room
             rows = [row for i, row in enumerate(rows) if i in kept]
         counts: dict[str, int] = {}
-        for record in self.supervisor.records.values():
+        for record in self.supervisor.process_records.values():
             counts[record.state] = counts.get(record.state, 0) + 1
         title = "mlaunch: " + ", ".join(f"{n} {state}" for state, n in counts.items())
         if hidden:
@@ -396,7 +403,7 @@ class StatusView:
         from rich.text import Text
 
         assert self.keys is not None
-        record = self.supervisor.records.get(label)
+        record = self.supervisor.process_records.get(label)
         state = self._state_text(record) if record is not None else "-"
         shown, problem = self.keys.last_lines(label, max(1, int(lines * MAX_SHARE) - 2))
         what = f"its last {len(shown)} lines" if shown else problem or "no output yet"
@@ -408,7 +415,7 @@ class StatusView:
     def _state_text(self, record: ProcessRecord) -> str:
         """The state as the table shows it: whether the user stopped or muted it too."""
         state = record.outcome if record.state == STOPPED else record.state
-        if record.label in self.printer.muted:
+        if self.printer.is_muted(record.label):
             state += ", muted"
         return state
 
@@ -440,17 +447,18 @@ def _printable(raw: bytes, *, strip: bool = True) -> str:
     return text.strip() if strip else text.rstrip()
 
 
-def attach_status_view(supervisor: Any) -> StatusView | None:
+def attach_status_view(
+    supervisor: Supervisor, printer: Printer, control: Callable[[], Control]
+) -> StatusView | None:
     """The view on a terminal; on anything else a warning (redrawing would fill a log file).
 
     With a terminal on stdin too, its keys select a process and act on it (``read_keys``).
     """
     if not os.isatty(1):
-        supervisor.printer.message(
-            "WARNING", "launch", "--status needs a terminal on stdout; no status view"
-        )
+        text = "--status needs a terminal on stdout; no status view"
+        supervisor.events.emit(Said("WARNING", "launch", text))
         return None
-    view = StatusView(supervisor, color=bool(getattr(supervisor.printer, "color", True)))
+    view = StatusView(supervisor, printer, control, color=printer.color)
     if os.isatty(0):
         view.read_keys(0)
     return view

@@ -10,13 +10,10 @@ nothing is imported for it. The durations and sizes are written as the ``--statu
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Mapping
 
 from mlaunch.engine.records import GAVE_UP, ProcessRecord
-
-TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
-if TYPE_CHECKING:
-    from typing import Any
+from mlaunch.plan.events import Event, Summary
 
 
 def format_duration(seconds: float) -> str:
@@ -83,13 +80,21 @@ def render_summary(records: Iterable[ProcessRecord]) -> str:
 
 
 class ExitSummary:
-    """Attached to a supervisor; prints the summary through its printer when the run ends."""
+    """The summary of a run's processes, said when the run ends (``close``): ``records`` is the
+    run's read-only view of them, ``emit`` its event stream's (the printer says the table)."""
 
-    def __init__(self, supervisor: Any, *, quiet: bool = False) -> None:
-        self.supervisor = supervisor
+    def __init__(
+        self,
+        records: Mapping[str, ProcessRecord],
+        emit: Callable[[Event], None],
+        *,
+        quiet: bool = False,
+    ) -> None:
+        self.records = records
+        self.emit = emit
         self.quiet = quiet
 
     def close(self) -> None:
-        records = list(self.supervisor.records.values())
+        records = list(self.records.values())
         if records and summary_wanted(records, quiet=self.quiet):
-            self.supervisor.printer.block(render_summary(records))
+            self.emit(Summary(render_summary(records)))

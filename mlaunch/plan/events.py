@@ -294,6 +294,15 @@ class Said(Event):
         self.text = text
 
 
+class Summary(Event):
+    """Lines said as they are, not as one message (the exit summary's table)."""
+
+    __slots__ = ("text",)
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+
 # --- the stream -----------------------------------------------------------------------------------
 
 Subscriber = Callable[[Event], object]

@@ -10,7 +10,8 @@ from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.plan.events import Event, Exited, HandedOff, Output, Started
+from mlaunch.engine.part import Part
+from mlaunch.plan.events import Event, Exited, HandedOff, Output, Said, Started
 from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
@@ -46,7 +47,7 @@ _ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 # --- watching the run -----------------------------------------------------------------------------
 
 
-class SmokeRun:
+class SmokeRun(Part):
     """Attached to the supervisor: decides ready / failed, then shuts the launch down.
 
     Process and output checks run in the supervisor's loop thread (its event stream);
@@ -258,11 +259,11 @@ class SmokeRun:
         if any(e.status == "pending" and e.kind != "shutdown" for e in self.expectations):
             return
         self.phase = "holding"
-        printer = self.supervisor.printer
+        emit = self.supervisor.events.emit
         count = sum(1 for e in self.expectations if e.status == "met")
-        printer.message("INFO", "test", f"ready after {self.elapsed():.1f} s ({count} checks met)")
+        emit(Said("INFO", "test", f"ready after {self.elapsed():.1f} s ({count} checks met)"))
         if self.settings.hold > 0:
-            printer.message("INFO", "test", f"holding for {self.settings.hold:g} s")
+            emit(Said("INFO", "test", f"holding for {self.settings.hold:g} s"))
             self.supervisor.schedule(self.settings.hold, self._held, keeps_alive=False)
         else:
             self._held()
