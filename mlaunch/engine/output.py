@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Mapping
 
 from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile, tail_lines
-from mlaunch.engine.sayings import SAYINGS, VIEWER_ADDRESS, Sayings
+from mlaunch.engine.sayings import VIEWER_ADDRESS, Sayings
 from mlaunch.engine.screen import Screen
 from mlaunch.plan.events import Event, Output, Summary
 
@@ -60,11 +60,12 @@ def prefix_lines(prefix: bytes, data: bytes) -> bytes:
     return prefix + data[:-1].replace(b"\n", b"\n" + prefix) + b"\n"
 
 
-class Printer(Sayings):
-    """Owns the terminal and the log files of a run, and every word mlaunch says about it.
+class Printer:
+    """Owns the terminal and the log files of a run: every byte mlaunch writes goes here.
 
-    A Printer is a subscriber of the supervisor's EventStream (``__call__``): each record
-    becomes its line (``_SAYS`` at the end of this module lists which).
+    A Printer is a subscriber of the supervisor's EventStream (``__call__``): a process's output
+    and the exit summary are its own (``_SAYS`` at the end of this module), every other record
+    its ``sayings`` put in words (mlaunch.engine.sayings).
 
     ``out`` receives every byte meant for the screen; None means the real terminal through a
     Screen (non-blocking, bounded), whose flow control the supervisor drives (``waiting_fd``,
@@ -106,8 +107,8 @@ class Printer(Sayings):
         self._muted: set[str] = set()
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
-        self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
         self._viewers: set[str] = set()  # labels of viewer stand-ins, whose address is said
+        self.sayings = Sayings(self)
         if self.log_dir:
             self._launch_log = self._open("launch.log", lazy=False, rotate=False)
 
@@ -297,6 +298,12 @@ class Printer(Sayings):
         method = _SAYS.get(type(event))
         if method is not None:
             method(self, event)
+        else:
+            self.sayings(event)
+
+    def say_address_of(self, label: str) -> None:
+        """``label`` is a viewer stand-in: its address line is said whatever its output mode."""
+        self._viewers.add(label)
 
     def _summary(self, event: Summary) -> None:
         self.block(event.text)
@@ -348,7 +355,6 @@ def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
 # Which words each record of the event stream becomes (records not listed are not said): a
 # process's output here, everything else mlaunch.engine.sayings'.
 _SAYS: dict[type, Callable[[Printer, Any], None]] = {
-    **SAYINGS,
     Output: Printer._output,
     Summary: Printer._summary,
 }

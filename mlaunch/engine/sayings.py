@@ -1,8 +1,9 @@
-"""What mlaunch says about a run's events: the Printer's words for each record of the stream.
+"""What mlaunch says about a run's events: the words for each record of the stream.
 
-``Sayings`` is the half of mlaunch.engine.output.Printer that turns records (started, exited,
-escalated, respawn scheduled, ...) into its one-line messages; ``SAYINGS`` says which method
-says which record. The Printer provides ``message`` and ``register`` and owns the terminal.
+``Sayings`` turns records (started, exited, escalated, respawn scheduled, ...) into one-line
+messages; ``SAYINGS`` says which method says which record. It writes nothing itself: each line
+goes to the printer it was made for (mlaunch.engine.output.Printer, which owns the terminal and
+the log files and hands it every record that is not a process's output).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from mlaunch.engine.process import describe_status, signal_name
 from mlaunch.plan.events import (
     Controlled,
     Escalated,
+    Event,
     Exited,
     FailedToStart,
     GaveUp,
@@ -34,6 +36,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any
 
+    from mlaunch.engine.output import Printer
     from mlaunch.plan.events import ProcessView
 
 # The viewer stand-in (mlaunch.standins.viewer) prints its page's address as a line starting
@@ -43,33 +46,34 @@ VIEWER_ADDRESS = b"viewer: open "
 
 
 class Sayings:
-    """The words for the run's records; mlaunch.engine.output.Printer is the one subclass."""
+    """The words for the run's records, said through ``printer``."""
 
-    # Set up by the Printer: labels of viewer stand-ins, and core_pattern once read.
-    _viewers: set[str]
-    _core: tuple[str, bool, int] | None
+    def __init__(self, printer: Printer) -> None:
+        self.printer = printer
+        self.message = printer.message
+        self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
 
-    def message(self, level: str, source: str, text: str, *, always: bool = False) -> None:
-        raise NotImplementedError  # the Printer's: one line on screen and in launch.log
-
-    def register(self, label: str, index: int) -> None:
-        raise NotImplementedError  # the Printer's: a process's prefix and log file
+    def __call__(self, event: Event) -> None:
+        """Say ``event`` (records not in SAYINGS are not said)."""
+        method = SAYINGS.get(type(event))
+        if method is not None:
+            method(self, event)
 
     def _started(self, event: Started) -> None:
         process = event.process
         spec = process.spec
-        self.register(spec.label, process.index)
+        self.printer.register(spec.label, process.index)
         if spec.standin and process.restarts == 0:
             self.message(
                 "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
             )
             if VIEWER_MODULE in spec.argv:
-                self._viewers.add(spec.label)
+                self.printer.say_address_of(spec.label)
         self.message("INFO", spec.label, f"process started with pid [{process.pid}]")
 
     def _failed_to_start(self, event: FailedToStart) -> None:
         spec = event.process.spec
-        self.register(spec.label, event.process.index)
+        self.printer.register(spec.label, event.process.index)
         if spec.standin and event.process.restarts == 0:
             self.message(
                 "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
@@ -231,7 +235,7 @@ _VIA = {"ctl": " (mlaunch ctl)", "keys": " (--status keys)"}
 
 
 # Which words each record becomes (records not listed are not said; Output is the Printer's own).
-SAYINGS: dict[type, Callable[[Any, Any], None]] = {
+SAYINGS: dict[type, Callable[[Sayings, Any], None]] = {
     Started: Sayings._started,
     FailedToStart: Sayings._failed_to_start,
     NotStarted: Sayings._not_started,
