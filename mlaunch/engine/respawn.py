@@ -1,4 +1,4 @@
-"""Respawn policy: whether a process that exited starts again, and after how long.
+"""Respawn: whether a process that exited starts again, and after how long; the run's respawns.
 
 Crash loops back off: the first restart waits ``respawn_delay`` (often 0), and each further exit
 within STABLE_UPTIME of starting multiplies the wait by ``respawn_backoff``, up to
@@ -7,8 +7,18 @@ within STABLE_UPTIME of starting multiplies the wait by ``respawn_backoff``, up 
 
 from __future__ import annotations
 
-from mlaunch.engine.records import ProcessRecord
+from mlaunch.engine.records import GAVE_UP, RESTARTING, STOPPED, ProcessRecord
+from mlaunch.plan.events import GaveUp, RespawnScheduled
 from mlaunch.plan.steps import RespawnPolicy
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.timers import Timer, Timers
+    from mlaunch.plan.events import EventStream
+    from mlaunch.plan.steps import ProcessSpec
 
 # A crash loop's backoff starts over once a process has stayed up this long.
 STABLE_UPTIME = 10.0
@@ -48,3 +58,89 @@ def next_restart(policy: RespawnPolicy, record: ProcessRecord, code: int, uptime
     delay = respawn_delay(policy, record.streak)
     record.streak += 1
     return delay
+
+
+class Respawns:
+    """The respawns of one run: decided after each exit, waited for by label, cancelled or
+    hurried by the user (runtime control).
+
+    ``start(spec, restarts)`` starts a spec again (the supervisor's ``start``); ``forget(old)``
+    drops an ended instance from the run's list of processes.
+    """
+
+    def __init__(
+        self,
+        *,
+        records: dict[str, ProcessRecord],
+        timers: Timers,
+        events: EventStream,
+        clock: Callable[[], float],
+        start: Callable[[ProcessSpec, int], object],
+        forget: Callable[[Process], None],
+    ) -> None:
+        self.records = records
+        self.timers = timers
+        self.events = events
+        self.clock = clock
+        self.start = start
+        self.forget = forget
+        # Pending respawns by label: a user's stop or start cancels the one waiting.
+        self.waiting: dict[str, Timer] = {}
+
+    def after_exit(self, process: Process, code: int, *, shutting_down: bool) -> None:
+        """Start ``process`` again if the user asked for a restart, or if its policy says so
+        (after its delay), or give up on it."""
+        if process.user_stop == "restart":
+            if shutting_down:
+                self.records[process.label].not_restarting()
+            else:
+                self.start_again(process)  # at once: no backoff, the user asked for it
+            return
+        if shutting_down or process.stopping:
+            return
+        record = self.records[process.label]
+        uptime = process.ended_at - process.started_at
+        policy = process.spec.respawn
+        delay = next_restart(policy, record, code, uptime)
+        if delay == NO_RESTART:
+            return
+        if delay == GIVE_UP:
+            record.state = GAVE_UP
+            record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
+            self.events.emit(GaveUp(process, code, record.restarts))
+            return
+        attempt = record.restarts + 1
+        self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
+        record.state, record.restart_at = RESTARTING, self.clock() + delay
+        self.waiting[process.label] = self.timers.add(delay, lambda: self._due(process, attempt))
+
+    def _due(self, old: Process, attempt: int) -> None:
+        """Start the same spec again (same argv, label, temp files); forget the old instance."""
+        self.waiting.pop(old.label, None)
+        self.forget(old)
+        self.start(old.spec, attempt)
+
+    def cancel(self, label: str, outcome: str) -> None:
+        """The respawn ``label`` waits for does not happen: it stays down, ``outcome`` says why."""
+        self._cancel_timer(label)
+        record = self.records[label]
+        record.state, record.restart_at, record.outcome = STOPPED, None, outcome
+
+    def start_again(self, old: Process) -> object:
+        """Start ``old``'s spec again now, as the user asked.
+
+        It counts as a restart, but not against respawn's ``max_retries``, and respawn's
+        crash-loop backoff starts over: the user ended the last run, not a crash. A respawn
+        still waiting for its delay is cancelled.
+        """
+        self._cancel_timer(old.label)
+        record = self.records[old.label]
+        record.user_starts += 1
+        record.streak = 0
+        self.forget(old)
+        return self.start(old.spec, record.restarts + 1)
+
+    def _cancel_timer(self, label: str) -> None:
+        timer = self.waiting.pop(label, None)
+        if timer is not None:
+            timer.cancelled = True

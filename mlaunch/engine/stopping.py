@@ -1,8 +1,9 @@
-"""How a Supervisor stops: the two-phase shutdown, holding a process back, the second Ctrl-C.
+"""How a run stops: the two-phase shutdown, holding a process back, the second Ctrl-C.
 
-A base of mlaunch.engine.supervisor.Supervisor, apart so that module stays readable; the state it
-works on (processes, records, the stop ladder, the event stream ...) is the supervisor's own,
-declared here for the type checker only.
+``Shutdown`` is one object of the Supervisor (mlaunch.engine.supervisor) with state of its own:
+whether the run is shutting down and why, the processes held back from the stop ladder, the
+stop presses. What it acts on (the run's processes, their records, the stop ladder, the event
+stream, the timers) is handed to it when it is made.
 """
 
 from __future__ import annotations
@@ -16,52 +17,58 @@ from mlaunch.plan.events import Interrupted, ShutdownBegun, StoppingAll
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.engine import guard as guards
+    from collections.abc import Callable, Mapping
+
     from mlaunch.engine.ladder import StopLadder
     from mlaunch.engine.process import Process
     from mlaunch.engine.records import ProcessRecord
-    from mlaunch.engine.signals import SignalWatch
-    from mlaunch.engine.strays import Strays
     from mlaunch.engine.timers import Timers
     from mlaunch.plan.events import EventStream
 
 
-class Stopping:
-    """Shutdown and signal handling of a Supervisor (which sets every attribute below)."""
+class Shutdown:
+    """The shutdown of one run.
 
-    processes: list[Process]
-    lingering: list[Process]
-    by_pid: dict[int, Process]
-    records: dict[str, ProcessRecord]
-    timers: Timers
-    signals: SignalWatch
-    strays: Strays
-    guard: guards.Guard | None
-    events: EventStream
-    ladder: StopLadder
-    shutting_down: bool
-    shutdown_reason: str
-    exit_code: int
-    _held: set[Process]
-    _stop_presses: int
-    _kill_now: bool
+    ``processes`` and ``lingering`` are the supervisor's lists (kept up to date by it);
+    ``exit_status(code)`` raises the run's exit status to at least ``code``.
+    """
 
-    if TYPE_CHECKING:  # the supervisor's own, used by the emergency stop
+    def __init__(
+        self,
+        *,
+        events: EventStream,
+        timers: Timers,
+        records: Mapping[str, ProcessRecord],
+        ladder: StopLadder,
+        processes: list[Process],
+        lingering: list[Process],
+        exit_status: Callable[[int], None],
+    ) -> None:
+        self.events = events
+        self.timers = timers
+        self.records = records
+        self.ladder = ladder
+        self.processes = processes
+        self.lingering = lingering
+        self.exit_status = exit_status
+        self.active = False
+        self.reason = ""
+        # After a second Ctrl-C: strays too are killed without their grace.
+        self.kill_now = False
+        self._held: set[Process] = set()
+        self._presses = 0
 
-        def _reap(self) -> None: ...
-
-    # --- stopping ----------------------------------------------------------------------------
-
-    def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None:
+    def begin(self, reason: str, *, due_to_signal: int | None = None) -> None:
         """Shut the launch down, in two phases on the stream.
 
-        ShutdownBegun: the printer says why, OnShutdown handlers run (and may ``hold_stop``
-        a process); then StoppingAll: every process not held gets its stop ladder.
+        ShutdownBegun: the printer says why, OnShutdown handlers run (and may ``hold`` a
+        process); then StoppingAll: every process not held gets its stop ladder (``stop_all``,
+        the supervisor's reaction).
         """
-        if self.shutting_down:
+        if self.active:
             return
-        self.shutting_down = True
-        self.shutdown_reason = reason
+        self.active = True
+        self.reason = reason
         self.timers.shutting_down()  # pending respawns and TimerActions included
         for record in self.records.values():
             if record.state == RESTARTING:
@@ -69,16 +76,17 @@ class Stopping:
         self.events.emit(ShutdownBegun(reason, due_to_signal))
         self.events.emit(StoppingAll())
 
-    def _stop_all(self) -> None:
+    def stop_all(self) -> None:
+        """The stop ladder for every process not held, and for groups left by their leader."""
         for process in self.processes:
             if process.running and process not in self._held:
-                self.stop(process)
+                self.ladder.stop(process)
         for process in self.lingering:
             if process.check_group() and not process.stopping:
-                self.stop(process)
+                self.ladder.stop(process)
 
-    def hold_stop(self, process: Process) -> None:
-        """Keep ``process`` out of the stop ladder until ``release_stop`` (or a second Ctrl-C).
+    def hold(self, process: Process) -> None:
+        """Keep ``process`` out of the stop ladder until ``release`` (or a second Ctrl-C).
 
         For work that must happen while a process still runs at shutdown, such as deactivating
         a lifecycle node before it is signalled. Call it on ShutdownBegun: the ladder starts
@@ -86,63 +94,50 @@ class Stopping:
         """
         self._held.add(process)
 
-    def release_stop(self, process: Process) -> None:
+    def release(self, process: Process) -> None:
         """Hand a held process to the stop ladder (now, if the launch is shutting down)."""
         self._held.discard(process)
-        if self.shutting_down and process.running:
-            self.stop(process)
-
-    def stop(self, process: Process) -> None:
-        """The stop ladder for one process group (mlaunch.engine.ladder)."""
-        self.ladder.stop(process)
+        if self.active and process.running:
+            self.ladder.stop(process)
 
     def kill_everything(self) -> None:
         """A second Ctrl-C: SIGKILL every group and every stray at once."""
-        self._kill_now = True
+        self.kill_now = True
         self.ladder.kill(self.processes + self.lingering)
         self.events.emit(StoppingAll(kill=True))
-        self.begin_shutdown("killed")
+        self.begin("killed")
 
-    def _emergency_stop(self) -> None:
-        """The loop itself failed: kill everything we know of before the error propagates."""
-        try:
-            for process in self.processes + self.lingering:
-                if process.running or process.check_group():
-                    process.signal_group(signal.SIGKILL)
-            self.strays.kill_all(self.by_pid, self.guard.pid if self.guard is not None else None)
-            self._reap()
-        except Exception:
-            pass  # the original error is the one worth reporting
-
-    # --- signals -----------------------------------------------------------------------------
-
-    def _handle_signals(self) -> None:
-        pending = self.signals.pending
-        while pending:
-            sig = pending.pop(0)
-            if sig == signal.SIGCHLD:
-                self._reap()
-                continue
-            self._stop_pressed(sig)
-        self._reap()
-
-    def _handle_stop_signals(self) -> None:
-        """Act on the stop signals recorded so far; leave exits (SIGCHLD) for the loop."""
-        pending = self.signals.pending
-        i = 0
-        while i < len(pending):  # in place: the handler may append meanwhile
-            sig = pending[i]
-            if sig == signal.SIGCHLD:
-                i += 1
-                continue
-            del pending[i]
-            self._stop_pressed(sig)
-
-    def _stop_pressed(self, sig: int) -> None:
-        self._stop_presses += 1
-        if self._stop_presses == 1:
-            self.exit_code = max(self.exit_code, exit_for_signal(sig))
+    def pressed(self, sig: int) -> None:
+        """A stop signal (Ctrl-C, SIGTERM, SIGHUP): the first shuts down, the next kills."""
+        self._presses += 1
+        if self._presses == 1:
+            self.exit_status(exit_for_signal(sig))
             self.events.emit(Interrupted(sig))
-            self.begin_shutdown(f"{signal_name(sig)} received", due_to_signal=sig)
+            self.begin(f"{signal_name(sig)} received", due_to_signal=sig)
         else:
             self.kill_everything()
+
+
+def handle_signals(
+    pending: list[int], reap: Callable[[], None], pressed: Callable[[int], None]
+) -> None:
+    """Act on the signals recorded so far: exits (SIGCHLD) are reaped, the others pressed."""
+    while pending:
+        sig = pending.pop(0)
+        if sig == signal.SIGCHLD:
+            reap()
+            continue
+        pressed(sig)
+    reap()
+
+
+def handle_stop_signals(pending: list[int], pressed: Callable[[int], None]) -> None:
+    """Act on the stop signals recorded so far; leave exits (SIGCHLD) for the loop."""
+    i = 0
+    while i < len(pending):  # in place: the handler may append meanwhile
+        sig = pending[i]
+        if sig == signal.SIGCHLD:
+            i += 1
+            continue
+        del pending[i]
+        pressed(sig)

@@ -21,7 +21,8 @@ terminal holds the children's pipes unread instead of losing lines. The per-labe
 (mlaunch.engine.records) is what the status view and the exit summary read. Signals are recorded
 by mlaunch.engine.signals, timers are mlaunch.engine.timers, the respawn policy is
 mlaunch.engine.respawn, the launch file's event handlers are mlaunch.engine.handlers, and the
-shutdown and signal handling is the Stopping base (mlaunch.engine.stopping).
+shutdown is its ``Shutdown`` (mlaunch.engine.stopping), the respawns its ``Respawns``, and the
+plan's steps are carried out by its ``Executor`` (mlaunch.engine.executor).
 """
 
 from __future__ import annotations
@@ -29,56 +30,43 @@ from __future__ import annotations
 import itertools
 import os
 import selectors
+import signal
 import time
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
 
 from mlaunch.engine import guard as guards
 from mlaunch.engine import proctable
+from mlaunch.engine.executor import Executor
 from mlaunch.engine.handlers import LaunchHandlers
 from mlaunch.engine.ladder import StopLadder
 from mlaunch.engine.output import Printer
 from mlaunch.engine.pipes import Pipes
 from mlaunch.engine.process import Process, describe_status
 from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
-from mlaunch.engine.records import GAVE_UP, RESTARTING, RUNNING, STOPPED, ProcessRecord
-from mlaunch.engine.respawn import GIVE_UP, NO_RESTART, next_restart
+from mlaunch.engine.records import RESTARTING, RUNNING, STOPPED, ProcessRecord
+from mlaunch.engine.respawn import Respawns
 from mlaunch.engine.signals import SignalWatch
-from mlaunch.engine.stopping import Stopping
+from mlaunch.engine.stopping import Shutdown, handle_signals
 from mlaunch.engine.strays import STRAY_GRACE, Strays
 from mlaunch.engine.timers import Timer, Timers
-from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK, EXIT_USAGE, MlaunchError
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK
 from mlaunch.plan.events import (
-    Completed,
     Event,
     Exited,
     FailedToStart,
-    GaveUp,
-    HandedOff,
-    LaunchEvent,
     NotStarted,
     Output,
-    RespawnScheduled,
     Said,
     Started,
-    StartsSkipped,
     StoppingAll,
     StrayEnded,
-    Unclaimed,
 )
 from mlaunch.plan.steps import (
     AddHandler,
     Deferred,
-    EmitEvent,
-    Handoff,
-    Log,
-    Note,
     Plan,
     ProcessSpec,
-    RemoveHandler,
-    RequestShutdown,
-    Spawn,
-    StartTimer,
     Step,
 )
 from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve_deferred
@@ -93,7 +81,7 @@ if TYPE_CHECKING:
 POLL = 0.05
 
 
-class Supervisor(Stopping):
+class Supervisor:
     """Runs a Plan. Seams (printer, clock, guard, run id) are constructor arguments.
 
     The printer is subscribed to ``events`` first (after the supervisor's own reactions), then
@@ -139,8 +127,6 @@ class Supervisor(Stopping):
         self.lingering: list[Process] = []
         self.records: dict[str, ProcessRecord] = {}
         self.timers = Timers(clock)
-        # Pending respawns by label: a user's stop or start cancels the one waiting.
-        self.respawn_timers: dict[str, Timer] = {}
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
             self.run_id, adopt=adopt, grace=stray_grace, clock=clock, cgroup=cgroup
@@ -162,18 +148,83 @@ class Supervisor(Stopping):
         self.events.reactor = self.reactor
         self.selector = PartSelector(self._selector, self.reactor)
         self._index = itertools.count()
-        self.shutting_down = False
-        self._held: set[Process] = set()
-        self.shutdown_reason = ""
         self.exit_code = EXIT_OK
-        self._stop_presses = 0
-        self._skipped = 0  # starts a description asked for while shutting down
-        self._kill_now = False
+        self.shutdown = Shutdown(
+            events=self.events,
+            timers=self.timers,
+            records=self.records,
+            ladder=self.ladder,
+            processes=self.processes,
+            lingering=self.lingering,
+            exit_status=self.exit_status,
+        )
+        self.respawns = Respawns(
+            records=self.records,
+            timers=self.timers,
+            events=self.events,
+            clock=clock,
+            start=self.start,
+            forget=self._forget,
+        )
+        self.executor = Executor(
+            events=self.events,
+            timers=self.timers,
+            handlers=self.launch_handlers,
+            shutdown=self.shutdown,
+            signals=self.signals,
+            start=self.start,
+            resolve=lambda body, event: resolve_deferred(
+                body, labels=self.labels, options=self.options, event=event
+            ),
+            exit_status=self.exit_status,
+        )
         self._marker_env = {proctable.MARKER: self.run_id}
-        # Specs (by id) an OnExecutionComplete handler waited for when they were visited.
-        self._awaited: set[int] = set()
         # Work attached parts do outside the loop (composable node loads): keeps the run alive.
         self._work: set[object] = set()
+
+    # --- stopping (mlaunch.engine.stopping) ------------------------------------------------------
+
+    @property
+    def shutting_down(self) -> bool:
+        return self.shutdown.active
+
+    @property
+    def shutdown_reason(self) -> str:
+        return self.shutdown.reason
+
+    def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None:
+        """Shut the launch down (``Shutdown.begin``): ShutdownBegun, then StoppingAll."""
+        self.shutdown.begin(reason, due_to_signal=due_to_signal)
+
+    def hold_stop(self, process: Process) -> None:
+        """Keep ``process`` out of the stop ladder until ``release_stop`` (``Shutdown.hold``)."""
+        self.shutdown.hold(process)
+
+    def release_stop(self, process: Process) -> None:
+        self.shutdown.release(process)
+
+    def stop(self, process: Process) -> None:
+        """The stop ladder for one process group (mlaunch.engine.ladder)."""
+        self.ladder.stop(process)
+
+    def kill_everything(self) -> None:
+        """A second Ctrl-C: SIGKILL every group and every stray at once."""
+        self.shutdown.kill_everything()
+
+    def exit_status(self, code: int) -> None:
+        """The run's exit status is at least ``code`` (a failure, an interruption)."""
+        self.exit_code = max(self.exit_code, code)
+
+    def _emergency_stop(self) -> None:
+        """The loop itself failed: kill everything we know of before the error propagates."""
+        try:
+            for process in self.processes + self.lingering:
+                if process.running or process.check_group():
+                    process.signal_group(signal.SIGKILL)
+            self.strays.kill_all(self.by_pid, self.guard.pid if self.guard is not None else None)
+            self._reap()
+        except Exception:
+            pass  # the original error is the one worth reporting
 
     @property
     def process_records(self) -> Mapping[str, ProcessRecord]:
@@ -224,7 +275,7 @@ class Supervisor(Stopping):
         ready = self._selector.select(timeout)
         for key, _ in ready:
             key.data(key.fd)
-        self._handle_signals()
+        handle_signals(self.signals.pending, self._reap, self.shutdown.pressed)
         self.timers.run_due()
 
     def _finished(self) -> bool:
@@ -266,7 +317,7 @@ class Supervisor(Stopping):
     def _strays_pending(self) -> bool:
         """Processes of the run outside every group we watch: end them; True while any lives."""
         skip = self.guard.pid if self.guard is not None else None
-        alive, sent = self.strays.sweep(self.by_pid, skip, now_kill=self._kill_now)
+        alive, sent = self.strays.sweep(self.by_pid, skip, now_kill=self.shutdown.kill_now)
         for name, pid, sig in sent:
             self.events.emit(StrayEnded(name, pid, sig))
         return alive
@@ -300,102 +351,29 @@ class Supervisor(Stopping):
         text = f"{name} failed and was detached: {type(error).__name__}: {error}"
         if essential:
             text += "; the run cannot go on without it"
-            self.exit_code = max(self.exit_code, EXIT_INTERNAL)
+            self.exit_status(EXIT_INTERNAL)
         self.events.emit(Said("ERROR", "launch", text))
         if essential:
             self.begin_shutdown(f"{name} failed")
 
-    # --- plan steps ------------------------------------------------------------------------------
+    # --- plan steps (mlaunch.engine.executor) -----------------------------------------------
 
     def execute(self, steps: list[Step], warnings: list[str] | tuple[str, ...] = ()) -> None:
-        """Carry out a visited description's steps.
-
-        What they cause is queued on the event stream until every step has been carried out,
-        as launch handles events only after the description was visited: a handler
-        registered after a process in the same description still sees it start.
-        """
-        self.events.hold()
-        try:
-            for warning in warnings:
-                self.events.say_now(Said("WARNING", "launch", warning))
-            for step in steps:
-                if self.signals.pending:
-                    # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
-                    # after the last one started. Exits wait for the loop, as in ROS 2.
-                    self._handle_stop_signals()
-                self._step(step)
-            if self._skipped:
-                self.events.emit(StartsSkipped(self._skipped))  # once, not once per process
-                self._skipped = 0
-        finally:
-            self.events.release()
-
-    def _step(self, step: Step) -> None:
-        if isinstance(step, Spawn):
-            if step.spec is not None and self.shutting_down:
-                self._skipped += 1
-            elif step.spec is not None:
-                if self.launch_handlers.wants_completion(step.spec.action):
-                    self._awaited.add(id(step.spec))  # ExecutionComplete once it exits for good
-                self.start(step.spec)
-        elif isinstance(step, Log):
-            # LogInfo is no event in launch: it is said as it is visited.
-            self.events.say_now(Said(step.level, step.source, step.message))
-        elif isinstance(step, StartTimer):
-            self._start_timer(step)
-        elif isinstance(step, AddHandler):
-            self.launch_handlers.add(step)
-        elif isinstance(step, RemoveHandler):
-            self.launch_handlers.remove(step.handler)
-        elif isinstance(step, RequestShutdown):
-            self.begin_shutdown(step.reason)
-        elif isinstance(step, EmitEvent):
-            self.events.emit(LaunchEvent(step.event))
-        elif isinstance(step, Handoff):
-            # For the part that carries it out (the LoadNode driver): from the plan, a timer
-            # or a handler alike, in the order the steps are reached.
-            handed = HandedOff(step)
-            self.events.emit(handed)
-            self.events.emit(Unclaimed(handed))
-        elif not isinstance(step, Note):
-            raise TypeError(
-                f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"
-                " whatever adds this kind of step must also handle it"
-            )
-
-    def _start_timer(self, step: StartTimer) -> None:
-        body, action = step.body, step.action
-        awaited = action is not None and self.launch_handlers.wants_completion(action)
-        if body is None and not awaited:
-            return
-
-        def expire() -> None:
-            if body is not None:
-                self.fire(body, None)
-            if awaited:
-                self.events.emit(Completed(action))
-
-        self.timers.add(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
+        """Carry out a visited description's steps (``Executor.execute``)."""
+        self.executor.execute(steps, warnings)
 
     def fire(self, body: Deferred, event: Any) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
-        try:
-            plan = resolve_deferred(body, labels=self.labels, options=self.options, event=event)
-        except MlaunchError as e:
-            self.handler_failed(str(e))
-            return
-        self.execute(plan.steps, plan.warnings)
+        self.executor.fire(body, event)
 
     def handler_failed(self, message: str) -> None:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
-        self.events.emit(Said("ERROR", "launch", message))
-        self.exit_code = max(self.exit_code, EXIT_USAGE)
-        self.begin_shutdown("an event handler failed")
+        self.executor.handler_failed(message)
 
     def _react(self, event: Event) -> None:
         """The supervisor's own subscription: the stop ladder begins at StoppingAll."""
         if isinstance(event, StoppingAll) and not event.kill:
-            self._stop_all()
+            self.shutdown.stop_all()
 
     # --- processes ---------------------------------------------------------------------------
 
@@ -476,70 +454,19 @@ class Supervisor(Stopping):
         if spec.required and not process.stopping:
             # A required process decides the run: it ends it, and its failure is the run's.
             if code != 0:
-                self.exit_code = max(self.exit_code, EXIT_FAILURE)
+                self.exit_status(EXIT_FAILURE)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
-        self._maybe_respawn(process, code)
-        if id(spec) in self._awaited and self.records[spec.label].state != RESTARTING:
-            self._awaited.discard(id(spec))
-            self.events.emit(Completed(spec.action))
-
-    def _maybe_respawn(self, process: Process, code: int) -> None:
-        if process.user_stop == "restart":
-            if self.shutting_down:
-                self.records[process.label].not_restarting()
-            else:
-                self.start_again(process)  # at once: no backoff, the user asked for it
-            return
-        if self.shutting_down or process.stopping:
-            return
-        record = self.records[process.label]
-        uptime = process.ended_at - process.started_at
-        policy = process.spec.respawn
-        delay = next_restart(policy, record, code, uptime)
-        if delay == NO_RESTART:
-            return
-        if delay == GIVE_UP:
-            record.state = GAVE_UP
-            record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
-            self.events.emit(GaveUp(process, code, record.restarts))
-            return
-        attempt = record.restarts + 1
-        self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
-        record.state, record.restart_at = RESTARTING, self.clock() + delay
-        self.respawn_timers[process.label] = self.timers.add(
-            delay, lambda: self._respawn(process, attempt)
-        )
-
-    def _respawn(self, old: Process, attempt: int) -> None:
-        """Start the same spec again (same argv, label, temp files); forget the old instance."""
-        self.respawn_timers.pop(old.label, None)
-        self._forget(old)
-        self.start(old.spec, restarts=attempt)
+        self.respawns.after_exit(process, code, shutting_down=self.shutting_down)
+        if self.records[spec.label].state != RESTARTING:
+            self.executor.ended_for_good(spec)
 
     def cancel_respawn(self, label: str, outcome: str) -> None:
-        """The respawn ``label`` waits for does not happen: it stays down, ``outcome`` says why
-        (runtime control's stop of a crashed process)."""
-        timer = self.respawn_timers.pop(label, None)
-        if timer is not None:
-            timer.cancelled = True
-        record = self.records[label]
-        record.state, record.restart_at, record.outcome = STOPPED, None, outcome
+        """The respawn ``label`` waits for does not happen (runtime control's stop)."""
+        self.respawns.cancel(label, outcome)
 
-    def start_again(self, old: Process) -> Process | None:
-        """Start ``old``'s spec again now, as the user asked (mlaunch.parts.control).
-
-        It counts as a restart, but not against respawn's ``max_retries``, and respawn's
-        crash-loop backoff starts over: the user ended the last run, not a crash. A respawn
-        still waiting for its delay is cancelled.
-        """
-        timer = self.respawn_timers.pop(old.label, None)
-        if timer is not None:
-            timer.cancelled = True
-        record = self.records[old.label]
-        record.user_starts += 1
-        record.streak = 0
-        self._forget(old)
-        return self.start(old.spec, restarts=record.restarts + 1)
+    def start_again(self, old: Process) -> object:
+        """Start ``old``'s spec again now, as the user asked (``Respawns.start_again``)."""
+        return self.respawns.start_again(old)
 
     def _forget(self, old: Process) -> None:
         if not old.streams and old not in self.lingering and old in self.processes:

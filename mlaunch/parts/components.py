@@ -346,7 +346,7 @@ class ComponentDriver(Part):
 
         def fail() -> None:
             supervisor = self.supervisor
-            supervisor.exit_code = max(supervisor.exit_code, EXIT_FAILURE)
+            supervisor.exit_status(EXIT_FAILURE)
             supervisor.begin_shutdown(f"loading into container '{step.container_name}' failed")
 
         self.loop.call_soon(fail)

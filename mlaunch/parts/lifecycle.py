@@ -347,7 +347,7 @@ class LifecycleManager(Part):
             why = f" [{outcome.reason}]" if outcome.reason else ""
             self._say("ERROR", f"transition failed{why}: {result.detail}")
             if outcome.shutdown_on_failure and outcome.reason != "shutdown":
-                self.supervisor.exit_code = max(self.supervisor.exit_code, EXIT_FAILURE)
+                self.supervisor.exit_status(EXIT_FAILURE)
                 self.supervisor.begin_shutdown(
                     f"lifecycle node {result.node}: {result.transition} failed"
                 )
