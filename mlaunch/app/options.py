@@ -52,6 +52,7 @@ class Options:
         self.use_sim_time = use_sim_time
         self.capture = False  # --capture-at-definition (mlaunch.resolve.binding)
         self.scoped_parameters = False  # --scoped-parameters (mlaunch.launch_ros.scope)
+        self.ros: int | None = None  # --ros1 / --ros2: how a roslaunch file runs (None: by env)
         self.package_path: list[str] = [] if package_path is None else package_path
         self.standins = standins
         self.status = status
@@ -163,6 +164,24 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="resolve timers and event handlers with the values from where they are written,"
         " not (as ros2 launch) when they fire; per file: a comment"
         " 'mlaunch: capture-at-definition'",
+    )
+    ros = parser.add_mutually_exclusive_group()
+    ros.add_argument(
+        "--ros1",
+        dest="ros",
+        action="store_const",
+        const=1,
+        help="run a roslaunch file natively on ROS 1, as roslaunch does (a master, its parameter"
+        " server, ROS 1 command lines); the default in a shell set up for ROS 1 (ROS_VERSION=1,"
+        " ROS_DISTRO and ROS_MASTER_URI set)",
+    )
+    ros.add_argument(
+        "--ros2",
+        dest="ros",
+        action="store_const",
+        const=2,
+        help="run a roslaunch file on ROS 2 (its nodes mapped to ROS 2 ones, docs/ros1.md),"
+        " even in a shell set up for ROS 1",
     )
     parser.add_argument(
         "--scoped-parameters",
@@ -302,6 +321,7 @@ def parse_options(argv: Sequence[str]) -> Options:
             f" arguments as {opts.format}"
         )
     opts.scoped_parameters = ns.scoped_parameters
+    opts.ros = ns.ros
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
         opts.second = rest.pop(0)

@@ -126,8 +126,12 @@ def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
     return PackageSearch(opts.package_path, launch_file, os.environ)
 
 
-def load_target(opts: Options) -> tuple[str, LaunchDescription]:
-    """The launch file the command line names (a path, or PKG FILE) and its description."""
+def load_target(opts: Options, temp_dir: str | None = None) -> tuple[str, LaunchDescription]:
+    """The launch file the command line names (a path, or PKG FILE) and its description.
+
+    A roslaunch file runs natively on ROS 1 (``mlaunch.parts.ros1_native``, its files in
+    ``temp_dir``) with --ros1, or in a shell set up for ROS 1 unless --ros2 says otherwise.
+    """
     from mlaunch.ros.search import searching
 
     # `mlaunch PKG FILE` looks the package up with the search settings, before there is a file.
@@ -140,7 +144,27 @@ def load_target(opts: Options) -> tuple[str, LaunchDescription]:
     set_launch_argv(opts.target, opts.second, opts.launch_argv)
     # Launch-file code run while loading (get_package_share_directory) sees the same search.
     with searching(package_search(opts, path)):
+        if temp_dir is not None and native_ros1(opts, path):
+            from mlaunch.parts import ros1_native
+
+            return path, ros1_native.description(path, opts.arguments, os.environ, temp_dir)
         return path, readers.load(path)
+
+
+def native_ros1(opts: Options, path: str) -> bool:
+    """Whether a run of ``path`` is a native ROS 1 one (--ros1 / --ros2, else the shell)."""
+    from mlaunch import readers
+
+    roslaunch_file = readers.frontend_for(path) == readers.FRONTENDS[".launch"]
+    if opts.ros == 1 and not roslaunch_file:
+        from mlaunch.plan.errors import UsageError
+
+        raise UsageError(f"--ros1 runs roslaunch files (*.launch), not {path!r}")
+    if not roslaunch_file or opts.ros == 2:
+        return False
+    from mlaunch.parts import ros1_native  # (a roslaunch file: nothing on a ROS 2 run's path)
+
+    return opts.ros == 1 or ros1_native.wants_native(path, os.environ)
 
 
 def resolve_for_run(
@@ -189,7 +213,7 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
     # From here on a launch file's code and substitutions may start processes: signals, the
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
     with Lifeline() as life:
-        path, description = load_target(opts)
+        path, description = load_target(opts, temp_dir=life.temp_dir)
         streams_back(path)
         if opts.show_args:
             from mlaunch.resolve.describe import format_arguments

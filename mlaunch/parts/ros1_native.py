@@ -1,0 +1,255 @@
+"""A roslaunch file run natively on ROS 1, as roslaunch runs it, under mlaunch's supervision.
+
+``description(path, args, environ, temp_dir)`` resolves the file as roslaunch does
+(``mlaunch.ros1.config``) and returns the launch description that runs it:
+
+1. a master (``rosmaster --core``) and roscore.xml's nodes (rosout) when none answers at
+   ``ROS_MASTER_URI``, as roslaunch starts them;
+2. the parameter server loaded as roslaunch loads it (``mlaunch.parts.ros1_params``: /run_id,
+   ``clear_params``, then every parameter in one multicall);
+3. when that succeeded, every node with roslaunch's command line (launch-prefix, the program,
+   ``args`` split like a shell, remaps as ``from:=to``, ``__name:=``, ``__log:=``) and
+   environment (``ROS_MASTER_URI``, ``ROS_NAMESPACE``, its ``<env>``), ``required``,
+   ``respawn``/``respawn_delay`` and ``cwd`` (ROS_HOME, or the program's folder).
+
+ROS 1's Python nodes run with the system's Python: mlaunch's own virtual environment is taken
+out of their PATH, PYTHONPATH and VIRTUAL_ENV. Everything else is mlaunch's: labels, logs,
+--status, ctl, no orphans.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import shlex
+import sys
+import uuid
+from collections.abc import Mapping
+from typing import Any
+
+from mlaunch.plan.errors import LaunchFileError
+from mlaunch.ros1.actions import MappingWarning
+from mlaunch.ros1.config import Config, Ros1Node, load
+from mlaunch.ros1.lookup import package_finder
+
+DEFAULT_MASTER = "http://localhost:11311/"
+# Programs of older ROS 1 releases the seeds use -> what replaced them.
+RENAMED = {("robot_state_publisher", "state_publisher"): "robot_state_publisher"}
+
+
+def wants_native(path: str, environ: Mapping[str, str]) -> bool:
+    """A shell set up for ROS 1 (as a ROS 1 setup.bash leaves it) and a roslaunch file."""
+    ros1_shell = environ.get("ROS_VERSION") == "1" and bool(environ.get("ROS_DISTRO"))
+    return ros1_shell and bool(environ.get("ROS_MASTER_URI")) and is_roslaunch_file(path)
+
+
+def is_roslaunch_file(path: str) -> bool:
+    from mlaunch import readers
+
+    return readers.frontend_for(path) == readers.FRONTENDS[".launch"]
+
+
+def description(
+    path: str, args: Mapping[str, str], environ: Mapping[str, str], temp_dir: str
+) -> Any:
+    """The launch description of a native ROS 1 run of ``path``."""
+    from mlaunch.launch.actions import LaunchDescription
+
+    env = dict(environ)
+    config = load(path, args, environ=env, core=True)
+    uri = env.get("ROS_MASTER_URI") or DEFAULT_MASTER
+    env["ROS_MASTER_URI"] = uri
+    actions: list[Any] = [MappingWarning(w, path) for w in config.warnings]
+    from mlaunch.parts.ros1_params import master_ready
+
+    start_master = not master_ready(uri)
+    run_id = str(uuid.uuid1())
+    if start_master:
+        actions.append(master_process(uri, env))
+    loader = params_process(config, uri, run_id, temp_dir, env)
+    actions.append(loader)
+    for action in actions:
+        action.origin = f"{os.path.abspath(path)}:1"
+    nodes = [*(config.core_nodes if start_master else []), *config.nodes]
+    finder = package_finder(path, env)
+    processes: list[Any] = []
+    for number, node in enumerate(nodes, start=1):
+        process, message = node_process(node, finder, env, f"{run_id}", number)
+        if message:
+            actions.append(MappingWarning(message, node.origin))
+        if process is not None:
+            processes.append(process)
+    actions.append(after_loading(loader, processes))
+    return LaunchDescription(actions)
+
+
+def master_process(uri: str, env: dict[str, str]) -> Any:
+    """``rosmaster --core -p PORT``, as roslaunch starts it."""
+    import shutil
+
+    from mlaunch.launch.actions import ExecuteProcess
+
+    program = shutil.which("rosmaster", path=env.get("PATH"))
+    if program is None:
+        raise LaunchFileError(
+            f"no ROS master answers at {uri} and rosmaster is not installed (Debian:"
+            " apt-get install python3-rosmaster; or start roscore first)"
+        )
+    from urllib.parse import urlparse
+
+    port = str(urlparse(uri).port or 11311)
+    return ExecuteProcess(
+        cmd=[program, "--core", "-p", port, "-w", "3"],
+        name="master",
+        env=system_python_env(env),
+        required=True,
+        output="log",
+    )
+
+
+def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: Any) -> Any:
+    from mlaunch.launch.actions import ExecuteProcess
+
+    job = {
+        "master_uri": uri,
+        "run_id": run_id,
+        "clear_params": list(config.clear_params),
+        "params": dict(config.params),
+    }
+    os.makedirs(temp_dir, exist_ok=True)
+    job_file = os.path.join(temp_dir, f"ros1-params-{run_id}.pickle")
+    with open(job_file, "wb") as f:
+        pickle.dump(job, f)
+    return ExecuteProcess(
+        cmd=[sys.executable, "-m", "mlaunch.parts.ros1_params", job_file],
+        name="roslaunch_params",
+        env=env,
+        output="screen",
+    )
+
+
+def after_loading(loader: Any, processes: list[Any]) -> Any:
+    """The nodes start once the parameter server is loaded (roslaunch's order); a failed load
+    ends the run."""
+    from mlaunch.launch.actions import RegisterEventHandler, Shutdown
+    from mlaunch.launch.event_handlers import OnProcessExit
+
+    def on_exit(event: Any, context: Any) -> list[Any]:
+        if event.returncode != 0:
+            return [Shutdown(reason="the ROS 1 parameter server could not be loaded")]
+        return processes
+
+    return RegisterEventHandler(OnProcessExit(target_action=loader, on_exit=on_exit))
+
+
+def node_process(
+    node: Ros1Node, finder: Any, env: dict[str, str], run_id: str, number: int
+) -> tuple[Any, str]:
+    """The node's process as roslaunch starts it (its ``number``-th), and a warning: why it
+    cannot start (in roslaunch's words), or what it runs instead of an old name."""
+    from mlaunch.launch.actions import ExecuteProcess
+
+    program, note = find_node(node, finder)
+    if program is None:
+        return None, f"cannot launch node of type [{node.package}/{node.type}]: {note}"
+    log_dir = os.path.join(ros_log_dir(env), run_id)
+    os.makedirs(log_dir, exist_ok=True)  # roslaunch makes it (rosout writes its log there)
+    process_name = f"{node.full_name.lstrip('/')}-{number}"
+    argv = [
+        *shlex.split(node.launch_prefix or ""),
+        program,
+        *shlex.split(node.args),
+        *(f"{src}:={dst}" for src, dst in node.remaps),
+        f"__name:={node.name}",
+        f"__log:={os.path.join(log_dir, process_name.replace('/', '-') + '.log')}",
+    ]
+    node_env = system_python_env(env)
+    node_env.pop("ROS_NAMESPACE", None)
+    if node.namespace.rstrip("/"):
+        node_env["ROS_NAMESPACE"] = node.namespace.rstrip("/")
+    node_env.update({str(k): str(v) for k, v in node.env})
+    cwd = os.path.dirname(program) if node.cwd == "node" else ros_home(env)
+    os.makedirs(cwd, exist_ok=True)
+    process = ExecuteProcess(
+        cmd=argv,
+        name=node.name,
+        env=node_env,
+        cwd=cwd,
+        output="screen" if node.output == "screen" else "log",
+        respawn=node.respawn,
+        respawn_delay=node.respawn_delay or None,
+        required=node.required,
+    )
+    process.origin = node.origin
+    return process, note
+
+
+def find_node(node: Ros1Node, finder: Any) -> tuple[str | None, str]:
+    """roslib's find_node: the executable ``type`` in the package's libexec or its folder."""
+    kind, note = node.type, ""
+    renamed = RENAMED.get((node.package, kind))
+    if renamed is not None:
+        note = (
+            f"{node.package}/{kind} is the name of an older ROS 1 release:"
+            f" running {node.package}/{renamed}, which replaced it"
+        )
+        kind = renamed
+    try:
+        folder = finder(node.package)
+    except LaunchFileError as e:
+        return None, str(e)
+    for root in (os.path.join("/usr/lib", node.package), folder):
+        for base, _, files in os.walk(root):
+            if kind in files and os.access(os.path.join(base, kind), os.X_OK):
+                return os.path.join(base, kind), note
+    return None, f"Cannot locate node of type [{kind}] in package [{node.package}]"
+
+
+def system_python_env(env: Mapping[str, str]) -> dict[str, str]:
+    """The environment without mlaunch's virtual environment: ROS 1's Python programs
+    (``#!/usr/bin/env python3``) must find the system's Python and its packages."""
+    out = dict(env)
+    venv = sys.prefix if sys.prefix != sys.base_prefix else out.get("VIRTUAL_ENV")
+    system_first(out)
+    out.pop("VIRTUAL_ENV", None)
+    out.pop("PYTHONHOME", None)
+    if venv:
+        inside = os.path.realpath(venv) + os.sep
+
+        def keep(entry: str) -> bool:
+            return bool(entry) and not (os.path.realpath(entry) + os.sep).startswith(inside)
+
+        for name in ("PATH", "PYTHONPATH"):
+            if name in out:
+                kept = [e for e in out[name].split(os.pathsep) if keep(e)]
+                if kept:
+                    out[name] = os.pathsep.join(kept)
+                else:
+                    out.pop(name)
+    return out
+
+
+SYSTEM_PYTHON = "/usr/bin/python3"
+
+
+def system_first(env: dict[str, str]) -> None:
+    """``python3`` on PATH is the system's (where ROS 1's packages are): its folder goes
+    first when another one (a pyenv shim, a virtual environment) would be found before it."""
+    import shutil
+
+    if not os.access(SYSTEM_PYTHON, os.X_OK):
+        return
+    found = shutil.which("python3", path=env.get("PATH", os.defpath))
+    if found is not None and os.path.realpath(found) == os.path.realpath(SYSTEM_PYTHON):
+        return
+    folder = os.path.dirname(SYSTEM_PYTHON)
+    rest = [e for e in env.get("PATH", "").split(os.pathsep) if e and e != folder]
+    env["PATH"] = os.pathsep.join([folder, *rest])
+
+
+def ros_home(env: Mapping[str, str]) -> str:
+    return env.get("ROS_HOME") or os.path.join(env.get("HOME") or os.path.expanduser("~"), ".ros")
+
+
+def ros_log_dir(env: Mapping[str, str]) -> str:
+    return env.get("ROS_LOG_DIR") or os.path.join(ros_home(env), "log")
