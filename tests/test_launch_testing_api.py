@@ -30,7 +30,8 @@ from mlaunch.launch_testing.test_result import TestResult as LaunchTestResult
 from mlaunch.launch_testing.test_runner import LaunchTestRunner
 from mlaunch.launch_testing.util import NoMatchingProcessException, resolveProcesses
 
-# Every module of launch_testing 3.4.3 and launch_pytest 3.4.3 and the public names each holds.
+# Every module of launch_testing and launch_pytest 3.4.3 and launch_testing_ros 0.26.6, with the
+# public names each holds.
 UPSTREAM_LAYOUT = {
     "launch_testing": [
         "ActiveIoHandler",
@@ -106,6 +107,20 @@ UPSTREAM_LAYOUT = {
         "resolveProcesses",
     ],
     "launch_testing.util.proc_lookup": ["resolveProcesses"],
+    "launch_testing_ros": [
+        "DataRepublisher",
+        "LaunchTestRunner",
+        "MessagePump",
+        "WaitForTopics",
+        "tools",
+    ],
+    "launch_testing_ros.data_republisher": ["DataRepublisher"],
+    "launch_testing_ros.message_pump": ["MessagePump"],
+    "launch_testing_ros.pytest.hooks": ["LaunchROSTestItem", "LaunchROSTestModule"],
+    "launch_testing_ros.test_runner": ["LaunchTestRunner"],
+    "launch_testing_ros.tools": ["basic_output_filter"],
+    "launch_testing_ros.tools.output": ["basic_output_filter", "get_rmw_output_filter"],
+    "launch_testing_ros.wait_for_topics": ["WaitForTopics"],
     "launch_pytest": ["actions", "fixture", "tools"],
     "launch_pytest.actions": ["ReadyToTest"],
     "launch_pytest.fixture": ["fixture"],

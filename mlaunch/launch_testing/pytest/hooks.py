@@ -31,7 +31,7 @@ _ROS_IMPORT = re.compile(
     rb"^\s*(?:import|from)\s+(?:launch|launch_ros|launch_testing|launch_testing_ros|launch_pytest)\b",
     re.MULTILINE,
 )
-_LAUNCH_TEST_MARK = re.compile(rb"\bmark\.launch_test\b")
+_ENTRYPOINT = re.compile(rb"^(?:async\s+)?def\s+generate_test_description\b", re.MULTILINE)
 
 
 def version_tuple(version: str) -> tuple[int, ...]:
@@ -108,7 +108,7 @@ def collect_module(
     if serve_names is not None:
         serve_names()
     # Only files that may be launch tests are imported here (pytest imports the others itself).
-    if not _LAUNCH_TEST_MARK.search(source) or b"generate_test_description" not in source:
+    if not _ENTRYPOINT.search(source):
         return None
     entrypoint = getattr(
         import_test_module(module_path, parent.config), "generate_test_description", None
@@ -123,13 +123,9 @@ def collect_module(
 
 @pytest.hookimpl(trylast=True)
 def pytest_launch_collect_makemodule(path: Path, parent: Any, entrypoint: Any) -> Any:
-    marks = [m for m in getattr(entrypoint, "pytestmark", []) if m.name == "launch_test"]
-    if not marks:
+    if not any(mark.name == "launch_test" for mark in getattr(entrypoint, "pytestmark", [])):
         return None
-    module = LaunchTestModule.from_parent(parent, path=path)
-    for mark in getattr(entrypoint, "pytestmark", []):
-        module.add_marker(getattr(pytest.mark, mark.name).with_args(*mark.args, **mark.kwargs))
-    return module
+    return LaunchTestModule.marked_as(entrypoint, parent=parent, path=path)
 
 
 class LaunchTestFailure(Exception):
@@ -195,6 +191,14 @@ class LaunchTestItem(pytest.Item):
 
 class LaunchTestModule(pytest.File):
     """A launch_testing file: imported once, collected as one LaunchTestItem."""
+
+    @classmethod
+    def marked_as(cls, entrypoint: Any, *, parent: Any, path: Path) -> LaunchTestModule:
+        """The collector of ``path``, with the pytest marks of its generate_test_description."""
+        module: LaunchTestModule = cls.from_parent(parent, path=path)
+        for mark in getattr(entrypoint, "pytestmark", []):
+            module.add_marker(getattr(pytest.mark, mark.name).with_args(*mark.args, **mark.kwargs))
+        return module
 
     def makeitem(self, *, name: str, parent: Any, test_runs: Any) -> LaunchTestItem:
         return LaunchTestItem.from_parent(parent, name=name, test_runs=test_runs)
