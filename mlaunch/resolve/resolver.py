@@ -37,7 +37,9 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Mapping
     from contextlib import AbstractContextManager
-    from typing import Any
+    from typing import Any, TypeVar
+
+    R = TypeVar("R")
 
     from mlaunch.launch.launch_description import LaunchDescriptionEntity
     from mlaunch.ros.search import PackageSearch, searching
@@ -152,7 +154,7 @@ class Resolver:
         for entity in entities:
             self.visit(entity)
 
-    def call_user(self, function: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
         """Call launch-file code (OpaqueFunction), locating any exception in the user's file."""
         try:
             return function(*args, **kwargs)
@@ -190,7 +192,12 @@ class Resolver:
     def new_label(self, base: str) -> str:
         return self.labels.next(base)
 
-    def defer(self, entities: Iterable[Any], origin: str = "", callback: Any = None) -> Deferred:
+    def defer(
+        self,
+        entities: Iterable[object],
+        origin: str = "",
+        callback: Callable[..., object] | None = None,
+    ) -> Deferred:
         from mlaunch.plan.pragmas import file_captures
 
         entities = list(entities)
