@@ -21,7 +21,7 @@ from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch_ros.actions import LifecycleNode, Node
 
 from mlaunch.commands.smoke import Expect
-from mlaunch.parts.lifecycle import LifecycleSequence
+from mlaunch.launch_ros.lifecycle_sequence import LifecycleSequence
 
 NODES = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "nodes")
 VARIANTS = ("ok", "crash", "die_later", "ghost", "silent", "fail_configure")
