@@ -70,6 +70,14 @@ UPSTREAM_LAYOUT = {
     "launch_testing.io_handler": ["ActiveIoHandler", "IoHandler"],
     "launch_testing.junitxml": ["unittestCaseToXml", "unittestResultToXml", "unittestResultsToXml"],
     "launch_testing.launch_test": ["add_arguments", "main", "parse_arguments", "run"],
+    "launch_testing.legacy": ["LaunchTestService", "output"],
+    "launch_testing.legacy.output": [
+        "create_output_lines_filter",
+        "create_output_lines_test",
+        "create_output_regex_test",
+        "create_output_test_from_file",
+        "get_rmw_output_filter",
+    ],
     "launch_testing.loader": [
         "LoadTestsFromPythonModule",
         "PostShutdownTestLoader",

@@ -31,6 +31,26 @@ def get_default_filtered_patterns() -> list[str]:
     return []
 
 
+RMW_FILTER_TYPES = ("prefixes", "patterns")
+
+
+def registered_rmw_filters(rmw_implementation: str, filter_type: str) -> list[str]:
+    """The lines of output filters ``rmw_implementation`` registers in the ament index as its
+    ``rmw_output_prefixes`` or ``rmw_output_patterns`` resource (``filter_type``), one a line;
+    none when it registers none (launch_testing_ros and launch_testing.legacy read them)."""
+    if filter_type not in RMW_FILTER_TYPES:
+        raise TypeError(
+            f'Unsupported filter_type "{filter_type}". Supported types: {list(RMW_FILTER_TYPES)}'
+        )
+    from mlaunch.ros import ament_index
+
+    resource_type = "rmw_output_" + filter_type
+    if not ament_index.has_resource(resource_type, rmw_implementation):
+        return []
+    content, _ = ament_index.get_resource(resource_type, rmw_implementation)
+    return content.splitlines()
+
+
 def basic_output_filter(
     filtered_prefixes: list[str] | None = None, filtered_patterns: list[str] | None = None
 ) -> Callable[[str], str]:

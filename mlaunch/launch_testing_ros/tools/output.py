@@ -10,28 +10,18 @@ from mlaunch.launch_testing.tools.output import (
 from mlaunch.launch_testing.tools.output import (
     get_default_filtered_patterns,
     get_default_filtered_prefixes,
+    registered_rmw_filters,
 )
-from mlaunch.ros import ament_index
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-FILTER_TYPES = ("prefixes", "patterns")
-
 
 def get_rmw_output_filter(rmw_implementation: str, filter_type: str) -> list[str]:
     """The ``filter_type`` ('prefixes' or 'patterns') lines ``rmw_implementation`` registered
     in the ament index, one filter a line; none when it registered none."""
-    if filter_type not in FILTER_TYPES:
-        raise TypeError(
-            f'Unsupported filter_type "{filter_type}". Supported types: {list(FILTER_TYPES)}'
-        )
-    resource_type = "rmw_output_" + filter_type
-    if not ament_index.has_resource(resource_type, rmw_implementation):
-        return []
-    content, _ = ament_index.get_resource(resource_type, rmw_implementation)
-    return content.splitlines()
+    return registered_rmw_filters(rmw_implementation, filter_type)
 
 
 def basic_output_filter(
