@@ -3,13 +3,16 @@
 The Printer decides what is said; this module decides when the terminal takes it. Output is
 queued and written without blocking whenever fd 1 is writable (the supervisor's loop selects on
 it); above a high-water mark the supervisor stops reading its children's pipes until the queue
-drains, so a slow reader slows the children down and no line is lost. Only a reader that takes
-nothing at all for a while (a paused terminal) costs screen lines, counted and reported; the log
-files (mlaunch.engine.logfiles) get every line.
+drains, so a slow reader slows the children down and no line is lost. A reader much slower than
+that (a 30 KB/s link: ReaderPace measures it) costs a flooding process's excess screen lines
+instead, so that nobody's line waits a second behind a flood; and a reader that takes nothing
+at all for a while (a paused terminal) costs screen lines too. Both are counted and reported;
+the log files (mlaunch.engine.logfiles) get every line.
 """
 
 from __future__ import annotations
 
+import math
 import os
 import select
 import stat
@@ -34,6 +37,104 @@ SCREEN_CHUNK = 256 * 1024
 # still read, and their lines queue behind at most this much of the flood (head-of-line).
 SOURCE_HIGH_WATER = 32 * 1024
 SOURCE_LOW_WATER = 8 * 1024
+# A slow but steady reader (a slow ssh link, a 30 KB/s serial console): once its pace is known,
+# at most this many seconds of it wait in the kernel's buffer (a pipe holds 64 KiB: 2 s at
+# 30 KB/s), and at most SOURCE_SECONDS of one process's output in the queue; the rest of that
+# process's output is dropped from the screen (counted, said, kept in the logs), not held, so
+# a quiet process's line waits well under a second behind a flood whatever the reader's pace.
+KERNEL_SECONDS = 0.15
+SOURCE_SECONDS = 0.25
+PACE_WINDOW = 2.0  # seconds of the reader's recent progress its pace is measured over
+MIN_AHEAD = 4096  # never pace below a page: a slow reader still gets whole lines
+# Until the reader's pace is known (its first ~0.3 s of backlog), it may be a slow one: the
+# kernel gets at most this much, and one process holds from UNKNOWN_SOURCE_HIGH queued bytes.
+UNKNOWN_AHEAD = 8 * 1024
+MAX_AHEAD = 1 << 20  # a reader that keeps up: no pacing to speak of
+UNKNOWN_SOURCE_HIGH = 8 * 1024
+
+
+class ReaderPace:
+    """How fast the reader takes what is written to ``fd``, from the kernel's count of what it
+    has not read yet (FIONREAD of a pipe, TIOCOUTQ of a terminal or socket).
+
+    The pace (bytes/s) is measured only while the reader is the bottleneck: it took some and
+    left the rest in the buffer. A reader that empties the buffer keeps up: the bytes allowed
+    ahead of it double (``ahead``, from UNKNOWN_AHEAD) and its pace is unknown again. A stalled
+    reader (nothing taken) changes neither: that is the Screen's ``stall``.
+    """
+
+    def __init__(self, fd: int, mode: int, clock: Callable[[], float]) -> None:
+        import fcntl
+        import termios
+
+        self.fd, self.clock = fd, clock
+        self._ioctl = fcntl.ioctl
+        self._request = termios.FIONREAD if stat.S_ISFIFO(mode) else termios.TIOCOUTQ
+        self.written = 0  # bytes handed to the fd
+        self.ahead = UNKNOWN_AHEAD  # bytes the kernel may hold while the pace is unknown
+        self.progress_at = -math.inf  # when the reader last took something
+        self._taken = 0  # bytes the reader took (written - still in the kernel's buffer)
+        self._since: float | None = None  # since when the reader has had data to read
+        self._samples: deque[tuple[float, int]] = deque()  # (seconds, bytes) while saturated
+        self._span = 0.0
+        self._bytes = 0
+
+    def wrote(self, n: int) -> None:
+        """``n`` more bytes handed to the fd: the reader has something to read from now on."""
+        self.written += n
+        if self._since is None:
+            self._since = self.clock()
+
+    def unread(self) -> int | None:
+        """Bytes in the kernel's buffer not yet read, or None when the fd cannot say."""
+        buf = bytearray(4)
+        try:
+            self._ioctl(self.fd, self._request, buf)
+        except OSError:
+            return None
+        return int.from_bytes(buf, "little")
+
+    def sample(self) -> int | None:
+        """Note the reader's progress now; the bytes still unread."""
+        unread = self.unread()
+        if unread is None:
+            return None
+        now, taken = self.clock(), self.written - unread
+        if taken > self._taken:
+            self.progress_at = now
+            elapsed = 0.0 if self._since is None else now - self._since
+            size = taken - self._taken
+            if unread == 0 and size * KERNEL_SECONDS < self.ahead * elapsed:
+                self._add(elapsed, size)  # it emptied the buffer, but slowly: a slow reader
+                self._since = None
+            elif unread == 0:  # it kept up with what it was given: give it more, pace unknown
+                self.ahead = min(2 * self.ahead, MAX_AHEAD)
+                self._samples.clear()
+                self._span, self._bytes, self._since = 0.0, 0, None
+            elif self._since is not None:
+                self._add(now - self._since, taken - self._taken)
+                self._since = now
+            self._taken = taken
+        return unread
+
+    def _add(self, seconds: float, size: int) -> None:
+        self._samples.append((seconds, size))
+        self._span += seconds
+        self._bytes += size
+        while self._span - self._samples[0][0] >= PACE_WINDOW:
+            old_seconds, old_size = self._samples.popleft()
+            self._span, self._bytes = self._span - old_seconds, self._bytes - old_size
+
+    @property
+    def rate(self) -> float | None:
+        """Bytes per second, once 0.3 s of the reader being the bottleneck was seen."""
+        return self._bytes / self._span if self._span >= 0.3 else None
+
+    def room(self, unread: int) -> int:
+        """Bytes the kernel's buffer may take now."""
+        rate = self.rate
+        ahead = self.ahead if rate is None else max(MIN_AHEAD, int(rate * KERNEL_SECONDS))
+        return ahead - unread
 
 
 class Screen:
@@ -95,11 +196,16 @@ class Screen:
         self._by_source: dict[str, int] = {}
         self._owners: deque[tuple[str | None, int]] = deque()
         self._held_sources: set[str] = set()
+        self._pacing = False
+        self._overflow: dict[str, bytes] = {}  # a process's lines read beyond its share
+        self._noticed_at = -math.inf
         self._progress_at = 0.0  # the last write the reader took, or when output began waiting
         try:
-            self._regular = stat.S_ISREG(os.fstat(fd).st_mode)
+            mode = os.fstat(fd).st_mode
         except OSError:
-            self._regular = False
+            mode = 0
+        self._regular = stat.S_ISREG(mode)
+        self.pace = None if self._regular or not mode else ReaderPace(fd, mode, clock)
 
     def __call__(self, data: bytes) -> None:
         self.write(data)
@@ -114,18 +220,72 @@ class Screen:
         (counted) unless ``urgent``."""
         if self.gone:
             return
+        if source is None or urgent or self.pace is None:
+            if self._overflow:  # mlaunch's word about a process comes after that one's lines
+                self._spill()
+            self._enqueue(data, urgent=urgent, source=source)
+        else:
+            self._admit(data, source)
+
+    def _enqueue(self, data: bytes, *, urgent: bool = False, source: str | None = None) -> None:
         if self._size + len(data) > self.limit and not urgent:
-            self.dropped_lines += data.count(b"\n")
-            self.dropped_bytes += len(data)
+            self._drop(data)
             return
         if not self._queue:
             self._progress_at = self.clock()  # the stall clock starts when output waits
-        if self.dropped_bytes != self._noted_bytes and not urgent:
+        if self.dropped_bytes != self._noted_bytes and not urgent and self._notice_due():
             # Room again after a gap: say so right where the lines are missing.
             self._append(self._drop_notice())
         self._append(data, source)
         if self._size >= SCREEN_CHUNK:
             self.flush()
+
+    def _drop(self, data: bytes) -> None:
+        self.dropped_lines += data.count(b"\n")
+        self.dropped_bytes += len(data)
+
+    def _notice_due(self) -> bool:
+        """A notice at most once a second: a flood dropped on a slow reader gaps every write."""
+        return self.clock() - self._noticed_at >= 1.0
+
+    def _marks(self) -> tuple[int, int, int | None]:
+        """(hold mark, release mark, drop cap) of one process's queued bytes for this reader."""
+        high, low = self.source_high_water, self.source_low_water
+        rate = None if self.pace is None else self.pace.rate
+        if rate is None:  # maybe a slow reader: hold early
+            return min(high, UNKNOWN_SOURCE_HIGH), min(low, UNKNOWN_SOURCE_HIGH // 4), None
+        cap = max(MIN_AHEAD, int(rate * SOURCE_SECONDS))
+        return high, low, cap if cap < high else None
+
+    def _admit(self, data: bytes, source: str) -> None:
+        """Queue a process's lines up to its share; a slow reader's excess is dropped, else kept
+        aside (in order) until the terminal has taken its queued lines. One read of a pipe can
+        be 64 KiB: queued whole, a quiet process's line would wait behind all of it."""
+        if source in self._overflow:
+            self._overflow[source] += data
+            return
+        queued = self.queued(source)
+        high, _, cap = self._marks()
+        head, rest = _split(data, (high if cap is None else cap) - queued, queued == 0)
+        if head:
+            self._enqueue(head, source=source)
+        if rest and cap is not None:
+            self._drop(rest)
+        elif rest:
+            self._overflow[source] = rest
+
+    def _feed(self) -> None:
+        """Queue what was kept aside of the processes whose queued lines the terminal took."""
+        low = self._marks()[1]
+        for source in [s for s in self._overflow if self.queued(s) < low]:
+            self._admit(self._overflow.pop(source), source)
+
+    def _spill(self, source: str | None = None) -> None:
+        """Queue what was kept aside (of ``source``, or of everyone) as it is."""
+        for name in [source] if source is not None else list(self._overflow):
+            data = self._overflow.pop(name, None)
+            if data:
+                self._enqueue(data, source=name)
 
     def _append(self, data: bytes, source: str | None = None) -> None:
         self._queue.append(data)
@@ -169,13 +329,20 @@ class Screen:
     @property
     def blocked(self) -> bool:
         """Output is waiting for the terminal."""
-        return bool(self._queue) and not self.gone
+        return (bool(self._queue) or bool(self._overflow)) and not self.gone
 
-    waiting = blocked
+    @property
+    def waiting(self) -> bool:
+        """Output waits and the terminal may take it when writable (not while pacing a slow
+        reader: its fd is writable long before it should be written; the loop polls then)."""
+        return self.blocked and not self._pacing
 
     def stalled(self) -> bool:
         """Output waits and the reader has taken nothing for ``stall`` seconds."""
-        return self.blocked and self.clock() - self._progress_at >= self.stall
+        progress = self._progress_at
+        if self.pace is not None:  # paced writes are rare: the reader's own progress counts
+            progress = max(progress, self.pace.progress_at)
+        return self.blocked and self.clock() - progress >= self.stall
 
     def holding(self, source: str | None = None) -> bool:
         """Whether the producers (or process ``source``) should wait for the reader.
@@ -194,12 +361,19 @@ class Screen:
             return not self.stalled()
         if source is None or self.gone:
             return False
+        if source in self._overflow:
+            self._feed()
+            if source in self._overflow:
+                if not self.stalled():
+                    return True
+                self._spill(source)  # a stalled reader holds nobody: the limit drops
         queued = self._by_source.get(source, 0)
+        high, low, _ = self._marks()
         if source in self._held_sources:
-            if queued < self.source_low_water:
+            if queued < low:
                 self._held_sources.discard(source)
                 return False
-        elif queued < self.source_high_water:
+        elif queued < high:
             return False
         else:
             self._held_sources.add(source)
@@ -207,16 +381,22 @@ class Screen:
 
     def flush(self) -> None:
         """Write what the terminal takes now; keep the rest queued."""
+        if self._overflow and not self.gone:
+            self._feed()
         if not self._queue or self.gone:
+            return
+        room = self._room()
+        self._pacing = room is not None and room <= 0
+        if self._pacing:
             return
         nonblocking = not self._regular and os.get_blocking(self.fd)
         if nonblocking:
             os.set_blocking(self.fd, False)
         try:
-            self._write_queue()
+            self._write_queue(room)
             if not self._queue and self.dropped_bytes != self._noted_bytes:
                 self._append(self._drop_notice())
-                self._write_queue()
+                self._write_queue(room)
         finally:
             if nonblocking:
                 try:
@@ -224,9 +404,16 @@ class Screen:
                 except OSError:
                     pass
 
-    def _write_queue(self) -> None:
+    def _room(self) -> int | None:
+        """Bytes the kernel's buffer may take now (None: as much as it takes)."""
+        if self.pace is None:
+            return None
+        unread = self.pace.sample()
+        return None if unread is None else self.pace.room(unread)
+
+    def _write_queue(self, room: int | None = None) -> None:
         queue = self._queue
-        while queue:
+        while queue and (room is None or room > 0):
             if len(queue) > 1 and len(queue[0]) - self._offset < SCREEN_CHUNK:
                 # Many small pieces (one per line burst) go out in one write.
                 parts, size = [], 0
@@ -238,9 +425,12 @@ class Screen:
                     parts.append(part)
                 queue.appendleft(b"".join(parts))
             head = queue[0]
+            view = memoryview(head)[self._offset :] if self._offset else head
+            if room is not None:
+                view = memoryview(head)[self._offset : self._offset + room]
             try:
                 # A partial write keeps an offset into the head: the rest is never copied.
-                n = os.write(self.fd, memoryview(head)[self._offset :] if self._offset else head)
+                n = os.write(self.fd, view)
             except BlockingIOError:
                 return
             except OSError:
@@ -253,6 +443,10 @@ class Screen:
             if n > 0:
                 self._progress_at = self.clock()
                 self._taken(n)
+                if self.pace is not None:
+                    self.pace.wrote(n)
+                if room is not None:
+                    room -= n
             self._size -= n
             self._offset += n
             if self._offset < len(head):
@@ -261,6 +455,7 @@ class Screen:
             self._offset = 0
 
     def _drop_notice(self) -> bytes:
+        self._noticed_at = self.clock()
         lines = self.dropped_lines - self._noted_lines
         size = self.dropped_bytes - self._noted_bytes
         self._noted_lines, self._noted_bytes = self.dropped_lines, self.dropped_bytes
@@ -272,10 +467,25 @@ class Screen:
     def close(self, timeout: float = 2.0) -> None:
         """Give the terminal up to ``timeout`` seconds to take what is still queued."""
         deadline = time.monotonic() + timeout
+        self._spill()
         self.flush()
         while self.blocked:
             left = deadline - time.monotonic()
             if left <= 0:
                 break
-            select.select([], [self.fd], [], left)
+            if self._pacing:  # writable long before it should be written: wait a moment
+                time.sleep(min(left, 0.02))
+            else:
+                select.select([], [self.fd], [], left)
             self.flush()
+
+
+def _split(data: bytes, size: int, first: bool) -> tuple[bytes, bytes]:
+    """``data`` cut after its last whole line within ``size`` bytes (the first line at least
+    when ``first``: a process with nothing queued always gets a line out)."""
+    if len(data) <= size:
+        return data, b""
+    end = data.rfind(b"\n", 0, max(size, 0)) + 1
+    if end == 0 and first:
+        end = data.find(b"\n") + 1 or len(data)
+    return data[:end], data[end:]
