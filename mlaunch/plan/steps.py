@@ -384,7 +384,17 @@ def step_needs(step: Step) -> frozenset[Need]:
 class ArgumentInfo(Record):
     """A declared launch argument, for --show-args and CLI checks."""
 
-    _fields = ("name", "default", "description", "choices", "origin", "conditional", "value")
+    _fields = (
+        "name",
+        "default",
+        "description",
+        "choices",
+        "origin",
+        "conditional",
+        "value",
+        "resolved",
+        "passed_by",
+    )
     __slots__ = _fields
 
     def __init__(
@@ -406,6 +416,11 @@ class ArgumentInfo(Record):
         # The value the run gave it where it was first declared (resolve sets it; --show-args
         # does not resolve, so None there).
         self.value = value
+        # --show-args: the default worked out before running, when it has substitutions that
+        # can be (a package's path); None when it is plain text or cannot be.
+        self.resolved: str | None = None
+        # --show-args: where an including file passes it (file:line), so it is not required.
+        self.passed_by = ""
 
 
 class Plan(Record):

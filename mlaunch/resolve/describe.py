@@ -141,7 +141,13 @@ def _flatten(params: dict[str, object], prefix: str = "") -> list[tuple[str, obj
 
 
 def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
-    """The --show-args table: name, default, description (and choices), conditional marked."""
+    """The --show-args table: name, default, description (and choices), conditional marked.
+
+    A default with substitutions shows the value they give where it can be worked out before
+    running (a package's path), else their description; one longer than its column goes whole
+    on a line of its own below the row (never cut or wrapped: it is often a path to copy). An
+    argument an including file passes is not required.
+    """
     if not infos:
         return "No arguments.\n"
     import textwrap
@@ -151,26 +157,34 @@ def format_arguments(infos: Sequence[ArgumentInfo]) -> str:
     for info in infos:
         name = info.name + ("*" if info.conditional else "")
         any_conditional |= info.conditional
-        default = "(required)" if info.default is None else repr(info.default)
-        rows.append((name, default, info.description))
+        rows.append((name, _default_text(info), info.description))
     w_name = max(len("name"), *(len(r[0]) for r in rows))
-    w_def = min(36, max(len("default"), *(len(r[1]) for r in rows)))
+    w_def = max([len("default"), *(len(r[1]) for r in rows if len(r[1]) <= 36)])
     width = max(40, _terminal_width() - w_name - w_def - 6)
     out = ["Arguments (pass arguments as '<name>:=<value>'):", ""]
     out.append(f"  {'name':<{w_name}}  {'default':<{w_def}}  description")
     out.append(f"  {'-' * w_name}  {'-' * w_def}  {'-' * min(width, 40)}")
     for name, default, description in rows:
         lines = textwrap.wrap(description, width) or [""]
-        # A long default wraps in its column rather than being cut: it is often a path to copy.
-        defaults = [default[i : i + w_def] for i in range(0, len(default), w_def)]
-        for i in range(max(len(lines), len(defaults))):
-            left = name if i == 0 else ""
-            shown = defaults[i] if i < len(defaults) else ""
-            text = lines[i] if i < len(lines) else ""
-            out.append(f"  {left:<{w_name}}  {shown:<{w_def}}  {text}".rstrip())
+        long = len(default) > w_def
+        for i, text in enumerate(lines):
+            shown = "(below)" if long and i == 0 else (default if i == 0 else "")
+            out.append(f"  {name if i == 0 else '':<{w_name}}  {shown:<{w_def}}  {text}".rstrip())
+        if long:
+            out.append(f"  {'':<{w_name}}  default: {default}")
     if any_conditional:
         out += ["", "* argument(s) which are only used if specific conditions occur"]
     return "\n".join(out) + "\n"
+
+
+def _default_text(info: ArgumentInfo) -> str:
+    if info.default is not None:
+        return repr(info.resolved if info.resolved is not None else info.default)
+    if info.passed_by:
+        where = info.passed_by
+        file, sep, line = where.rpartition(":")
+        return f"(passed by {os.path.basename(file)}:{line})" if sep else f"(passed by {where})"
+    return "(required)"
 
 
 def _terminal_width() -> int:

@@ -436,27 +436,37 @@ def collect_arguments(
     context.launch_configurations.update(arguments)
     seen: set[str] = set()
 
-    def declare(roots: list[object], conditional: bool) -> None:
-        for visit in walk(roots, include=include):
+    def declare(roots: list[object], conditional: bool, passed: Mapping[str, str]) -> None:
+        """Declare what ``roots`` declare; ``passed``: the names an including file passes."""
+
+        def include_here(entity: object, conditional: bool) -> list[object]:
+            return include(entity, conditional, passed)
+
+        for visit in walk(roots, include=include_here):
             entity = visit.entity
             if not isinstance(entity, DeclareLaunchArgument):
                 continue
-            info = entity.argument_info(conditional or visit.conditional)
-            found.setdefault(info.name, info)
+            info = found.setdefault(
+                entity.name, entity.argument_info(conditional or visit.conditional)
+            )
+            info.passed_by = info.passed_by or passed.get(info.name, "")
             if info.name not in context.launch_configurations and entity.default_value:
                 try:
-                    context.launch_configurations[info.name] = perform_substitutions(
-                        context, entity.default_value
-                    )
+                    value = perform_substitutions(context, entity.default_value)
                 except MlaunchError:
-                    pass
+                    continue
+                context.launch_configurations[info.name] = value
+                if info.default != value:
+                    info.resolved = value
 
-    def include(entity: object, conditional: bool) -> list[object]:
+    def include(entity: object, conditional: bool, passed: Mapping[str, str]) -> list[object]:
         """Declare what a statically found include declares, with its file's locals; the walk
         goes on after it (so the order of declarations is the file's)."""
+        passed = {**passed, **_passed_names(entity, context)}
         source = entity.launch_description_source  # type: ignore[attr-defined]
         if source.launch_description is not None:
-            return [source.launch_description]
+            declare([source.launch_description], conditional, passed)
+            return []
         try:
             location = source.get_launch_file_location(context)
         except (MlaunchError, SubstitutionFailure):
@@ -467,12 +477,24 @@ def collect_arguments(
         from mlaunch import readers
 
         with context.file_locals(location):
-            declare([readers.load(location, source.format_hint)], conditional)
+            declare([readers.load(location, source.format_hint)], conditional, passed)
         return []
 
     if path is None:
-        declare([description], False)
+        declare([description], False, {})
     else:
         with context.file_locals(path):
-            declare([description], False)
+            declare([description], False, {})
     return list(found.values())
+
+
+def _passed_names(include: Any, context: LaunchContext) -> dict[str, str]:
+    """The argument names an IncludeLaunchDescription passes -> its origin (file:line)."""
+    names = {}
+    for name, _value in getattr(include, "launch_arguments", None) or ():
+        try:
+            text = name if isinstance(name, str) else perform_substitutions(context, name)
+        except MlaunchError:
+            continue
+        names[text] = getattr(include, "origin", "") or "the including file"
+    return names
