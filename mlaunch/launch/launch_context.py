@@ -114,6 +114,10 @@ class LaunchContext:
     def get_locals_as_dict(self) -> dict[str, Any]:
         return {**self._globals, **self._locals}
 
+    def get_locals_as_dict_of_scope(self) -> dict[str, Any]:
+        """The locals of this context alone (the run's globals left out)."""
+        return dict(self._locals)
+
     def extend_locals(self, values: Mapping[str, Any]) -> None:
         self._locals.update(values)
 

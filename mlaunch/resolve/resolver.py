@@ -355,6 +355,10 @@ def resolve_deferred(
     # the live context's locals (and planner) are the event's only now
     saved = context._locals, context._warn, context._planner
     context._locals, context._warn = dict(saved[0]), plan.warnings.append
+    if isinstance(deferred.captured, LaunchContext):
+        # The locals where the body was written (ThisLaunchFileDir, $(dirname) ...), as launch's
+        # TimerAction restores the locals it captured: the file visited last is not the body's.
+        context._locals.update(deferred.captured.get_locals_as_dict_of_scope())
     if event is not None:
         context.extend_locals({"event": event})
     resolver = Resolver(context, plan, labels=labels, options=options)
