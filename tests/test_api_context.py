@@ -83,7 +83,9 @@ def test_event_handler_matches_and_handles_as_upstream() -> None:
     with pytest.raises(ValueError):  # handled once: it unregistered itself
         handler.handle(event, context)
 
-    target = object()
+    from launch.actions import ExecuteProcess
+
+    target = ExecuteProcess(cmd=["true"])
     on_start = OnProcessStart(target_action=target, on_start=[])
     assert on_start.matches(ProcessStarted(action=target))
     assert not on_start.matches(ProcessStarted(action=object()))
@@ -158,3 +160,36 @@ def test_an_action_describes_its_sub_entities() -> None:
     assert conditional.describe_sub_entities() == []
     ((why, entities),) = conditional.describe_conditional_sub_entities()
     assert why.startswith("Conditionally included by") and list(entities) == [inner]
+
+
+def test_process_handlers_check_targets_and_call_callables_as_upstream() -> None:
+    from launch import LaunchContext
+    from launch.actions import ExecuteProcess, LogInfo
+    from launch.event_handlers import OnExecutionComplete, OnProcessExit, OnProcessIO
+    from launch.events.process import ProcessExited, ProcessIO
+
+    with pytest.raises(TypeError, match="target_action"):
+        OnProcessExit(target_action=LogInfo(msg="not a process"), on_exit=[])
+    with pytest.raises(TypeError, match="target_action"):
+        OnExecutionComplete(target_action="text", on_completion=[])
+    with pytest.raises(TypeError, match="launch entities"):
+        OnProcessExit(on_exit=["not an action"])
+    process = ExecuteProcess(cmd=["true"])
+    seen: list[object] = []
+    by_name = OnProcessExit(
+        target_action=lambda action: action is process,
+        on_exit=lambda event, context: seen.append(event),
+    )
+    event = ProcessExited(action=process, returncode=0)
+    assert by_name.matches(event) and not by_name.matches(ProcessExited(action=object()))
+    assert by_name.handle(event, LaunchContext()) == [] and seen == [event]
+
+    streams: list[str] = []
+    io = OnProcessIO(
+        on_stdin=lambda e: streams.append("in"),
+        on_stdout=lambda e: streams.append("out"),
+        on_stderr=lambda e: streams.append("err"),
+    )
+    for fd in (0, 1, 2):
+        io.handle(ProcessIO(action=process, text=b"x", fd=fd), LaunchContext())
+    assert streams == ["in", "out", "err"]

@@ -21,11 +21,43 @@ def _as_entities(value: Any) -> tuple[list[Any], Callable[..., Any] | None]:
     """Split ``on_*`` into entities or a callable(event, context) -> entities."""
     if value is None:
         return [], None
-    if callable(value) and not hasattr(value, "visit"):
+    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+
+    if callable(value) and not isinstance(value, LaunchDescriptionEntity):
         return [], value
     if isinstance(value, Iterable) and not isinstance(value, (str, bytes)):
-        return list(value), None
+        entities = list(value)
+        for entity in entities:
+            if not isinstance(entity, LaunchDescriptionEntity):
+                raise TypeError(
+                    "expected all items in the handler's entities to be launch entities"
+                    f" (actions, descriptions), got {type(entity).__name__}: {entity!r:.60}"
+                )
+        return entities, None
     return [value], None
+
+
+def _is_predicate(target: Any) -> bool:
+    """A target given as a function of the action (launch tries this before identity)."""
+    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+
+    return callable(target) and not isinstance(target, LaunchDescriptionEntity)
+
+
+def check_target(target: Any, handler: str, target_class: type, what: str) -> None:
+    """launch's TypeError for a target that is neither ``target_class``, a callable nor None."""
+    if target is None or callable(target) or isinstance(target, target_class):
+        return
+    raise TypeError(
+        f"{handler}: target_action must be {what} or a callable, got"
+        f" {type(target).__name__}: {target!r:.60}"
+    )
+
+
+def _process_target(target: Any, handler: str) -> None:
+    from mlaunch.launch.execute_process import ExecuteProcess
+
+    check_target(target, handler, ExecuteProcess, "an ExecuteProcess (or Node) action")
 
 
 def returned_entities(result: Any) -> list[Any]:
@@ -62,7 +94,7 @@ class EventHandler:
         target = self.target_action
         if target is None:
             return self.custom_matcher
-        if callable(target) and not hasattr(target, "visit"):
+        if _is_predicate(target):
             return lambda spec: bool(target(spec.action))
         return lambda spec: spec.action is target
 
@@ -86,7 +118,7 @@ class EventHandler:
         if target is None:
             return True
         action = getattr(event, "action", None)
-        if callable(target) and not hasattr(target, "visit"):
+        if _is_predicate(target):
             return bool(target(action))
         return action is target
 
@@ -146,6 +178,7 @@ class OnProcessStart(EventHandler):
         return events.ProcessStarted
 
     def __init__(self, *, target_action: Any = None, on_start: Any, handle_once: bool = False):
+        _process_target(target_action, "OnProcessStart")
         super().__init__(target_action=target_action, entities=on_start, handle_once=handle_once)
 
 
@@ -158,6 +191,7 @@ class OnProcessExit(EventHandler):
         return events.ProcessExited
 
     def __init__(self, *, target_action: Any = None, on_exit: Any, handle_once: bool = False):
+        _process_target(target_action, "OnProcessExit")
         super().__init__(target_action=target_action, entities=on_exit, handle_once=handle_once)
 
 
@@ -180,10 +214,25 @@ class OnProcessIO(EventHandler):
         on_stderr: Callable[[Any], Any] | None = None,
         handle_once: bool = False,
     ) -> None:
+        _process_target(target_action, "OnProcessIO")
         super().__init__(target_action=target_action, handle_once=handle_once)
         self.io_callbacks = {
             k: v for k, v in (("stdout", on_stdout), ("stderr", on_stderr)) if v is not None
         }
+        self.on_stdin = on_stdin
+
+    def handle(self, event: Any, context: Any) -> list[Any] | None:
+        """The callback of the event's stream (stdin, stdout, stderr), given the event."""
+        context.extend_locals({"event": event})
+        if self.handle_once:
+            context.unregister_event_handler(self)
+        streams: dict[Any, Callable[[Any], Any] | None] = {
+            0: self.on_stdin,
+            1: self.io_callbacks.get("stdout"),
+            2: self.io_callbacks.get("stderr"),
+        }
+        callback = streams.get(getattr(event, "fd", None))
+        return None if callback is None else returned_entities(callback(event))
 
 
 class OnShutdown(EventHandler):
@@ -212,6 +261,9 @@ class OnExecutionComplete(EventHandler):
     def __init__(
         self, *, target_action: Any = None, on_completion: Any, handle_once: bool = False
     ) -> None:
+        from mlaunch.launch.launch_description import Action
+
+        check_target(target_action, "OnExecutionComplete", Action, "an action")
         super().__init__(
             target_action=target_action, entities=on_completion, handle_once=handle_once
         )
