@@ -157,9 +157,10 @@ def test_conditions_are_strict(ctx: LaunchContext) -> None:
 
 
 def test_launch_configuration_equals(ctx: LaunchContext) -> None:
-    assert LaunchConfigurationEquals("robot", "rb1").evaluate(ctx)
-    assert LaunchConfigurationNotEquals("robot", "rb2").evaluate(ctx)
-    assert LaunchConfigurationEquals("unset", None).evaluate(ctx)
+    with pytest.warns(UserWarning, match="deprecated"):  # as launch warns
+        assert LaunchConfigurationEquals("robot", "rb1").evaluate(ctx)
+        assert LaunchConfigurationNotEquals("robot", "rb2").evaluate(ctx)
+        assert LaunchConfigurationEquals("unset", None).evaluate(ctx)
 
 
 def test_text_substitution_describe() -> None:

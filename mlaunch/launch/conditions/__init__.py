@@ -93,6 +93,16 @@ class LaunchConfigurationEquals(Condition):
     """The configuration equals the expected text; ``expected_value=None`` means it is unset."""
 
     def __init__(self, launch_configuration_name: str, expected_value: Any) -> None:
+        import warnings
+
+        warnings.warn(
+            "The 'LaunchConfigurationEquals' and 'LaunchConfigurationNotEquals' Conditions are"
+            " deprecated. Use the 'EqualsSubstitution' and 'NotEqualsSubstitution' substitutions"
+            " instead! E.g.:\n  IfCondition(\n  \tEqualsSubstitution("
+            "LaunchConfiguration('some_launch_arg'), \"some_equality_check\")\n  )",
+            UserWarning,
+            stacklevel=2,
+        )
         super().__init__()
         self.name = launch_configuration_name
         self.expected = None if expected_value is None else normalize(expected_value)
