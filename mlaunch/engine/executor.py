@@ -136,7 +136,8 @@ class Executor:
             if awaited:
                 self.events.emit(Completed(action))
 
-        self.timers.add(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
+        timer = self.timers.add(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
+        timer.holds_shutdown = not step.cancel_on_shutdown
 
     def ended_for_good(self, spec: ProcessSpec) -> None:
         """``spec``'s process exited and will not restart: ExecutionComplete, if awaited."""

@@ -101,6 +101,8 @@ class LaunchHandlers:
         elif isinstance(event, ev.SignalProcess):
             for p in self._running(event.process_matcher):
                 p.signal_group(int(event.signal_number))
+        elif isinstance(event, ev.ExecutionComplete):  # an action without a process or timer
+            self._completed(event.action)
         else:
             supervisor.events.emit(Unclaimed(record))
             return

@@ -288,7 +288,7 @@ class Supervisor:
                 return False  # stopped by the user, who may start it again: not idle
             # Idle: nothing runs and nothing is pending, as ROS 2's idle shutdown.
             self.begin_shutdown("idle")
-        if self._lingering_pending():
+        if self._lingering_pending() or self.timers.hold_shutdown():
             return False
         if self._strays_pending():
             return False

@@ -14,7 +14,15 @@ class Timer:
     refresh); ``cancel_on_shutdown`` False: it still fires while shutting down (the ladder).
     """
 
-    __slots__ = ("callback", "cancel_on_shutdown", "cancelled", "keeps_alive", "seq", "when")
+    __slots__ = (
+        "callback",
+        "cancel_on_shutdown",
+        "cancelled",
+        "holds_shutdown",
+        "keeps_alive",
+        "seq",
+        "when",
+    )
 
     def __init__(
         self,
@@ -30,6 +38,9 @@ class Timer:
         self.keeps_alive = keeps_alive
         self.cancel_on_shutdown = cancel_on_shutdown
         self.cancelled = False
+        # A TimerAction(cancel_on_shutdown=False): the shut-down launch waits for it to fire, as
+        # launch waits for its future (the stop ladder's timers do not hold the end).
+        self.holds_shutdown = False
 
     def __lt__(self, other: Timer) -> bool:
         return (self.when, self.seq) < (other.when, other.seq)
@@ -58,6 +69,10 @@ class Timers:
     def keep_alive(self) -> bool:
         """Whether a pending timer keeps an otherwise idle launch running."""
         return any(t.keeps_alive and not t.cancelled for t in self._heap)
+
+    def hold_shutdown(self) -> bool:
+        """Whether a pending timer must fire before a shut-down launch may end."""
+        return any(t.holds_shutdown and not t.cancelled for t in self._heap)
 
     def shutting_down(self) -> None:
         """Cancel what should not fire once the launch shuts down (respawns, TimerActions)."""

@@ -51,6 +51,7 @@ class ExecuteProcess(Action):
     burn a core), up to ``respawn_max_delay`` (30 s). ``respawn_backoff=1`` restarts like ROS 2.
     """
 
+    completes_later = True  # ExecutionComplete when it exits for good (the engine says)
     # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
     # (mlaunch.app.launch_service fills it in; launch_testing looks processes up by it).
     process_details: dict[str, Any] | None = None

@@ -162,13 +162,13 @@ class LaunchContext:
 
     def register_event_handler(self, event_handler: Any, append: bool = False) -> None:
         """Listen with ``event_handler`` from now on (first in line unless ``append``)."""
-        from mlaunch.launch.event_handlers import handler_step
+        from mlaunch.launch.event_handlers import register_step
 
         if append:
             self._event_handlers.append(event_handler)
         else:
             self._event_handlers.insert(0, event_handler)
-        step = handler_step(event_handler, self.planner, getattr(event_handler, "origin", ""))
+        step = register_step(self, event_handler, getattr(event_handler, "origin", ""))
         if step is not None:
             self.planner.add(step)
 

@@ -19,6 +19,10 @@ if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
 
 
+# The run's state key set once an OnExecutionComplete handler was registered.
+COMPLETION_HANDLERS = "completion_handlers"
+
+
 class LaunchDescriptionEntity:
     """Anything that can appear in a launch description."""
 
@@ -54,10 +58,22 @@ class Action(LaunchDescriptionEntity):
         self.condition = condition
         self.origin = caller_origin()
 
+    # An action whose execution ends later than its visit (a process, a timer) says so itself.
+    completes_later = False
+
     def visit(self, context: LaunchContext) -> list[Any] | None:
         if self.condition is not None and not self.condition.evaluate(context):
             return None
-        return self.execute(context)
+        more = self.execute(context)
+        if not self.completes_later and context.run_state.get(COMPLETION_HANDLERS):
+            # launch emits ExecutionComplete for every action once it has executed; only
+            # when an OnExecutionComplete handler was registered may one be waiting for it.
+            from mlaunch.launch.events import ExecutionComplete
+            from mlaunch.plan.steps import EmitEvent
+
+            event = ExecutionComplete(action=self)
+            context.planner.add(EmitEvent(origin=self.origin, event=event))
+        return more
 
     def execute(self, context: LaunchContext) -> list[Any] | None:
         return None

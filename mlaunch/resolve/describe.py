@@ -6,6 +6,7 @@ import os
 import shlex
 from collections.abc import Sequence
 
+from mlaunch.launch.events import ExecutionComplete
 from mlaunch.plan.steps import (
     AddHandler,
     ArgumentInfo,
@@ -61,7 +62,8 @@ def describe_plan(plan: Plan, path: str) -> str:
             out.append("remove a handler")
         elif isinstance(step, RequestShutdown):
             out.append(f"shutdown: {step.reason}")
-        elif isinstance(step, EmitEvent):
+        elif isinstance(step, EmitEvent) and not isinstance(step.event, ExecutionComplete):
+            # (an action's completion, emitted for OnExecutionComplete handlers, goes unsaid)
             out.append(f"emit {type(step.event).__name__}")
         elif hasattr(step, "describe_lines"):
             # Steps of extensions (composable node loads) describe themselves.

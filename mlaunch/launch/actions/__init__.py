@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 
-from mlaunch.launch.event_handlers import handler_step
+from mlaunch.launch.event_handlers import register_step
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
@@ -356,6 +356,8 @@ class OpaqueCoroutine(OpaqueFunction):
 class TimerAction(Action):
     """Resolve and run ``actions`` after ``period`` seconds (cancelled on shutdown by default)."""
 
+    completes_later = True  # ExecutionComplete when it fires (the engine's timer)
+
     def __init__(
         self,
         *,
@@ -402,7 +404,7 @@ class RegisterEventHandler(Action):
 
     def execute(self, context: LaunchContext) -> None:
         handler = self.event_handler
-        step = handler_step(handler, context.planner, self.origin)
+        step = register_step(context, handler, self.origin)
         if step is None:
             raise LaunchFileError(
                 f"event handler {type(handler).__name__} is not supported by mlaunch",

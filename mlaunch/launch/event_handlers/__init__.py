@@ -164,6 +164,17 @@ def handler_step(handler: Any, planner: Any, origin: str) -> AddHandler | None:
     )
 
 
+def register_step(context: Any, handler: Any, origin: str) -> AddHandler | None:
+    """``handler_step`` for a handler registered with ``context``; the run notes from then on
+    that actions' completions may be awaited (ExecutionComplete)."""
+    step = handler_step(handler, context.planner, origin)
+    if step is not None and step.kind == "execution_complete":
+        from mlaunch.launch.launch_description import COMPLETION_HANDLERS
+
+        context.run_state[COMPLETION_HANDLERS] = True
+    return step
+
+
 def event_named(name: str) -> Callable[[Any], bool]:
     """A matcher of the events called ``name``."""
     return lambda event: getattr(event, "name", None) == name
