@@ -12,7 +12,7 @@ import os
 import re
 import sys
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, UsageError
 from mlaunch.smoke import junit
@@ -31,8 +31,10 @@ from mlaunch.smoke.settings import Settings, parse_settings, split_arguments
 from mlaunch.smoke.watch import SmokeRun
 
 if TYPE_CHECKING:
+    from mlaunch.app.options import Options
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.plan.steps import Plan, ProcessSpec
+    from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
 
 
 def command(args: Sequence[str]) -> int:
@@ -66,7 +68,7 @@ def command(args: Sequence[str]) -> int:
 # --- running --------------------------------------------------------------------------------------
 
 
-def run(opts: Any, settings: Settings) -> int:
+def run(opts: Options, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.engine.logfiles import make_run_log_dir
@@ -77,7 +79,7 @@ def run(opts: Any, settings: Settings) -> int:
         return supervise(opts, settings, plan, options, labels, log_dir, path, expectations, life)
 
 
-def print_plan(opts: Any, settings: Settings) -> int:
+def print_plan(opts: Options, settings: Settings) -> int:
     """``mlaunch test FILE --print --format json``: the plan, plus what the run would check."""
     from mlaunch.engine.lifeline import Lifeline, write_stdout
     from mlaunch.resolve.plan_json import plan_json
@@ -95,8 +97,8 @@ def print_plan(opts: Any, settings: Settings) -> int:
 
 
 def prepare(
-    opts: Any, settings: Settings, life: Lifeline, log_dir: str
-) -> tuple[str, Plan, Any, Any, list[Expectation]]:
+    opts: Options, settings: Settings, life: Lifeline, log_dir: str
+) -> tuple[str, Plan, ResolveOptions, LabelCounter, list[Expectation]]:
     """Load and resolve as ``mlaunch FILE`` does, with the launch configurations collected;
     (path, plan, resolve options, labels, the expectations of the run)."""
     from mlaunch.app import pipeline
@@ -187,11 +189,11 @@ def _involve(expectation: Expectation, specs: list[ProcessSpec]) -> None:
 
 
 def supervise(
-    opts: Any,
+    opts: Options,
     settings: Settings,
     plan: Plan,
-    options: Any,
-    labels: Any,
+    options: ResolveOptions,
+    labels: LabelCounter,
     log_dir: str,
     path: str,
     expectations: list[Expectation],
