@@ -52,7 +52,7 @@ def test_a_fixture_dying_fails_the_run_with_its_code() -> None:
     assert run(service, description) == 4
 
 
-def test_output_tests_pass_on_matching_output_and_fail_otherwise(tmp_path: Path) -> None:
+def test_output_tests_end_the_launch_once_matched_and_never_fail_it(tmp_path: Path) -> None:
     (tmp_path / "expected.regex").write_text(r"this is line \d" + "\n" + "this is line [a-z]")
     service, description = LaunchTestService(), LaunchDescription()
     talker = service.add_fixture_action(description, python(TALKER))
@@ -61,10 +61,16 @@ def test_output_tests_pass_on_matching_output_and_fail_otherwise(tmp_path: Path)
     )
     assert run(service, description) == 0  # matched: the launch shuts down, talker exits 0
 
+    # Unmatched output: the test finishes when its process exits, and the shutdown marks it
+    # succeeded, as launch_testing does (only exit codes fail a legacy run).
     service, description = LaunchTestService(), LaunchDescription()
     printer = service.add_fixture_action(description, python("print('something else')"))
     service.add_output_test(description, printer, create_output_lines_test([b"this is line 1"]))
-    assert run(service, description) == 1
+    assert run(service, description) == 0
+    service, description = LaunchTestService(), LaunchDescription()
+    failing = service.add_fixture_action(description, python("import sys; sys.exit(5)"))
+    service.add_output_test(description, failing, create_output_lines_test([b"never"]))
+    assert run(service, description) == 5
 
 
 def test_bytes_filter_drops_prefixes_and_patterns_on_every_line() -> None:
