@@ -161,3 +161,19 @@ async def _until(done, loop) -> None:  # type: ignore[no-untyped-def]
     while not done():
         assert loop.time() < deadline, "the signal handler never ran"
         await __import__("asyncio").sleep(0.01)
+
+
+def test_composable_node_load_request_as_launch_ros_builds_it() -> None:
+    pytest.importorskip("composition_interfaces.srv")
+    from launch import LaunchContext
+    from launch_ros.actions.load_composable_nodes import get_composable_node_load_request
+    from launch_ros.descriptions import ComposableNode
+
+    context = LaunchContext()
+    context.launch_configurations["ros_namespace"] = "/robot"
+    request = get_composable_node_load_request(
+        ComposableNode(package="p", plugin="a::B", name="n", parameters=[{"x": 1}]), context
+    )
+    assert (request.package_name, request.plugin_name, request.node_name) == ("p", "a::B", "n")
+    assert request.node_namespace == "/robot"
+    assert [(p.name, p.value.integer_value) for p in request.parameters] == [("x", 1)]
