@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import re
 import signal
+import sys
 import urllib.request
 from pathlib import Path
 
@@ -84,3 +85,34 @@ def test_a_simulator_restart_is_said_and_the_robot_that_is_gone_is_not_drawn() -
     assert back["simulator"] == {"restarts": 1, "robot": "live"}
     assert back["robot"] is not None and back["pose"]["x"] == 0.0
     assert "the simulator restarted: showing the new state" in back["warnings"]
+
+
+@requires_rclpy
+@pytest.mark.timeout(90)
+def test_the_viewer_sees_a_real_simulator_restart(ros_env: dict[str, str], tmp_path: Path) -> None:
+    from procutil import wait_for
+    from test_viewer import Child, fetch_state
+    from test_viewer_world import JT_WORLD
+
+    env = {**ros_env, "MLAUNCH_VIEWER_PORT": "0"}
+    sim_argv = [sys.executable, "-m", "mlaunch.standins.sim", str(JT_WORLD)]
+    sim = Child(sim_argv, env, tmp_path, "sim")
+    viewer = Child([sys.executable, "-m", "mlaunch.standins.viewer"], env, tmp_path, "viewer")
+    again = None
+    try:
+        url = wait_for(
+            lambda: re.search(r"viewer: open (\S+)", viewer.stdout()), 20, "the viewer's address"
+        ).group(1)
+        wait_for(lambda: fetch_state(url)["world"], 20, "the first simulator's world")
+        assert fetch_state(url)["simulator"]["restarts"] == 0
+        sim.stop()
+        again = Child(sim_argv, env, tmp_path, "sim2")  # a new start of the same simulator
+        state = wait_for(
+            lambda: (s := fetch_state(url))["simulator"]["restarts"] == 1 and s, 30, "a restart"
+        )
+        assert "the simulator restarted: showing the new state" in state["warnings"]
+        assert state["world"]["name"] == "jt_world"
+    finally:
+        for child in (viewer, sim, again):
+            if child is not None:
+                child.stop()

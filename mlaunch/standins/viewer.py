@@ -97,6 +97,7 @@ class ViewerState:
     world: WorldPicture = field(default_factory=WorldPicture)
     restarted_at: float | None = None  # when the simulator last came back (a new world run)
     restarts: int = 0
+    had_robot: bool = False  # the restarted simulator's predecessor had this robot
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     def __post_init__(self) -> None:
@@ -131,6 +132,7 @@ class ViewerState:
         with self.lock:
             if self.world.set(text):  # a new simulator: the robot drawn so far is gone
                 self.pose, self.scan_points, self.restarted_at = None, [], now
+                self.had_robot = self.stats["odom"].last is not None
                 self.trail.clear()
                 self.restarts += 1
             self._seen("world", now)
@@ -299,7 +301,8 @@ class ViewerState:
     def _gone(self) -> bool:
         """The simulator restarted and this robot has not been seen in the new one."""
         odom = self.stats["odom"].last
-        return self.restarted_at is not None and (odom is None or odom < self.restarted_at)
+        restarted = self.restarted_at is not None and self.had_robot
+        return restarted and (odom is None or odom < (self.restarted_at or 0.0))
 
     def _robot_status(self, now: float) -> str:
         """'gone' (not in the restarted simulator), 'lost' (odometry silent), 'live', 'waiting'."""
