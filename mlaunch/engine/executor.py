@@ -27,7 +27,6 @@ from mlaunch.plan.steps import (
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable
-    from typing import Any
 
     from mlaunch.engine.handlers import LaunchHandlers
     from mlaunch.engine.signals import SignalWatch
@@ -53,7 +52,7 @@ class Executor:
         shutdown: Shutdown,
         signals: SignalWatch,
         start: Callable[[ProcessSpec], object],
-        resolve: Callable[[Deferred, Any], Plan],
+        resolve: Callable[[Deferred, object], Plan],
         exit_status: Callable[[int], None],
     ) -> None:
         self.events = events
@@ -145,7 +144,7 @@ class Executor:
             self._awaited.discard(id(spec))
             self.events.emit(Completed(spec.action))
 
-    def fire(self, body: Deferred, event: Any) -> None:
+    def fire(self, body: Deferred, event: object) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
         try:
             plan = self.resolve(body, event)

@@ -73,8 +73,6 @@ from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve_defer
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Any
-
     from mlaunch.engine.cgroup import RunCgroup
 
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
@@ -111,7 +109,9 @@ class Supervisor:
         cgroup: RunCgroup | None = None,
     ) -> None:
         self.plan = plan
-        self.printer = printer
+        # Subscribed below, and the terminal whose flow control the loop drives; parts are
+        # handed the printer by the run (mlaunch.app.pipeline.Run), never through here.
+        self._printer = printer
         self.options = options or ResolveOptions()
         self.labels = labels or LabelCounter()
         self.clock = clock
@@ -261,13 +261,13 @@ class Supervisor:
             self.signals.stop()
             self._selector.close()
             self.pipes.forget_terminal()
-            self.printer.flush()
+            self._printer.flush()
         return self.exit_code
 
     def _loop_once(self) -> None:
         timeout = self._next_timeout()
         if timeout is None or timeout > 0:
-            self.printer.flush()
+            self._printer.flush()
         if self.guard is not None and self.guard.pending:
             self.guard.flush()  # this turn's +pgid/-pgid lines, in one write
         if self.pipes.before_wait() or self.signals.polling:
@@ -362,7 +362,7 @@ class Supervisor:
         """Carry out a visited description's steps (``Executor.execute``)."""
         self.executor.execute(steps, warnings)
 
-    def fire(self, body: Deferred, event: Any) -> None:
+    def fire(self, body: Deferred, event: object) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
         self.executor.fire(body, event)
 

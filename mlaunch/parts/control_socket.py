@@ -31,6 +31,7 @@ import stat
 from collections.abc import Callable, Mapping
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
+from mlaunch.plan.events import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -317,9 +318,8 @@ class _Client:
             self.answered = True
             self.out = b""
             self.server.forget(self)
-            self.server.supervisor.printer.message(
-                "WARNING", "launch", f"control socket: a request failed: {type(e).__name__}: {e}"
-            )
+            text = f"control socket: a request failed: {type(e).__name__}: {e}"
+            self.server.supervisor.events.emit(Said("WARNING", "launch", text))
 
     def _on_ready(self) -> None:
         if self.out:
