@@ -221,3 +221,23 @@ def test_execute_process_parse_cmdline_splits_on_spaces_outside_substitutions() 
         ["TextSubstitution"],
         ["TextSubstitution", "EnvironmentVariable"],
     ]
+
+
+@pytest.mark.parametrize(("name", "text"), [("s.launch.xml", XML), ("s.launch.yaml", YAML)])
+def test_a_source_outside_a_run_is_read_through_launch_frontend(
+    tmp_path: Path, name: str, text: str
+) -> None:
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.launch_description_sources import (
+        AnyLaunchDescriptionSource,
+        FrontendLaunchDescriptionSource,
+    )
+
+    path = tmp_path / name
+    path.write_text(text)
+    for source in (
+        AnyLaunchDescriptionSource(str(path)),
+        FrontendLaunchDescriptionSource(str(path)),
+    ):
+        description = source.get_launch_description(LaunchContext())
+        assert shape(description) == shape(readers.load(str(path)))

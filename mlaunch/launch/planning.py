@@ -109,10 +109,14 @@ class StandalonePlanner:
             )
 
             return get_launch_description_from_python_launch_file(path)
+        if path is not None:
+            # XML, YAML (or a package's format): launch.frontend finds the implementation.
+            from mlaunch.launch.frontend.parser import Parser
+
+            root, parser = Parser.load(path)
+            return parser.parse_description(root)
         raise MlaunchError(
-            f"{path!r}: a standalone LaunchContext loads Python launch files; other formats"
-            " are loaded when a run visits them (LaunchService, mlaunch FILE)",
-            where=origin,
+            f"{source!r} names no launch file and holds no description", where=origin
         )
 
     def locate_program(
