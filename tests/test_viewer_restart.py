@@ -14,9 +14,11 @@ from conftest import requires_rclpy
 from procutil import Running, mlaunch, run_mlaunch
 
 LAUNCH = """from launch import LaunchDescription
+from launch.actions import TimerAction
 from launch_ros.actions import Node
 def generate_launch_description():
-    return LaunchDescription([Node(package="rviz2", executable="rviz2", output="screen")])
+    viewer = Node(package="rviz2", executable="rviz2", output="screen")
+    return LaunchDescription([{}])
 """
 OPEN = r"viewer: open http://127\.0\.0\.1:(\d+)/"
 
@@ -28,11 +30,12 @@ def state_of(port: str) -> dict[str, object]:
 
 @requires_rclpy
 @pytest.mark.timeout(90)
+@pytest.mark.parametrize("started", ["viewer", "TimerAction(period=0.1, actions=[viewer])"])
 def test_a_restarted_viewer_listens_on_the_same_port(
-    ros_env: dict[str, str], tmp_path: Path
+    ros_env: dict[str, str], tmp_path: Path, started: str
 ) -> None:
     path = tmp_path / "view.launch.py"
-    path.write_text(LAUNCH)
+    path.write_text(LAUNCH.format(started))
     env = {**ros_env, "ROS_LOG_DIR": str(tmp_path / "logs")}
     env.pop("MLAUNCH_VIEWER_PORT", None)
     run = Running(mlaunch(str(path)), env=env, cwd=str(tmp_path))

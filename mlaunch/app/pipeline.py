@@ -286,11 +286,6 @@ def supervise(
             f"--log-max-bytes is {opts.log_max_bytes}; valid: 0 (never rotate) or more"
         )
     guard, run_id = life.guard, life.run_id
-    for spec in plan.processes():
-        if spec.standin is not None:  # a restarted viewer keeps its port (and the open tab)
-            from mlaunch.standins import pin_viewer_port
-
-            pin_viewer_port(spec.argv, spec.env)
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes
     printer = Printer(

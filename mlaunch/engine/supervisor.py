@@ -381,6 +381,10 @@ class Supervisor:
         if self.shutting_down:
             self.events.emit(NotStarted(spec))
             return None
+        if spec.standin is not None:  # a restarted viewer keeps its port (and the open tab)
+            from mlaunch.standins import pin_viewer_port
+
+            pin_viewer_port(spec.argv, spec.env)
         process = self.spawner(spec, next(self._index), restarts)
         record = self.records.get(spec.label)
         if record is None:
