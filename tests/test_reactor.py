@@ -7,8 +7,13 @@ Real runs of a Supervisor with real children, as in test_supervision.
 from __future__ import annotations
 
 import os
+import re
 import selectors
+import subprocess
+import sys
+from pathlib import Path
 
+from procutil import clean_env
 from test_supervision import Harness, make_spec
 
 from mlaunch.engine.part import Part
@@ -168,3 +173,74 @@ def test_a_close_that_raises_is_said_and_the_others_still_close() -> None:
         "[ERROR] [launch]: the status view failed and was detached: KeyError: 'gone'"
     ]
     assert isinstance(last, Recorder) and last.closed
+
+
+# --- through the pipeline, as mlaunch FILE runs (a subprocess: signals, guard, log folder) ---
+
+PIPELINE_RUN = """
+import sys
+from mlaunch import compat
+from mlaunch.app import pipeline
+from mlaunch.app.options import parse_options
+from mlaunch.engine.part import Part
+from mlaunch.plan.events import Started
+
+class Broken(Part):
+    def __init__(self, run):
+        run.supervisor.events.subscribe(self.on_event)
+
+    def on_event(self, event):
+        if isinstance(event, Started):
+            raise RuntimeError("broken at its first start")
+
+    def close(self):
+        print("BROKEN CLOSED", flush=True)
+
+compat.install()  # as mlaunch's main does: the launch file imports the ROS 2 names
+opts = parse_options([sys.argv[1]])
+essential = sys.argv[2] == "essential"
+extra = pipeline.PartMaker("the broken part", Broken, essential=essential)
+sys.exit(pipeline.launch(opts, [*pipeline.standard_parts(opts), extra]))
+"""
+
+
+def pipeline_run(tmp_path: Path, code: str, how: str) -> subprocess.CompletedProcess[str]:
+    launch = tmp_path / "one.launch.py"
+    launch.write_text(
+        "import sys\n"
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        f"    return LaunchDescription([ExecuteProcess(cmd=[sys.executable, '-c', {code!r}],"
+        " name='worker', output='screen')])\n"
+    )
+    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+    return subprocess.run(
+        [sys.executable, "-c", PIPELINE_RUN, str(launch), how],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+
+
+def test_a_failing_part_in_a_pipeline_run_is_said_and_the_run_goes_on(tmp_path: Path) -> None:
+    done = pipeline_run(tmp_path, BRIEF, "contained")
+    assert done.returncode == EXIT_OK, done.stdout + done.stderr
+    said = [line for line in done.stdout.splitlines() if line.startswith("[ERROR]")]
+    assert said == [
+        "[ERROR] [launch]: the broken part failed and was detached:"
+        " RuntimeError: broken at its first start"
+    ]
+    assert "BROKEN CLOSED" in done.stdout
+    assert "[INFO] [worker-1]: process has finished cleanly" in done.stdout
+
+
+def test_an_essential_part_failing_in_a_pipeline_run_ends_it_with_70(tmp_path: Path) -> None:
+    done = pipeline_run(tmp_path, WAITER, "essential")
+    assert done.returncode == EXIT_INTERNAL, done.stdout + done.stderr
+    assert "the run cannot go on without it" in done.stdout
+    # The ladder's first step: SIGINT (the part broke at the start, maybe before the child's
+    # handler was in: then SIGINT itself ended it); nothing was killed.
+    assert re.search(r"\[worker-1\]: process stopped (by|after) SIGINT \[pid \d+", done.stdout)
+    assert "SIGKILL" not in done.stdout and "SIGTERM" not in done.stdout
