@@ -157,7 +157,8 @@ def test_names_are_rerooted_by_ros1_name_rules(tmp_path: Path) -> None:
     )
     nodes = {s.node.name: s for s in plan_of(path).processes() if s.node}
     # /gazebo/x is node /gazebo's private ~x; /rrbot/... reaches /rrbot's nodes by relative name
-    assert globals_of(nodes["gazebo"]) == {"shared": "1", "enable_ros_network": "True"}
+    assert globals_of(nodes["gazebo"]) == {"shared": "1"}
+    assert params(nodes["gazebo"]) == {"enable_ros_network": True}
     assert globals_of(nodes["urdf_spawner"]) == {"shared": "1"}
     assert globals_of(nodes["controller_spawner"]) == {
         "shared": "1",
@@ -194,7 +195,8 @@ def test_a_global_set_in_an_included_file_reaches_the_includers_nodes(tmp_path: 
     )
     plan = plan_of(path)
     nodes = {s.node.name: s for s in plan.processes() if s.node}
-    assert globals_of(nodes["rsp"]) == {"rate_from_include": "30", "robot_description": robot}
+    assert globals_of(nodes["rsp"]) == {"rate_from_include": "30"}
+    assert params(nodes["rsp"]) == {"robot_description": robot}
     # roslaunch sets every parameter before any node starts: the order of tags does not matter
     assert globals_of(nodes["before_include"]) == {"rate_from_include": "30"}
     assert "gets no robot_description" not in warnings_text(plan)

@@ -409,7 +409,8 @@ def test_global_params_reach_every_node_of_their_scope_whatever_the_order(tmp_pa
     assert globals_of(nodes["last"]) == {"use_sim_time": "False", "rate": "5"}
     nodes = {s.node.name: s for s in plan_of(path, {"sim": "true"}).processes() if s.node}
     # a <group if> without ns is no parameter scope in ROS 1: its param reaches the others too
-    assert globals_of(nodes["first"]) == {"use_sim_time": "True", "rate": "5", "sim_only": "on"}
+    # roslaunch keeps "on" as text, and so does the node: quoted, as rcl would read a bool
+    assert globals_of(nodes["first"]) == {"use_sim_time": "True", "rate": "5", "sim_only": "'on'"}
 
 
 def test_robot_description_goes_to_robot_state_publisher_only(tmp_path: Path) -> None:

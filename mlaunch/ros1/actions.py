@@ -7,6 +7,7 @@ substitutions is substituted first, then split like a shell.
 
 from __future__ import annotations
 
+import os
 import shlex
 from typing import TYPE_CHECKING, Any
 
@@ -20,13 +21,13 @@ from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.ros1 import config
 from mlaunch.ros1.model import rel_origin
-from mlaunch.ros1.params import flow_text, numeric_rows, ros2_problem
+from mlaunch.ros1.params import ros2_value
 from mlaunch.ros1.server import SERVER_KEY, Server, flat
 from mlaunch.ros1.values import convert_value
 
 if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch_ros.node import NodeCommand
+    from mlaunch.launch_ros.node import NodeCommand, NodeNames
 
 
 class RoslaunchSource(AnyLaunchDescriptionSource):
@@ -55,13 +56,10 @@ class RoslaunchNode(Node):
     parameters (``own_names``: those the mapping gave it, which win).
     """
 
-    def __init__(
-        self, *, shell_args: Any = None, ros1_package: str = "", own_names: Any = (), **kwargs: Any
-    ) -> None:
+    def __init__(self, *, shell_args: Any = None, ros1_package: str = "", **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.shell_args = None if shell_args is None else normalize(shell_args)
         self.ros1_package = ros1_package
-        self.own_names = frozenset(own_names)
 
     def node_command(self, context: LaunchContext, *, remote: bool = False) -> NodeCommand:
         if self.shell_args is not None:
@@ -75,41 +73,78 @@ class RoslaunchNode(Node):
 
     def _global_parameter_arguments(self, ctx: LaunchContext) -> list[str]:
         out = super()._global_parameter_arguments(ctx)
+        found = self.from_server(ctx)
+        if found is None:
+            return out
+        for name, value in self.holdable(ctx, flat(found[1])).items():
+            out += ["-p", rule(name, value)]
+        return out
+
+    def _parameter_arguments(
+        self, context: LaunchContext, names: NodeNames
+    ) -> tuple[list[str], tuple[str, ...]]:
+        found = self.from_server(context)
+        if found is None:
+            return super()._parameter_arguments(context, names)
+        mapped = self.parameters
+        own = self.holdable(context, flat(found[0]))
+        self.parameters = params.normalize_parameters([own]) if own else ()
+        try:
+            return super()._parameter_arguments(context, names)
+        finally:
+            self.parameters = mapped
+
+    def _remap_arguments(self, ctx: LaunchContext) -> list[tuple[str, str]]:
+        """roslaunch's remaps: one per ``from``, the node's own (or a later one) replacing its
+        scope's (rcl would apply the first of two)."""
+        out: list[tuple[str, str]] = []
+        for src, dst in super()._remap_arguments(ctx):
+            out = [r for r in out if r[0] != src]
+            out.append((src, dst))
+        return out
+
+    def from_server(self, ctx: LaunchContext) -> tuple[dict[str, Any], dict[str, Any]] | None:
+        """(own, others): the parameters the file's parameter server holds for this node."""
         server = server_for(ctx, _file(self.origin))
         if server is None:
-            return out
+            return None
         names = self._names(ctx)
-        found = server.parameters_of(
-            names.name, names.namespace or "/", self.ros1_package, self.origin
-        )
-        for name, value in self.holdable(ctx, flat(found)).items():
-            out += ["-p", params.global_parameter_rule(name, value)]
-        return out
+        return server.parameters_of(names.name, names.namespace or "/", self.ros1_package)
 
     def holdable(self, context: LaunchContext, found: dict[str, Any]) -> dict[str, Any]:
         """The values a ROS 2 parameter can hold; each other one is a warning."""
         out: dict[str, Any] = {}
         for name, value in found.items():
-            if name in self.own_names:
-                continue
-            if numeric_rows(value):
-                out[name] = flow_text(value)
-                continue
-            problem = ros2_problem(value)
-            if problem is None and isinstance(value, bytes):
-                problem = "binary data (binfile) has no ROS 2 parameter type"
+            held, problem = ros2_value(value)
             if problem is not None:
                 where = rel_origin(self.origin)
                 context.planner.warn(f"{where}: parameter {name}: {problem}; it is not set")
                 continue
-            if isinstance(value, tuple):
-                value = list(value)
-            if isinstance(value, list) and any(isinstance(v, float) for v in value):
-                value = [float(v) for v in value]
-            elif not isinstance(value, (bool, int, float, str, list)):
-                value = str(value)
-            out[name] = value
+            out[name] = held
         return out
+
+
+def rule(name: str, value: Any) -> str:
+    """``name:=value`` as a SetParameter writes it, text that rcl or YAML would read as
+    something else quoted (roslaunch's ``"1e3"`` and ``""`` stay text)."""
+    if isinstance(value, str) and (
+        not value
+        or "\n" in value
+        or not params.rcl_reads_as_text(value)
+        or not isinstance(_yaml(value), str)
+    ):
+        dumped = params.parameter_rule(name, value)
+        return dumped.removesuffix("\n...\n").rstrip("\n")
+    return params.global_parameter_rule(name, value)
+
+
+def _yaml(text: str) -> Any:
+    import yaml
+
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError:
+        return None
 
 
 class MappingWarning(Action):
@@ -155,7 +190,11 @@ class LoadParameterServer(Action):
 
         index = packages.for_context(context)
         try:
-            found = config.load(self.path, args, environ=context.environment, index=index)
+            environ = dict(context.environment)
+            pushed = configs.get("ros_namespace")
+            if isinstance(pushed, str) and pushed:  # a ROS 2 includer's namespace is its root
+                environ["ROS_NAMESPACE"] = pushed
+            found = config.load(self.path, args, environ=environ, index=index)
         except MlaunchError as e:
             context.planner.warn(
                 f"{rel_origin(self.path)}: roslaunch would refuse this file ({e}); its global"
@@ -172,8 +211,9 @@ class LoadParameterServer(Action):
 def server_for(context: LaunchContext, path: str) -> Server | None:
     """The parameter server that covers the roslaunch file at ``path``, if any."""
     servers: dict[str, Server | None] = context.locals.get(SERVER_KEY) or {}
+    real = os.path.realpath(path)
     for server in servers.values():
-        if server is not None and path in server.config.files:
+        if server is not None and real in server.config.files:
             return server
     return None
 

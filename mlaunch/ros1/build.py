@@ -149,13 +149,8 @@ def _action(item: Item) -> Any:
         if item.shell_args is not None:
             keywords.pop("arguments", None)
             shell_args = subs(item.shell_args)
-        own = {static_text(name) for name, _ in item.parameters}
-        return RoslaunchNode(
-            shell_args=shell_args,
-            ros1_package=static_text(item.package) or "",
-            own_names={name for name in own if name},
-            **keywords,
-        )
+        package = static_text(item.package) or ""
+        return RoslaunchNode(shell_args=shell_args, ros1_package=package, **keywords)
     if isinstance(item, ProcessItem):
         return core.ExecuteProcess(cmd=[subs(c) for c in item.cmd], **process_keywords(item))
     raise TypeError(f"unknown item {item!r}")

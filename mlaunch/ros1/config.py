@@ -113,7 +113,7 @@ class Context:
         ns: str,
         subst: Substitutions,
         parent: Context | None = None,
-        params: list[tuple[str, Any]] | None = None,
+        params: list[tuple[str, Any, str]] | None = None,
         env: list[tuple[str, str]] | None = None,
         arg_names: list[str] | None = None,
     ) -> None:
@@ -213,8 +213,9 @@ class Loader:
             raise LaunchFileError(
                 f"the root element must be <launch>, not <{root.tag}>", where=path
             )
-        if path not in self.config.files:
-            self.config.files.append(path)
+        real = os.path.realpath(path)  # (an include may name it through a symlink)
+        if real not in self.config.files:
+            self.config.files.append(real)
         self.walk(root.children, ctx, path)
 
     def walk(self, elements: list[Element], ctx: Context, path: str) -> None:
@@ -369,9 +370,9 @@ class Loader:
                 env.env.append(
                     (self.required(child, "name", ctx), self.required(child, "value", ctx))
                 )
-        for key, value in [*ctx.params, *private.params]:
+        for key, value, origin in [*ctx.params, *private.params]:
             key = private.ns + (key[1:] if key[0] == "~" else key)
-            self.config.set(key, value, node.origin, unroll=False)
+            self.config.set(key, value, origin, unroll=False)
         node.remaps = remaps.remap_args()
         node.env = env.env
         return node
@@ -389,9 +390,10 @@ class Loader:
             raise LaunchFileError("<param> tag is missing required attribute 'name'")
         value = self.param_value(kind, *next(iter(given.items())))
         if private is not None:
-            private.params = [p for p in private.params if p[0] != name] + [(name, value)]
+            private.params = [p for p in private.params if p[0] != name]
+            private.params.append((name, value, self.origin))
         elif name.startswith("~"):
-            ctx.params[:] = [p for p in ctx.params if p[0] != name] + [(name, value)]
+            ctx.params[:] = [p for p in ctx.params if p[0] != name] + [(name, value, self.origin)]
         else:
             self.config.set(ns_join(ctx.ns, name), value, self.origin, unroll=False)
 

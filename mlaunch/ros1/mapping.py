@@ -27,6 +27,7 @@ from mlaunch.ros1.model import (
     text,
 )
 from mlaunch.ros1.scope import Consumer, Out
+from mlaunch.ros1.server import DROPPED
 
 _PERIOD = ", period_ms"
 _EULER = ("x", "y", "z", "yaw", "pitch", "roll")
@@ -51,7 +52,7 @@ class NodeMapper(ElementReader):
             node.executable = text("robot_state_publisher")
         kept: Params = []
         for name, value in node.parameters:
-            if static_text(name) in ("tf_prefix", "use_tf_static"):
+            if static_text(name) in DROPPED["robot_state_publisher"]:
                 node.warnings.append(
                     f"parameter {static_text(name)} of ROS 1 robot_state_publisher does not exist"
                     " in ROS 2 (frames are never prefixed; static transforms always go to"

@@ -118,7 +118,15 @@ class ParamReader(ElementReader):
         target = "ns"
         if plain is not None:
             if plain.startswith("~"):
-                raise self.error(el, f"private parameter {plain!r} outside a <node>")
+                message = (
+                    f"private parameter {plain!r} outside a <node>: roslaunch gives it to each"
+                    " later node of its scope (and so does a run); ROS 2 has no such rule, so a"
+                    " converted file does not set it"
+                )
+                out.body.append(
+                    Warn(origin=origin, condition=cond, scope_note=True, message=message)
+                )
+                return
             if plain.startswith("/"):
                 inside = scope.ns is not None and scope.ns != "/"
                 if inside and plain.startswith(scope.ns.rstrip("/") + "/"):  # type: ignore[union-attr]
@@ -235,6 +243,24 @@ class ParamReader(ElementReader):
         if isinstance(value.literal, str) and "$(" in value.literal:
             return name, PValue(dynamic=self.value(value.literal, el, "rosparam", scope))
         return entry
+
+
+def ros2_value(value: Any) -> tuple[Any, str | None]:
+    """A ROS 1 parameter value as a ROS 2 parameter holds it, or why it cannot be one."""
+    if numeric_rows(value):
+        return flow_text(value), None
+    problem = ros2_problem(value)
+    if problem is None and isinstance(value, bytes):
+        problem = "binary data (binfile) has no ROS 2 parameter type"
+    if problem is not None:
+        return None, problem
+    if isinstance(value, tuple):
+        value = list(value)
+    if isinstance(value, list) and any(isinstance(v, float) for v in value):
+        return [float(v) for v in value], None
+    if not isinstance(value, (bool, int, float, str, list)):
+        return str(value), None  # dates and the like
+    return value, None
 
 
 def numeric_rows(value: Any) -> bool:

@@ -13,7 +13,8 @@ parameters, what it would read in ROS 1 (docs/ros1.md, *Parameters*):
   that holds it (``a/b`` -> ``a.b``), unless its first part there is another node's name or a
   namespace that holds nodes (it belongs to those); a global of an enclosing namespace reaches
   the nodes of the namespaces inside it, as a SetParameter of its scope would;
-- parameters set inside the node's own tag: the node's (the mapping has given them already).
+- its own parameters (under its name) go in its params file, as the mapping writes them, less
+  those its ROS 2 counterpart does not take (``DROPPED``).
 """
 
 from __future__ import annotations
@@ -27,6 +28,11 @@ from mlaunch.ros1.config import Config, global_ns
 SERVER_KEY = "mlaunch_ros1_parameter_server"
 # Global names the mapping gives only to the nodes that read them (or that pick a program).
 SPECIAL = ("robot_description", "use_gui")
+# Private parameters of ROS 1 programs their ROS 2 counterparts do not take (docs/ros1.md).
+DROPPED = {
+    "robot_state_publisher": ("tf_prefix", "use_tf_static"),
+    "joint_state_publisher": ("use_gui",),
+}
 
 
 @dataclass
@@ -49,34 +55,35 @@ class Server:
         return server
 
     def parameters_of(
-        self, name: str | None, namespace: str, package: str, own_origin: str
-    ) -> dict[str, Any]:
-        """A node's ROS 1 parameters as ROS 2 names (``a.b``) and values."""
+        self, name: str | None, namespace: str, package: str
+    ) -> tuple[dict[str, Any], dict[str, Any]]:
+        """A node's ROS 1 parameters as ROS 2 names (``a.b``) and values: (its own, under its
+        name, with robot_state_publisher's robot_description; the others it would read)."""
         ns = global_ns(namespace or "/")
         full = ns + name + "/" if name else None
         ranked: list[tuple[int, str, Any]] = []
         for key, value in self.config.params.items():
-            if self.config.origins.get(key) == own_origin and own_origin:
-                continue
             local = self.local_name(key, ns, full)
             if local is not None:
                 ranked.append((local[0], local[1].replace("/", "."), value))
-        # outer namespaces first, then inner ones, then private: where SetParameters of nested
-        # scopes would put them (a later one wins)
+        # outer namespaces first, then inner ones: where SetParameters of nested scopes would
+        # put them (a later one wins)
         ranked.sort(key=lambda r: r[0])
-        found = {name: value for _, name, value in ranked}
+        dropped = DROPPED.get(package, ())
+        own = {n: v for rank, n, v in ranked if rank < 0 and n not in dropped}
+        shared = {n: v for rank, n, v in ranked if rank >= 0}
         if package == "robot_state_publisher":
             description = self.search(ns, "robot_description")
             if description is not None:
-                found["robot_description"] = description
-        return found
+                own = {"robot_description": description, **own}
+        return own, shared
 
     def local_name(self, key: str, ns: str, full: str | None) -> tuple[int, str] | None:
         """(rank, name) of a parameter for a node: its depth of scope, and its local name."""
         if key == "/use_sim_time":
             return 0, "use_sim_time"
         if full is not None and key.startswith(full):
-            return len(full), key[len(full) :]
+            return -1, key[len(full) :]
         scope = self.nearest(key, ns)
         if scope is None:
             return None
