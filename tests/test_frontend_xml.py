@@ -66,7 +66,7 @@ def test_arg_with_default_description_and_choices(tmp_path: Path) -> None:
     )
     mode, robot = ld.entities
     assert isinstance(mode, actions.DeclareLaunchArgument)
-    assert mode.name == "mode" and mode.choices == ("sim", "real")
+    assert mode.name == "mode" and mode.choices == ["sim", "real"]
     assert mode.description == "Where to run. Valid choices are: ['sim', 'real']"
     assert mode.origin.endswith("t.launch.xml:2")
     assert robot.default_value is None

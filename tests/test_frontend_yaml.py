@@ -93,8 +93,8 @@ def test_arg_choice_forms_and_typing_of_text(tmp_path: Path) -> None:
         """,
     )
     mode, level, flag, ratio = ld.entities
-    assert mode.choices == ("sim", "real")
-    assert level.choices == ("1", "2", "3") and level.default_value[0].text == "3"
+    assert mode.choices == ["sim", "real"]
+    assert level.choices == ["1", "2", "3"] and level.default_value[0].text == "3"
     # a YAML bool is written as launch text: lowercase, as conditions and XML expect
     assert flag.default_value[0].text == "true" and flag.description == "A flag"
     assert ratio.default_value[0].text == "0.50"  # as written, like the XML attribute

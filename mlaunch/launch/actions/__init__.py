@@ -59,7 +59,8 @@ class DeclareLaunchArgument(Action):
         super().__init__(**kwargs)
         self.name = name
         self.default_value = None if default_value is None else normalize(default_value)
-        self.choices = None if choices is None else tuple(str(c) for c in choices)
+        # A list, as upstream's DeclareLaunchArgument.choices reads back.
+        self.choices = None if choices is None else [str(c) for c in choices]
         if self.choices is not None and not self.choices:
             raise LaunchArgumentError(
                 f"argument {name!r} declares an empty list of choices", where=self.origin
@@ -84,7 +85,7 @@ class DeclareLaunchArgument(Action):
             name=self.name,
             default=default,
             description=self.description,
-            choices=self.choices,
+            choices=None if self.choices is None else tuple(self.choices),
             origin=self.origin,
             conditional=conditional or self.condition is not None,
         )
