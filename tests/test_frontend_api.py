@@ -241,3 +241,13 @@ def test_a_source_outside_a_run_is_read_through_launch_frontend(
     ):
         description = source.get_launch_description(LaunchContext())
         assert shape(description) == shape(readers.load(str(path)))
+
+
+def test_on_exit_shutdown_is_the_process_sub_entity() -> None:
+    root, parser = Parser.load(
+        io.StringIO('<launch><executable cmd="ls" on_exit="shutdown"/></launch>')
+    )
+    (process,) = parser.parse_description(root).entities
+    (shutdown,) = process.get_sub_entities()
+    assert isinstance(shutdown, actions.Shutdown)
+    assert actions.ExecuteProcess(cmd=["ls"], on_exit=shutdown).get_sub_entities() == []

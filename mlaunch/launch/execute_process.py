@@ -310,6 +310,10 @@ class ExecuteProcess(Action):
             required = True
         return planner.defer(entities, self.origin), required
 
+    def get_sub_entities(self) -> list[Any]:
+        """The ``on_exit`` actions when they are a list (what introspection walks into)."""
+        return list(self.on_exit) if isinstance(self.on_exit, list) else []
+
     @classmethod
     def _parse_cmdline(cls, cmd: str, parser: Any) -> list[Any]:
         """A markup command line as argv items, each a list of substitutions (what the parse
