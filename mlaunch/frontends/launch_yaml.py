@@ -6,7 +6,6 @@ served by mlaunch's located YAML reader. mlaunch registers it as the entry point
 from __future__ import annotations
 
 from mlaunch.frontends import yaml
-from mlaunch.frontends.entity import Entity as ReaderEntity
 from mlaunch.frontends.markup import MarkupEntity, MarkupParser
 from mlaunch.launch import launch_description_sources
 
@@ -20,14 +19,8 @@ class Parser(MarkupParser):
     """The YAML parser implementation."""
 
     entity_class = Entity
-
-    @classmethod
-    def read(cls, data: bytes, name: str) -> ReaderEntity:
-        return yaml.parse_root(data, name)
-
-    @classmethod
-    def get_file_extensions(cls) -> set[str]:
-        return {"launch.yaml", "launch.yml", "yaml", "yml", "launch"}
+    reader = staticmethod(yaml.parse_root)
+    extensions = frozenset({"launch.yaml", "launch.yml", "yaml", "yml", "launch"})
 
 
 __all__ = ["Entity", "Parser", "launch_description_sources"]

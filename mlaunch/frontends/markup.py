@@ -131,11 +131,17 @@ class MarkupParser(Parser):
     """A parser of mlaunch's readers: built-in tags from the readers' table, others exposed."""
 
     entity_class: type[MarkupEntity] = MarkupEntity
+    # The format's reader: the root entity of a file's bytes, its errors located in the name.
+    reader: Callable[[bytes, str], ReaderEntity]
+    extensions: frozenset[str] = frozenset()
 
     @classmethod
     def read(cls, data: bytes, name: str) -> ReaderEntity:
-        """The root reader entity of a file's bytes (each format's reader)."""
-        raise NotImplementedError
+        return cls.reader(data, name)
+
+    @classmethod
+    def get_file_extensions(cls) -> set[str]:
+        return set(cls.extensions)
 
     @classmethod
     def load(cls, file: Any) -> tuple[FrontendEntity, Parser]:
