@@ -12,6 +12,15 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Any, List, Union  # noqa: UP035 (List[...] is the type spelling launch reads)
 
+# The coercion of text is launch.frontend's (typing-free, so reading markup stays cheap).
+from mlaunch.launch.frontend.coercion import (
+    coerce_to_type,
+    extract_type,
+    get_typed_value,
+    is_instance_of,
+    is_instance_of_valid_type,
+    is_typing_list,
+)
 from mlaunch.launch.substitution import Substitution
 from mlaunch.launch.utilities.ensure_argument_type_impl import ensure_argument_type
 from mlaunch.launch.utilities.normalize_to_list_of_substitutions_impl import (
@@ -39,119 +48,10 @@ StrSomeScalarType = Union[ScalarValueType, str]  # noqa: UP007
 StrSomeSequenceType = List[Any]  # noqa: UP006
 StrSomeValueType = Union[StrSomeScalarType, StrSomeSequenceType]  # noqa: UP007
 
-_TYPE_NAMES = "int, float, str, bool, List[int], List[float], List[str], List[bool]"
-
-
-def is_typing_list(data_type: Any) -> bool:
-    """Whether ``data_type`` is ``typing.List`` (or ``list``) or a subscription of it."""
-    if data_type is List:  # noqa: UP006 (typing's bare List, which launch files may pass)
-        return True
-    origin = getattr(data_type, "__origin__", None)
-    return hasattr(data_type, "__args__") and origin is list
-
 
 def is_valid_scalar_type(data_type: Any) -> bool:
     """Whether ``data_type`` is one of the scalar types."""
     return data_type in ScalarTypesTuple
-
-
-def extract_type(data_type: Any) -> tuple[Any, bool]:
-    """(item type, is a list) of an allowed type; ValueError for any other."""
-    scalar, is_list = data_type, False
-    args = getattr(data_type, "__args__", None)
-    if is_typing_list(data_type) and args:
-        scalar, is_list = args[0], True
-    if not is_valid_scalar_type(scalar):
-        raise ValueError(f"Unrecognized data type: {data_type}")
-    return scalar, is_list
-
-
-def is_instance_of_valid_type(value: Any, *, can_be_str: bool = False) -> bool:
-    """Whether ``value`` is a scalar or a uniform list of one scalar type (empty lists are).
-
-    ``can_be_str``: a list may also mix strings in.
-    """
-    if not isinstance(value, list):
-        return isinstance(value, ScalarTypesTuple)
-    if not value:
-        return True
-    item_type = next((type(x) for x in value if type(x) is not str), str)
-    if item_type not in ScalarTypesTuple:
-        return False
-    accepted = (item_type, str) if can_be_str else (item_type,)
-    return all(isinstance(x, accepted) for x in value)
-
-
-def is_instance_of(value: Any, data_type: Any = None, *, can_be_str: bool = False) -> bool:
-    """Whether ``value`` is an instance of ``data_type`` (None: of any allowed type)."""
-    if data_type is None:
-        return is_instance_of_valid_type(value, can_be_str=can_be_str)
-    scalar, is_list = extract_type(data_type)
-    accepted = (str, scalar) if can_be_str else (scalar,)
-    if not is_list:
-        return isinstance(value, accepted)
-    return isinstance(value, list) and all(isinstance(x, accepted) for x in value)
-
-
-def _yaml_value(text: str, error: str, can_be_str: bool) -> Any:
-    """``text`` read as YAML; an allowed type, or ValueError starting with ``error``."""
-    if not text:
-        return text
-    import yaml
-
-    try:
-        value = yaml.safe_load(text)
-    except Exception as exc:
-        if can_be_str:
-            return text
-        raise ValueError(f"{error}: yaml.safe_load() failed\n{exc}") from None
-    if not is_instance_of_valid_type(value, can_be_str=can_be_str):
-        raise ValueError(f"{error}: output type is not allowed, got {type(value)}")
-    return value
-
-
-def _coerce_list(value: str, scalar: Any, can_be_str: bool) -> list[Any]:
-    accepted = (str, scalar) if can_be_str else scalar
-    error = f"Cannot convert value '{value}' to a list of '{accepted}'"
-    items = _yaml_value(value, error, can_be_str)
-    if not isinstance(items, list):
-        raise ValueError(error)
-    if not all(isinstance(x, accepted) for x in items):
-        raise ValueError(f"{error}, got {items}")
-    return items
-
-
-def _coerce_number(value: str, scalar: type, can_be_str: bool) -> Any:
-    try:
-        return scalar(value)
-    except ValueError:
-        if can_be_str:
-            return value
-        raise
-
-
-def coerce_to_type(value: str, data_type: Any = None, *, can_be_str: bool = False) -> Any:
-    """Text as ``data_type`` (None: whatever YAML reads it as); ValueError when it is not one.
-
-    A bool also accepts '1' and '0'. ``can_be_str``: text that cannot be coerced stays text.
-    """
-    ensure_argument_type(value, str, "value", "coerce_to_type")
-    if data_type is None:
-        return _yaml_value(value, f"Failed to convert '{value}' using yaml rules", can_be_str)
-    scalar, is_list = extract_type(data_type)
-    if is_list:
-        return _coerce_list(value, scalar, can_be_str)
-    if scalar is str:
-        return value
-    if scalar in (int, float):
-        return _coerce_number(value, scalar, can_be_str)
-    if scalar is not bool:
-        raise ValueError(f"data_type is invalid. Expected one of: {_TYPE_NAMES}. Got {data_type}")
-    text = {"1": "true", "0": "false"}.get(value, value)
-    result = _yaml_value(text, f"Failed to convert '{text}' to '{scalar}'", can_be_str)
-    if isinstance(result, (str, bool) if can_be_str else bool):
-        return result
-    raise ValueError(f"Cannot convert value '{text}' to '{scalar}'")
 
 
 def coerce_list(value: list[str], data_type: Any = None, *, can_be_str: bool = False) -> Any:
@@ -161,19 +61,6 @@ def coerce_list(value: list[str], data_type: Any = None, *, can_be_str: bool = F
     if not is_instance_of_valid_type(result, can_be_str=can_be_str):
         raise ValueError(f"cannot convert value to {data_type}. Got value=`{value}`")
     return result
-
-
-def get_typed_value(value: Any, data_type: Any, *, can_be_str: bool = False) -> Any:
-    """A text or a list of texts coerced to ``data_type`` (a list needs a list type)."""
-    if not isinstance(value, list):
-        return coerce_to_type(value, data_type, can_be_str=can_be_str)
-    if data_type is not None:
-        data_type, is_list = extract_type(data_type)
-        if not is_list:
-            raise TypeError(
-                f"Cannot convert input '{value}' of type '{type(value)}' to '{data_type}'"
-            )
-    return coerce_list(value, data_type, can_be_str=can_be_str)
 
 
 def is_substitution(x: Any) -> bool:
@@ -297,3 +184,22 @@ def perform_typed_substitution(context: Any, value: Any, data_type: Any) -> Any:
             else "The output list is not uniform"
         )
     return result
+
+
+__all__ = [
+    "AllowedTypesTuple",
+    "ListTypesTuple",
+    "ScalarTypesTuple",
+    "coerce_list",
+    "coerce_to_type",
+    "extract_type",
+    "get_typed_value",
+    "is_instance_of",
+    "is_instance_of_valid_type",
+    "is_normalized_substitution",
+    "is_substitution",
+    "is_typing_list",
+    "is_valid_scalar_type",
+    "normalize_typed_substitution",
+    "perform_typed_substitution",
+]
