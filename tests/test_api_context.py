@@ -132,12 +132,15 @@ def test_lifecycle_transition_registers_then_emits() -> None:
         LifecycleTransition(lifecycle_node_names=["talker"], transition_ids=[])
     with pytest.raises(ValueError):
         LifecycleTransition(lifecycle_node_names=[], transition_ids=[1])
-    actions = LifecycleTransition(lifecycle_node_names=["talker"], transition_ids=["1", 3]).execute(
-        LaunchContext()
-    )
+    context = LaunchContext()
+    transition = LifecycleTransition(lifecycle_node_names=["talker"], transition_ids=["1", 3])
+    actions = transition.execute(context)
     kinds = [type(a) for a in actions]
-    assert kinds == [RegisterEventHandler] * 3 + [EmitEventAction]
+    assert kinds == [RegisterEventHandler] * 2 + [EmitEventAction]
     assert actions[-1].event.transition_id == 1
+    # the handler of a failed transition is registered with the context, as launch_ros does
+    (step,) = context.planner.plan.steps
+    assert step.kind == "state_transition"
 
 
 def test_introspector_draws_a_tree() -> None:

@@ -177,3 +177,22 @@ def test_composable_node_load_request_as_launch_ros_builds_it() -> None:
     assert (request.package_name, request.plugin_name, request.node_name) == ("p", "a::B", "n")
     assert request.node_namespace == "/robot"
     assert [(p.name, p.value.integer_value) for p in request.parameters] == [("x", 1)]
+
+
+def test_bad_node_parameters_are_type_errors_as_upstream() -> None:
+    from launch_ros.actions import Node
+
+    for bad in ([5.0], {"a": 5}, "params.yaml"):
+        with pytest.raises(TypeError, match="parameters"):
+            Node(package="p", executable="e", parameters=bad)
+
+
+def test_matches_node_name_takes_a_relative_name_from_the_root() -> None:
+    from launch_ros.events import matches_node_name
+
+    class Named:
+        def __init__(self, node_name: str) -> None:
+            self.node_name = node_name
+
+    assert matches_node_name("foo")(Named("/foo"))
+    assert not matches_node_name("foo")(Named("/foo/bar"))

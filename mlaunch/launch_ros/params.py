@@ -41,7 +41,7 @@ from mlaunch.launch_ros.parameter_descriptions import (
     ParameterValue,
     is_substitution,
 )
-from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.plan.errors import LaunchFileTypeError, SubstitutionFailure
 from mlaunch.plan.record import Record
 from mlaunch.ros.files import write_temp
 
@@ -102,7 +102,7 @@ if TYPE_CHECKING:
 def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
     """``Node(parameters=...)`` checked and normalized when the Node is built."""
     if isinstance(parameters, (str, Mapping)) or not isinstance(parameters, Sequence):
-        raise LaunchFileError(
+        raise LaunchFileTypeError(
             f"parameters must be a list of dicts, params-file paths and Parameter entries,"
             f" got {type(parameters).__name__}: {parameters!r:.120}"
         )
@@ -115,7 +115,7 @@ def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
         elif isinstance(entry, (str, Path, Substitution)) or is_substitution(entry):
             out.append(ParameterFile(entry))
         else:
-            raise LaunchFileError(
+            raise LaunchFileTypeError(
                 f"a parameters entry must be a dict, a params-file path or a Parameter, got"
                 f" {type(entry).__name__}: {entry!r:.120}"
             )
@@ -147,7 +147,7 @@ def normalize_value(value: Any, name: Subs = ()) -> NormalizedValue:
         return Text((value,))
     if isinstance(value, Sequence):
         return _normalize_list(value, name)
-    raise LaunchFileError(
+    raise LaunchFileTypeError(
         f"parameter {describe(name)}: a value must be a scalar, a substitution, a list or a dict,"
         f" got {type(value).__name__}: {value!r:.120}"
     )
@@ -174,7 +174,7 @@ def _kind(item: Any, name: Subs) -> type:
         return type(item)
     if isinstance(item, (list, tuple)) and all(isinstance(i, (str, Substitution)) for i in item):
         return tuple
-    raise LaunchFileError(
+    raise LaunchFileTypeError(
         f"parameter {describe(name)}: list item {item!r:.80} is not a scalar, a substitution or a"
         " list of substitutions"
     )

@@ -127,6 +127,10 @@ class LaunchFileError(MlaunchError):
     """The launch file cannot be found, read or parsed (syntax, schema, unknown tags)."""
 
 
+class LaunchFileTypeError(LaunchFileError, TypeError):
+    """A launch file gave an argument of the wrong type (a TypeError too, as launch raises)."""
+
+
 class SubstitutionFailure(MlaunchError):
     """A substitution cannot be performed (unset configuration, failing command, ...)."""
 

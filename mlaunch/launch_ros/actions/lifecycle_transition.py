@@ -128,6 +128,8 @@ class LifecycleTransition(Action):
             )
             # The last goal reached: the error handler is no longer wanted.
             handlers[-1].entities.append(UnregisterEventHandler(on_error))
-            registrations.extend(RegisterEventHandler(h) for h in (*handlers, on_error))
+            registrations.extend(RegisterEventHandler(h) for h in handlers)
+            # Registered now, as launch_ros does (not among the returned actions).
+            context.register_event_handler(on_error)
             first_emits.append(emits[0])
         return [*registrations, *first_emits]

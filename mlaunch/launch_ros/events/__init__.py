@@ -170,7 +170,10 @@ class OnStateTransition(EventHandler):
 
 
 def matches_node_name(node_name: str) -> LifecycleNodeMatcher:
-    """A matcher for the lifecycle node with this full name (a Node action or a ProcessSpec)."""
+    """A matcher for the lifecycle node with this full name (a Node action or a ProcessSpec);
+    a name without the leading '/' is taken from the root, as launch_ros does."""
+    if not node_name.startswith("/"):
+        node_name = "/" + node_name
 
     def match(target: Any) -> bool:
         info = getattr(target, "node", None)  # a ProcessSpec carries NodeInfo

@@ -9,7 +9,7 @@ from mlaunch.launch_ros.parameter_descriptions import ParameterFile
 from mlaunch.launch_ros.params import evaluate_dict as evaluate_parameter_dict
 
 
-def evaluate_parameters(context: Any, parameters: Any) -> list[Any]:
+def evaluate_parameters(context: Any, parameters: Any) -> tuple[Any, ...]:
     """Dicts evaluated, parameter files as paths, Parameter entries as they are."""
     out: list[Any] = []
     for entry in parameters:
@@ -19,7 +19,7 @@ def evaluate_parameters(context: Any, parameters: Any) -> list[Any]:
             out.append(Path(entry.evaluate(context)))
         else:
             out.append(entry)
-    return out
+    return tuple(out)
 
 
 __all__ = ["evaluate_parameter_dict", "evaluate_parameters"]
