@@ -196,3 +196,19 @@ def test_process_handlers_check_targets_and_call_callables_as_upstream() -> None
     for fd in (0, 1, 2):
         io.handle(ProcessIO(action=process, text=b"x", fd=fd), LaunchContext())
     assert streams == ["in", "out", "err"]
+
+
+def test_substitution_failures_say_what_launch_says(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from launch import LaunchContext
+    from launch.substitutions import EnvironmentVariable, FileContent, ThisLaunchFileDir
+    from launch.substitutions.substitution_failure import SubstitutionFailure
+
+    context = LaunchContext(environment={})
+    with pytest.raises(SubstitutionFailure, match="environment variable 'NOPE' does not exist"):
+        EnvironmentVariable("NOPE").perform(context)
+    with pytest.raises(SubstitutionFailure, match="File not found: "):
+        FileContent(str(tmp_path / "missing.txt")).perform(context)
+    with pytest.raises(SubstitutionFailure):
+        ThisLaunchFileDir().perform(context)
+    context.extend_locals({"current_launch_file_directory": "foo"})
+    assert ThisLaunchFileDir().perform(context) == "foo"

@@ -73,7 +73,7 @@ def test_env_with_default() -> None:
     assert run("$(env HOME)") == "/home/me"
     assert run("$(env NOPE fallback)") == "fallback"
     assert run("$(env NOPE '')") == ""
-    with pytest.raises(SubstitutionFailure, match="'NOPE' is not set"):
+    with pytest.raises(SubstitutionFailure, match="'NOPE' does not exist: it is not set"):
         run("$(env NOPE)")
 
 

@@ -18,30 +18,32 @@ if TYPE_CHECKING:
 
 
 def _as_entities(value: Any) -> tuple[list[Any], Callable[..., Any] | None]:
-    """Split ``on_*`` into entities or a callable(event, context) -> entities."""
+    """Split ``on_*`` into entities or a callable(event, context) -> entities (a callable
+    first, as launch: no launch entity is callable)."""
     if value is None:
         return [], None
-    from mlaunch.launch.launch_description import LaunchDescriptionEntity
-
-    if callable(value) and not isinstance(value, LaunchDescriptionEntity):
+    if callable(value) and not isinstance(value, type):
         return [], value
     if isinstance(value, Iterable) and not isinstance(value, (str, bytes)):
-        entities = list(value)
-        for entity in entities:
-            if not isinstance(entity, LaunchDescriptionEntity):
-                raise TypeError(
-                    "expected all items in the handler's entities to be launch entities"
-                    f" (actions, descriptions), got {type(entity).__name__}: {entity!r:.60}"
-                )
-        return entities, None
+        return list(value), None
     return [value], None
 
 
-def _is_predicate(target: Any) -> bool:
-    """A target given as a function of the action (launch tries this before identity)."""
+def check_entities(entities: list[Any], handler: str) -> None:
+    """launch's TypeError for an ``on_*`` list holding something that is not an entity."""
     from mlaunch.launch.launch_description import LaunchDescriptionEntity
 
-    return callable(target) and not isinstance(target, LaunchDescriptionEntity)
+    for entity in entities:
+        if not isinstance(entity, LaunchDescriptionEntity):
+            raise TypeError(
+                f"{handler}: expected all items in the handler's entities to be launch entities"
+                f" (actions, descriptions), got {type(entity).__name__}: {entity!r:.60}"
+            )
+
+
+def _is_predicate(target: Any) -> bool:
+    """A target given as a function of the action: launch tries this before identity."""
+    return callable(target)
 
 
 def check_target(target: Any, handler: str, target_class: type, what: str) -> None:
@@ -124,12 +126,15 @@ class EventHandler:
 
     def handle(self, event: Any, context: Any) -> list[Any] | None:
         """``event`` becomes ``context.locals.event``; the entities to visit for it."""
-        context.extend_locals({"event": event})
-        if self.handle_once:
-            context.unregister_event_handler(self)
+        self._begin_handling(event, context)
         if self.callback is not None:
             return returned_entities(self.callback(event, context))
         return list(self.entities)
+
+    def _begin_handling(self, event: Any, context: Any) -> None:
+        context.extend_locals({"event": event})
+        if self.handle_once:
+            context.unregister_event_handler(self)
 
     @property
     def handler_description(self) -> str | None:
@@ -191,6 +196,7 @@ class OnProcessStart(EventHandler):
     def __init__(self, *, target_action: Any = None, on_start: Any, handle_once: bool = False):
         _process_target(target_action, "OnProcessStart")
         super().__init__(target_action=target_action, entities=on_start, handle_once=handle_once)
+        check_entities(self.entities, "OnProcessStart")
 
 
 class OnProcessExit(EventHandler):
@@ -204,6 +210,7 @@ class OnProcessExit(EventHandler):
     def __init__(self, *, target_action: Any = None, on_exit: Any, handle_once: bool = False):
         _process_target(target_action, "OnProcessExit")
         super().__init__(target_action=target_action, entities=on_exit, handle_once=handle_once)
+        check_entities(self.entities, "OnProcessExit")
 
 
 class OnProcessIO(EventHandler):
@@ -234,9 +241,7 @@ class OnProcessIO(EventHandler):
 
     def handle(self, event: Any, context: Any) -> list[Any] | None:
         """The callback of the event's stream (stdin, stdout, stderr), given the event."""
-        context.extend_locals({"event": event})
-        if self.handle_once:
-            context.unregister_event_handler(self)
+        self._begin_handling(event, context)
         streams: dict[Any, Callable[[Any], Any] | None] = {
             0: self.on_stdin,
             1: self.io_callbacks.get("stdout"),
@@ -256,6 +261,14 @@ class OnShutdown(EventHandler):
 
     def __init__(self, *, on_shutdown: Any, handle_once: bool = False) -> None:
         super().__init__(entities=on_shutdown, handle_once=handle_once)
+        self.on_shutdown = on_shutdown
+
+    def handle(self, event: Any, context: Any) -> Any:
+        """What ``on_shutdown`` gives: its entities as given, or the callable's result."""
+        self._begin_handling(event, context)
+        if self.callback is not None:
+            return self.callback(event, context)
+        return self.on_shutdown
 
 
 class OnExecutionComplete(EventHandler):

@@ -93,7 +93,7 @@ class EnvironmentVariable(Substitution):
         if self.default_value is not None:
             return perform_substitutions(context, self.default_value)
         raise SubstitutionFailure(
-            f"environment variable {name!r} is not set and has no default"
+            f"environment variable {name!r} does not exist: it is not set and has no default"
             " (give one: EnvironmentVariable(name, default_value=...) or $(env NAME default))"
         )
 
@@ -140,6 +140,10 @@ class ThisLaunchFileDir(Substitution):
     """The directory of the launch file being resolved (``$(dirname)``)."""
 
     def perform(self, context: LaunchContext) -> str:
+        # The local launch sets with the file (a script may set it itself, as launch's tests do).
+        directory = context.locals.get("current_launch_file_directory")
+        if directory is not None:
+            return str(directory)
         path = context.current_launch_file_path
         if path is None:
             raise SubstitutionFailure("ThisLaunchFileDir used outside of a launch file")
@@ -192,6 +196,8 @@ class FileContent(Substitution):
         try:
             with open(path, encoding="utf-8") as f:
                 return f.read()
+        except FileNotFoundError:
+            raise SubstitutionFailure(f"File not found: {path}")
         except OSError as e:
             raise SubstitutionFailure(f"cannot read file {path!r}: {e.strerror}")
 
@@ -302,16 +308,17 @@ class Command(Substitution):
         rc, out, err = run_command(argv, context)
         if rc != 0:
             detail = err.strip().splitlines()[-1] if err.strip() else f"exit status {rc}"
+            # launch's words first, then what mlaunch adds (the status, stderr's last line)
             raise SubstitutionFailure(
-                f"command {text!r} failed with exit status {rc}: {detail}"
-                if err.strip()
-                else f"command {text!r} failed with exit status {rc}"
+                f"executed command failed. Command: {text} (exit status {rc}: {detail})"
             )
         if err:
             if on_stderr == "fail":
                 raise SubstitutionFailure(
-                    f"command {text!r} wrote to stderr: {err.strip()[:500]!r}"
-                    " (pass on_stderr='warn' or 'ignore' to accept that)"
+                    f"executed command showed stderr output. Command: {text}\n"
+                    f"Captured stderr output: {err.strip()[:500]}\n"
+                    "(the command wrote to stderr: pass on_stderr='warn' or 'ignore' to accept"
+                    " that)"
                 )
             if on_stderr == "warn":
                 context.warn(f"command {text!r} wrote to stderr: {err.strip()}")
@@ -339,7 +346,7 @@ def run_command(argv: list[str], context: LaunchContext) -> tuple[int, str, str]
             check=False,
         )
     except FileNotFoundError:
-        raise SubstitutionFailure(f"command {argv[0]!r} not found on the PATH")
+        raise SubstitutionFailure(f"file not found: command {argv[0]!r} not found on the PATH")
     except OSError as e:
         raise SubstitutionFailure(f"cannot run command {argv[0]!r}: {e.strerror}")
     return (
