@@ -1,12 +1,11 @@
 """Run by /usr/bin/python3 (Debian's, with roslaunch): a launch file as the real roslaunch
 resolves it, as JSON on stdout (argv: FILE [name:=value ...]). Used by the ROS 1 differential
-tests; it must not import mlaunch."""
+tests, which also import ``typed`` (the same typing for both sides); it must not import
+mlaunch."""
 
 import base64
 import json
 import sys
-
-import roslaunch.config
 
 
 def typed(value):
@@ -22,12 +21,16 @@ def typed(value):
         return ["list", [typed(v) for v in value]]
     if isinstance(value, dict):
         return ["dict", {k: typed(v) for k, v in value.items()}]
-    if hasattr(value, "data"):  # xmlrpc Binary
+    if isinstance(value, bytes):  # binfile, as mlaunch reads it
+        return ["binary", base64.b64encode(value).decode()]
+    if hasattr(value, "data"):  # binfile, as roslaunch reads it (xmlrpc Binary)
         return ["binary", base64.b64encode(value.data).decode()]
     return [type(value).__name__, str(value)]
 
 
 def main():
+    import roslaunch.config
+
     path, args = sys.argv[1], sys.argv[2:]
     sys.argv = ["roslaunch", path, *args]
     config = roslaunch.config.load_config_default([path], None, verbose=False)
@@ -57,4 +60,5 @@ def main():
     json.dump(found, sys.stdout)
 
 
-main()
+if __name__ == "__main__":
+    main()

@@ -23,6 +23,7 @@ from typing import Any
 import pytest
 import yaml
 from procutil import install_package
+from ros1_oracle import typed
 from ros1tree import oracle, package_tree, requires_roslaunch
 
 from mlaunch import readers, standins
@@ -58,23 +59,6 @@ CASES: list[tuple[str, str, list[dict[str, str]]]] = [
     ("bridge", "rosbridge_server/launch/rosbridge_websocket.launch", [{"ssl": "true"}]),
     ("smartcar", SMARTCAR, [{}, {"gui": "true"}]),
 ]
-
-
-def typed(value: Any) -> Any:
-    """A value with its type, as tests/ros1_oracle.py writes roslaunch's."""
-    if isinstance(value, bool):
-        return ["bool", value]
-    if isinstance(value, int):
-        return ["int", value]
-    if isinstance(value, float):
-        return ["double", value]
-    if isinstance(value, str):
-        return ["str", value]
-    if isinstance(value, list):
-        return ["list", [typed(v) for v in value]]
-    if isinstance(value, dict):
-        return ["dict", {k: typed(v) for k, v in value.items()}]
-    return [type(value).__name__, str(value)]
 
 
 def mlaunch_view(config: ros1_config.Config) -> dict[str, Any]:
