@@ -29,7 +29,7 @@ from mlaunch.launch_testing.proc_info_handler import ActiveProcInfoHandler
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
     from typing import Any
 
 # How long a launch fixture waits for its ReadyToTest, and for its launch to end at shutdown.
@@ -56,10 +56,15 @@ class LaunchRun:
         # halves must run on the same loop (closing a loop finalizes its async generators).
         self._loop: asyncio.AbstractEventLoop | None = None
 
-    def run_coroutine(self, coroutine: Any) -> Any:
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop:
+        """The asyncio loop the async tests of this launch run on (the ``event_loop`` fixture)."""
         if self._loop is None:
             self._loop = asyncio.new_event_loop()
-        return self._loop.run_until_complete(coroutine)
+        return self._loop
+
+    def run_coroutine(self, coroutine: Any) -> Any:
+        return self.loop.run_until_complete(coroutine)
 
     @classmethod
     def start(
@@ -254,6 +259,20 @@ def launch_service(request: pytest.FixtureRequest) -> LaunchService:
 def launch_context(request: pytest.FixtureRequest) -> Any:
     """The launch context of the test's launch fixture (for launch_pytest.tools)."""
     return _run_of(request).service.context
+
+
+@pytest.fixture
+def event_loop(request: pytest.FixtureRequest) -> Iterator[asyncio.AbstractEventLoop]:
+    """The asyncio loop a test's coroutines run on: its launch's for a launch test (closed when
+    the launch is done), else a new loop closed after the test, as launch_pytest's fixture."""
+    if _launch_marker(request.node) is not None:
+        yield _run_of(request).loop
+        return
+    loop = asyncio.new_event_loop()
+    try:
+        yield loop
+    finally:
+        loop.close()
 
 
 # --- collection -----------------------------------------------------------------------------
