@@ -1,11 +1,12 @@
 """launch_testing pieces that run a launch or sit in pytest: StdoutReadyListener on a real
-launch, and the pytest plugin's pytest-version-dependent path (7.4, what ROS 2 Jazzy runs on
-Ubuntu 24.04, and the venv's current pytest)."""
+launch, and the plugins' pytest-version-dependent paths (7.4, what ROS 2 Jazzy runs on Ubuntu
+24.04, and the venv's current pytest): importing a test module, reading a fixture's marker."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -16,6 +17,7 @@ from mlaunch.launch.actions import (
     OpaqueFunction,
     RegisterEventHandler,
 )
+from mlaunch.launch_pytest.plugin import fixture_marker
 from mlaunch.launch_testing.event_handlers import StdoutReadyListener
 from mlaunch.launch_testing.pytest import hooks
 from mlaunch.launch_testing.util import KeepAliveProc
@@ -61,14 +63,32 @@ def test_pytest_versions_are_read_as_numbers(text: str, expected: tuple[int, ...
     assert hooks.version_tuple(text) == expected
 
 
+class _Config:
+    """What import_kwargs reads of a pytest config, as any pytest version has it."""
+
+    rootpath = Path("/somewhere")
+
+    def getoption(self, name: str) -> str:
+        assert name == "importmode"
+        return "prepend"
+
+    def getini(self, name: str) -> bool:
+        assert name == "consider_namespace_packages"  # an ini only pytest >= 8.1 knows
+        return False
+
+
 def test_import_keywords_follow_the_pytest_version(pytestconfig: pytest.Config) -> None:
     # pytest 7.4's import_path refuses consider_namespace_packages (added in 8.1): every
     # @pytest.mark.launch_test file failed to collect there.
-    old = hooks.import_kwargs(pytestconfig, (7, 4, 4))
-    assert set(old) == {"mode", "root"}
-    new = hooks.import_kwargs(pytestconfig, (8, 1, 0))
-    assert set(new) == {"mode", "root", "consider_namespace_packages"}
-    assert hooks.import_kwargs(pytestconfig) == (new if pytest.version_tuple >= (8, 1) else old)
+    config: Any = _Config()
+    assert hooks.import_kwargs(config, (7, 4, 4)) == {"mode": "prepend", "root": config.rootpath}
+    assert hooks.import_kwargs(config, (8, 1, 0)) == {
+        "mode": "prepend",
+        "root": config.rootpath,
+        "consider_namespace_packages": False,
+    }
+    current = hooks.import_kwargs(pytestconfig)  # the running pytest: its own keywords
+    assert ("consider_namespace_packages" in current) == (pytest.version_tuple >= (8, 1))
 
 
 def test_the_current_pytest_imports_a_test_module_with_those_keywords(
@@ -80,3 +100,29 @@ def test_the_current_pytest_imports_a_test_module_with_those_keywords(
     module = hooks.import_test_module(path, pytestconfig)
     assert module.generate_test_description() == "described"
     monkeypatch.delitem(sys.modules, module.__name__)
+
+
+class _Marker:
+    def __init__(self, scope: str, name: str | None = None) -> None:
+        self.scope = scope
+        self.name = name
+
+
+def test_a_fixture_marker_is_found_where_each_pytest_keeps_it() -> None:
+    def pytest_7_4_fixture() -> None:  # the function itself, marked (up to pytest 8.3)
+        return None
+
+    pytest_7_4_fixture._pytestfixturefunction = _Marker("module")  # type: ignore[attr-defined]
+
+    class Pytest84Definition:  # a FixtureFunctionDefinition (pytest 8.4 on)
+        _fixture_function_marker = _Marker("class", "renamed")
+
+    assert fixture_marker(pytest_7_4_fixture).scope == "module"
+    assert fixture_marker(Pytest84Definition()).name == "renamed"
+    assert fixture_marker(lambda: None) is None
+
+    @pytest.fixture(scope="session")
+    def real() -> None:
+        return None
+
+    assert fixture_marker(real).scope == "session"  # whichever pytest runs this
