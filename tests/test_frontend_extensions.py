@@ -71,6 +71,17 @@ class Wrap(Action):
 
     def execute(self, context):
         return list(self.actions)
+
+
+@expose_action("explode")
+class Explode(Action):
+    @classmethod
+    def parse(cls, entity, parser):
+        _, kwargs = super().parse(entity, parser)
+        return cls, kwargs
+
+    def execute(self, context):
+        raise RuntimeError("boom")
 """
 
 XML = """\
@@ -227,3 +238,39 @@ def test_extension_mistakes_are_located(tmp_path: Path, body: str, message: str)
     assert "Traceback" not in done.stderr
     assert message in done.stderr, done.stderr
     assert done.stderr.startswith(f"mlaunch: error: {path}:")
+
+
+def test_an_exposed_action_that_raises_is_located_not_a_crash(tmp_path: Path) -> None:
+    site = tmp_path / "site"
+    site.mkdir()
+    env = extension(site, entry_point=True)
+    path = tmp_path / "x.launch.xml"
+    path.write_text("<launch>\n  <explode/>\n</launch>\n")
+    done = run_mlaunch(str(path), "--print", env=env)
+    assert done.returncode == 2, done.stderr
+    assert f"{site}/shout_ext/__init__.py:" in done.stderr
+    assert f"RuntimeError in Explode: boom (the action written at {path}:2)" in done.stderr
+
+
+def test_a_launch_file_action_that_raises_is_located(tmp_path: Path) -> None:
+    path = tmp_path / "x.launch.py"
+    path.write_text(
+        textwrap.dedent(
+            """\
+            from launch import LaunchDescription
+            from launch.action import Action
+
+
+            class Broken(Action):
+                def execute(self, context):
+                    return {}["missing"]
+
+
+            def generate_launch_description():
+                return LaunchDescription([Broken()])
+            """
+        )
+    )
+    done = run_mlaunch(str(path), "--print", env=clean_env())
+    assert done.returncode == 2, done.stderr
+    assert f"mlaunch: error: {path}:7: KeyError in Broken: 'missing'" in done.stderr

@@ -19,6 +19,7 @@ from mlaunch.plan.errors import (
     MlaunchError,
     PackageNotFoundError,
     SubstitutionFailure,
+    is_own_module,
 )
 from mlaunch.plan.origin import user_location
 from mlaunch.plan.record import Record
@@ -138,8 +139,23 @@ class Resolver:
                 e.what = _short(entity)
             self._name_declaration(e)
             raise
+        except Exception as e:
+            if is_own_module(type(entity).__module__):
+                raise  # mlaunch's own action failing is mlaunch's bug
+            raise self._foreign_failure(entity, e) from e
         if more:
             self.visit_all(more)
+
+    def _foreign_failure(self, entity: object, error: Exception) -> MlaunchError:
+        """An action class of a launch file or a package (an exposed tag) that raised: where it
+        raised, and where the action was written."""
+        origin = getattr(entity, "origin", None)
+        where = user_location(error.__traceback__, self.context.current_launch_file_path)
+        written = f" (the action written at {origin})" if origin and where else ""
+        return MlaunchError(
+            f"{type(error).__name__} in {type(entity).__name__}: {error}{written}",
+            where=where or origin,
+        )
 
     def _name_declaration(self, error: MlaunchError) -> None:
         """Add where the launch argument a bad value came from is declared (once)."""
