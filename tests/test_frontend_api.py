@@ -251,3 +251,13 @@ def test_on_exit_shutdown_is_the_process_sub_entity() -> None:
     (shutdown,) = process.get_sub_entities()
     assert isinstance(shutdown, actions.Shutdown)
     assert actions.ExecuteProcess(cmd=["ls"], on_exit=shutdown).get_sub_entities() == []
+
+
+def test_a_markup_parser_knows_launch_ros_substitutions_too() -> None:
+    from mlaunch.launch_ros.substitutions import FindPackageShare
+
+    parser = launch_yaml.Parser()
+    (share,) = parser.parse_substitution("$(find-pkg-share demo)")
+    assert isinstance(share, FindPackageShare)
+    values = parser.parse_if_substitutions(["$(find-pkg-share demo)", "x"])
+    assert isinstance(values[0][0], FindPackageShare) and values[1] == "x"

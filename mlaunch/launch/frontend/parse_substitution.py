@@ -31,14 +31,18 @@ def parse_substitution(string_value: str) -> list[Substitution]:
     ]
 
 
-def parse_if_substitutions(value: Any) -> Any:
+def parse_if_substitutions(value: Any, parse: Any = None) -> Any:
     """A str with substitutions as a list of them, plain text as the str, any other scalar as
-    it is; a list item by item. A list that mixes value types is a ValueError."""
+    it is; a list item by item. A list that mixes value types is a ValueError.
+
+    ``parse`` reads one str (default ``parse_substitution``; a parser passes its own).
+    """
+    parse = parse or parse_substitution
     kinds: set[type] = set()
 
     def one(item: Any) -> Any:
         if isinstance(item, str):
-            output = parse_substitution(item)
+            output = parse(item)
             if len(output) == 1 and isinstance(output[0], TextSubstitution):
                 kinds.add(str)
                 return output[0].text

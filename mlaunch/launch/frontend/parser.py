@@ -99,7 +99,7 @@ class Parser:
         return parse_substitution(value)
 
     def parse_if_substitutions(self, value: Any) -> Any:
-        return parse_if_substitutions(value)
+        return parse_if_substitutions(value, self.parse_substitution)
 
     def escape_characters(self, value: str) -> str:
         return replace_escaped_characters(value)
