@@ -5,9 +5,22 @@ and node ``args`` split before substitution."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from test_roslaunch import by_label, globals_of, package, params, plan_of, warnings_text, write
+from procutil import install_package
+from test_convert import converted
+from test_roslaunch import (
+    PREFIX,
+    by_label,
+    globals_of,
+    package,
+    params,
+    plan_of,
+    summarize,
+    warnings_text,
+    write,
+)
 
 
 def test_an_included_launch_xml_fragment_is_read_as_roslaunch_xml(tmp_path: Path) -> None:
@@ -200,3 +213,29 @@ def test_a_global_set_in_an_included_file_reaches_the_includers_nodes(tmp_path: 
     # roslaunch sets every parameter before any node starts: the order of tags does not matter
     assert globals_of(nodes["before_include"]) == {"rate_from_include": "30"}
     assert "gets no robot_description" not in warnings_text(plan)
+
+
+def test_find_xacro_as_an_argument_of_another_program_stays_its_path(tmp_path: Path) -> None:
+    prefix = install_package(tmp_path / "install", "xacro", {"xacro": "#!/bin/sh\n"})
+    path = write(
+        tmp_path,
+        "wrapped.launch",
+        """
+        <launch>
+          <arg name="model" default="$(dirname)/robot.urdf.xacro"/>
+          <node pkg="mlaunch_demo" type="talker" name="env_run"
+                args="$(find xacro)/xacro $(arg model) --inorder"/>
+        </launch>
+        """,
+    )
+    ament = f"{prefix}{os.pathsep}{PREFIX}"
+    (talker,) = plan_of(path, AMENT_PREFIX_PATH=ament).processes()
+    assert list(talker.argv[1 : talker.argv.index("--ros-args")]) == [
+        str(prefix / "lib" / "xacro" / "xacro"),
+        str(tmp_path / "robot.urdf.xacro"),
+        "--inorder",
+    ]
+    for fmt in ("py", "yaml", "xml"):  # a conversion names the same program
+        out = converted(Path(path), fmt)
+        ros2 = plan_of(str(out), AMENT_PREFIX_PATH=ament)
+        assert summarize(ros2) == summarize(plan_of(path, AMENT_PREFIX_PATH=ament)), fmt

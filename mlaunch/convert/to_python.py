@@ -27,6 +27,7 @@ from mlaunch.ros1.model import (
     Dropped,
     EnvRef,
     EvalRef,
+    ExecRef,
     FileRef,
     FindRef,
     Group,
@@ -145,6 +146,7 @@ IMPORTS = {
     "SetRemap": "launch_ros.actions",
     "ParameterValue": "launch_ros.parameter_descriptions",
     "FindPackageShare": "launch_ros.substitutions",
+    "ExecutableInPackage": "launch_ros.substitutions",
     "Machine": "mlaunch.actions",
 }
 for _name in (
@@ -365,6 +367,8 @@ class PythonWriter:
             return self.use("LaunchConfiguration", pystr(part.name))
         if isinstance(part, FindRef):
             return self.use("FindPackageShare", pystr(part.package))
+        if isinstance(part, ExecRef):
+            return self.use("ExecutableInPackage", pystr(part.executable), pystr(part.package))
         if isinstance(part, EnvRef):
             default = None if part.default is None else pystr(part.default)
             return self.use("EnvironmentVariable", pystr(part.name), default_value=default)

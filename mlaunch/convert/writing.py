@@ -21,6 +21,7 @@ from mlaunch.ros1.model import (
     DirnameRef,
     EnvRef,
     EvalRef,
+    ExecRef,
     FileRef,
     FindRef,
     Include,
@@ -209,6 +210,9 @@ class Templates:
             return f"$(var {self.arg(part.name, nested)})"
         if isinstance(part, FindRef):
             return f"$(find-pkg-share {self.arg(part.package, nested)})"
+        if isinstance(part, ExecRef):
+            program = self.arg(part.executable, nested)
+            return f"$(exec-in-pkg {program} {self.arg(part.package, nested)})"
         if isinstance(part, EnvRef):
             if part.default is None:
                 return f"$(env {self.arg(part.name, nested)})"

@@ -27,6 +27,7 @@ from mlaunch.ros1.model import (
     Dropped,
     EnvRef,
     EvalRef,
+    ExecRef,
     FileRef,
     FindRef,
     Group,
@@ -243,6 +244,10 @@ def _substitution(part: Part) -> Any:
         from mlaunch.launch_ros.substitutions import FindPackageShare
 
         return FindPackageShare(part.package)
+    if isinstance(part, ExecRef):
+        from mlaunch.launch_ros.substitutions import ExecutableInPackage
+
+        return ExecutableInPackage(part.executable, part.package)
     if isinstance(part, EnvRef):
         return core.EnvironmentVariable(part.name, default_value=part.default)
     if isinstance(part, AnonRef):

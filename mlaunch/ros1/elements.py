@@ -30,7 +30,7 @@ from mlaunch.ros1.model import (
     static_text,
 )
 from mlaunch.ros1.scope import Desc, Out, Scope
-from mlaunch.ros1.values import convert_value, resolve_static, rewrite_xacro
+from mlaunch.ros1.values import convert_value, program_paths, resolve_static, rewrite_xacro
 
 
 @dataclass
@@ -184,13 +184,17 @@ class ElementReader:
                     )
                 )
 
-    def attr(self, el: Element, name: str, scope: Scope, required: bool = False) -> Value | None:
+    def attr(
+        self, el: Element, name: str, scope: Scope, required: bool = False, program: bool = True
+    ) -> Value | None:
+        """An attribute's value; ``program`` false: ``$(find xacro)/xacro`` stays a path (an
+        argument of another program), not the xacro command."""
         raw = el.attrs.get(name)
         if raw is None:
             if required:
                 raise self.error(el, f"missing required attribute {name!r}")
             return None
-        return self.value(raw, el, name, scope)
+        return self.value(raw, el, name, scope, program)
 
     def literal(self, el: Element, name: str, scope: Scope, required: bool = False) -> str | None:
         """An attribute that must be known when the file is read (no $(arg))."""
@@ -232,7 +236,7 @@ class ElementReader:
 
     # --- values -------------------------------------------------------------------------------
 
-    def value(self, raw: str, el: Element, attr: str, scope: Scope) -> Value:
+    def value(self, raw: str, el: Element, attr: str, scope: Scope, program: bool = True) -> Value:
         """An attribute's text with roslaunch's ``$(...)`` args parsed (no nesting, as there)."""
         if raw.startswith("$(eval ") and raw.endswith(")"):
             return (self.eval(raw[7:-1], el, scope),)
@@ -252,7 +256,7 @@ class ElementReader:
             parts.append(raw[i:j])
             parts.append(self.substitution(body, el, attr, raw, scope))
             i = k + 1
-        return rewrite_xacro(merge(parts))
+        return rewrite_xacro(merge(parts)) if program else program_paths(merge(parts))
 
     def substitution(self, body: str, el: Element, attr: str, raw: str, scope: Scope) -> Ref:
         words = [w for w in body.split(" ") if w]

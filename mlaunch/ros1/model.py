@@ -33,6 +33,15 @@ class FindRef(Ref):
 
 
 @dataclass(frozen=True)
+class ExecRef(Ref):
+    """``$(find pkg)/program`` where it names a program (an argument of another one): the
+    program's path (ROS 2 ExecutableInPackage), as roslaunch found it in the package."""
+
+    package: str
+    executable: str
+
+
+@dataclass(frozen=True)
 class EnvRef(Ref):
     """``$(env NAME)`` (no default: must be set) or ``$(optenv NAME default)``."""
 
@@ -342,6 +351,8 @@ def describe_value(value: Value | Any) -> str:
             out.append(f"$(arg {part.name})")
         elif isinstance(part, FindRef):
             out.append(f"$(find {part.package})")
+        elif isinstance(part, ExecRef):
+            out.append(f"$(find {part.package})/{part.executable}")
         elif isinstance(part, EnvRef):
             out.append(f"$(env {part.name})" if part.default is None else f"$(optenv {part.name})")
         elif isinstance(part, AnonRef):

@@ -308,7 +308,7 @@ class Reader(ParamReader, NodeMapper):
             prefix=self.attr(el, "launch-prefix", scope),
             machine=self.attr(el, "machine", scope),
         )
-        args = self.attr(el, "args", scope)
+        args = self.attr(el, "args", scope, program=False)
         node.arguments = split_arguments(args) if args is not None else []
         if args is not None and static_text(args) is None:
             node.shell_args = args

@@ -12,7 +12,7 @@ from typing import Any
 import yaml
 
 from mlaunch.plan.errors import LaunchFileError
-from mlaunch.ros1.model import DirnameRef, FindRef, Part, Value, merge
+from mlaunch.ros1.model import DirnameRef, ExecRef, FindRef, Part, Value, merge
 
 _XACRO = re.compile(r"^/xacro(\.py)?(?=\s)")
 
@@ -135,6 +135,22 @@ def rewrite_xacro(value: Value) -> Value:
         if parts[i] == FindRef("xacro") and isinstance(nxt, str) and _XACRO.match(nxt):
             parts[i] = "xacro"
             parts[i + 1] = _XACRO.sub("", nxt)
+    return merge(parts)
+
+
+_PROGRAM = re.compile(r"^/(xacro)(\.py)?(?=\s|$)")
+
+
+def program_paths(value: Value) -> Value:
+    """``$(find xacro)/xacro`` as an argument of another program (an ``env_run`` wrapper): the
+    path of the xacro program, as roslaunch found it (not the in-process ``xacro`` command)."""
+    parts = list(value)
+    for i in range(len(parts) - 1):
+        nxt = parts[i + 1]
+        found = _PROGRAM.match(nxt) if isinstance(nxt, str) else None
+        if parts[i] == FindRef("xacro") and found is not None and isinstance(nxt, str):
+            parts[i] = ExecRef("xacro", found.group(1))
+            parts[i + 1] = nxt[found.end() :]
     return merge(parts)
 
 
