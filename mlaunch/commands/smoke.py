@@ -14,6 +14,7 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
+from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, UsageError
 from mlaunch.smoke import junit
 from mlaunch.smoke.expectations import (
@@ -139,8 +140,10 @@ def build_expectations(
             out.setdefault(("lifecycle", fqn), Expectation("lifecycle", fqn))
     components: dict[str, str] = {}  # composable node -> its container (LoadComponents steps)
     for step in plan.steps:
-        for name in getattr(step, "component_names", list)():
-            components[name] = step.target  # type: ignore[attr-defined]
+        if not isinstance(step, LoadComponents):
+            continue
+        for name in step.component_names():
+            components[name] = step.target
             out.setdefault(("node", name), Expectation("node", name))
     if use_sim_time or collector.use_sim_time or any(_sim_time_argv(s.argv) for s in specs):
         out[("clock", "/clock")] = Expectation("clock", "/clock")

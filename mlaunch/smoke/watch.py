@@ -140,18 +140,19 @@ class SmokeRun(Part):
     def _on_handoff(self, step: object) -> None:
         """Components loaded later (a timer's or a handler's loads) are nodes the graph must
         show, as the plan's are; the plan's own are expected already."""
-        names = getattr(step, "component_names", None)
-        if names is None or self.phase == "done":
+        from mlaunch.launch_ros.composition import LoadComponents
+
+        if not isinstance(step, LoadComponents) or self.phase == "done":
             return
         keys = {e.key() for e in self.expectations}
-        target = getattr(step, "target", "")
+        target = step.target
         labels = [
             p.label
             for p in self.supervisor.processes
             if p.spec.node is not None and p.spec.node.fully_qualified_name == target
         ]
         added = False
-        for name in names():
+        for name in step.component_names():
             if ("node", name) not in keys:
                 e = Expectation("node", name, origin="loaded later", labels=labels)
                 self.expectations.insert(len(self.expectations) - 1, e)  # before 'shutdown'
@@ -343,7 +344,7 @@ class SmokeRun(Part):
                 self._mark(e, "failed", f"{e.seen}; the launch shut down first ({reason})")
 
     def _conclude_shutdown(self, e: Expectation) -> None:
-        records = getattr(self.supervisor, "records", None) or {}
+        records = self.supervisor.process_records
         killed = [r.label for r in records.values() if signal.SIGKILL in r.signals]
         e.labels = killed
         if killed:
