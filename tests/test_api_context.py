@@ -212,3 +212,17 @@ def test_substitution_failures_say_what_launch_says(tmp_path) -> None:  # type: 
         ThisLaunchFileDir().perform(context)
     context.extend_locals({"current_launch_file_directory": "foo"})
     assert ThisLaunchFileDir().perform(context) == "foo"
+
+
+def test_python_expression_errors_are_what_the_expression_raised() -> None:
+    from launch import LaunchContext
+    from launch.substitutions import PythonExpression
+    from launch.substitutions.substitution_failure import SubstitutionFailure
+
+    without_math = PythonExpression(["math.ceil(1.6)"], [])
+    with pytest.raises(NameError) as raised:  # as launch lets it through
+        without_math.perform(LaunchContext())
+    assert isinstance(raised.value, SubstitutionFailure)  # and mlaunch locates it
+    assert without_math.describe() == "PythonExpr('math.ceil(1.6)', [])"
+    assert PythonExpression("ceil(1.6)").perform(LaunchContext()) == "2"
+    assert PythonExpression("1", ["sys", "math"]).describe() == "PythonExpr('1', ['sys', 'math'])"

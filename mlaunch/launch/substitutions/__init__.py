@@ -387,12 +387,26 @@ class PythonExpression(Substitution):
         try:
             return str(eval(expression, {}, namespace))
         except Exception as e:
-            raise SubstitutionFailure(
-                f"Python expression {expression!r} failed: {type(e).__name__}: {e}"
-            )
+            message = f"Python expression {expression!r} failed: {type(e).__name__}: {e}"
+            raise _failure_of(e, message) from e
 
     def describe(self) -> str:
-        return f"PythonExpr({describe(self.expression)})"
+        mods = self.python_modules
+        listed = [mods] if isinstance(mods, (str, Substitution)) else list(mods)
+        modules = ", ".join(describe(normalize(m)) for m in listed)
+        return f"PythonExpr({describe(self.expression)}, [{modules}])"
+
+
+def _failure_of(error: Exception, message: str) -> SubstitutionFailure:
+    """A SubstitutionFailure that is also an instance of ``error``'s type: mlaunch reports it
+    as one located line, and code written against launch still catches the NameError (or
+    whatever the expression raised) that launch lets through."""
+    try:
+        both = type(type(error).__name__, (SubstitutionFailure, type(error)), {})
+        failure: SubstitutionFailure = both(message)
+    except TypeError:  # a type that cannot be combined (or built from one message)
+        failure = SubstitutionFailure(message)
+    return failure
 
 
 __all__ = [
