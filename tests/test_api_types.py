@@ -16,6 +16,8 @@ def test_types_are_extracted_and_unknown_ones_refused() -> None:
     assert tu.extract_type(bool) == (bool, False)
     with pytest.raises(ValueError, match="Unrecognized data type"):
         tu.extract_type(dict)
+    assert tu.is_typing_list(List) and tu.is_typing_list(List[int])  # noqa: UP006
+    assert not tu.is_typing_list(list) and not tu.is_typing_list(int)
 
 
 def test_text_is_coerced_with_yaml_rules() -> None:

@@ -16,9 +16,8 @@ SCALAR_TYPES = (int, float, bool, str)
 
 
 def is_typing_list(data_type: Any) -> bool:
-    """Whether ``data_type`` is ``List``/``list`` or a subscription of it (``List[int]``)."""
-    if data_type is list:
-        return True
+    """Whether ``data_type`` is ``typing.List`` or a subscription of a list (``List[int]``,
+    ``list[int]``); the bare ``list`` class is not, as in launch."""
     return getattr(data_type, "__origin__", None) is list
 
 
