@@ -226,3 +226,15 @@ def test_python_expression_errors_are_what_the_expression_raised() -> None:
     assert without_math.describe() == "PythonExpr('math.ceil(1.6)', [])"
     assert PythonExpression("ceil(1.6)").perform(LaunchContext()) == "2"
     assert PythonExpression("1", ["sys", "math"]).describe() == "PythonExpr('1', ['sys', 'math'])"
+
+
+def test_if_else_reads_a_typed_bool_and_completion_handlers_check_entities() -> None:
+    from launch import LaunchContext
+    from launch.actions import LogInfo
+    from launch.event_handlers import OnExecutionComplete
+    from launch.substitutions import IfElseSubstitution
+
+    assert IfElseSubstitution("on", "a", "b").perform(LaunchContext()) == "a"
+    assert IfElseSubstitution("0", "a", "b").perform(LaunchContext()) == "b"
+    with pytest.raises(TypeError):
+        OnExecutionComplete(target_action=LogInfo(msg="m"), on_completion="not an action")

@@ -173,7 +173,8 @@ class IfElseSubstitution(Substitution):
         self.else_value = normalize(else_value)
 
     def perform(self, context: LaunchContext) -> str:
-        chosen = evaluate_condition_expression(perform_substitutions(context, self.condition))
+        # launch reads the condition as a typed bool (YAML's true/yes/on..., and 1/0)
+        chosen = to_bool(perform_substitutions(context, self.condition), "IfElseSubstitution")
         return perform_substitutions(context, self.if_value if chosen else self.else_value)
 
     def describe(self) -> str:

@@ -291,6 +291,7 @@ class OnExecutionComplete(EventHandler):
         super().__init__(
             target_action=target_action, entities=on_completion, handle_once=handle_once
         )
+        check_entities(self.entities, "OnExecutionComplete")
 
 
 class OnIncludeLaunchDescription(EventHandler):

@@ -157,7 +157,12 @@ class LaunchLogDir(Substitution):
     """The log directory of this run (``$(log_dir)``)."""
 
     def perform(self, context: LaunchContext) -> str:
-        return context.log_dir
+        if context.log_dir:
+            return context.log_dir
+        # A context no run made: launch.logging's folder, made on first use, as launch's.
+        from mlaunch.launch.logging import launch_config
+
+        return launch_config.log_dir
 
     def describe(self) -> str:
         return "LaunchLogDir()"
