@@ -60,3 +60,26 @@ def test_every_action_completes_for_on_execution_complete(tmp_path: Path) -> Non
     assert said == ["first", "grouped", "last", "after first", "after grouped"], done.stderr
     printed = run_mlaunch(str(path), "--print", env=clean_env()).stdout
     assert "ExecutionComplete" not in printed  # implicit in the text plan
+
+
+EXECUTE_LOCAL = """\
+import sys
+from launch import LaunchDescription
+from launch.actions import ExecuteLocal
+from launch.descriptions import Executable
+
+def generate_launch_description():
+    return LaunchDescription([ExecuteLocal(
+        process_description=Executable(
+            cmd=[sys.executable, '-c', 'import os; print("got", os.environ["X"])'],
+            additional_env={'X': 'hello'}),
+        output='screen')])
+"""
+
+
+def test_execute_local_runs_its_executable_description(tmp_path: Path) -> None:
+    path = tmp_path / "l.launch.py"
+    path.write_text(EXECUTE_LOCAL)
+    done = run_mlaunch(str(path), env=clean_env())
+    assert done.returncode == 0, done.stderr
+    assert "got hello" in done.stdout

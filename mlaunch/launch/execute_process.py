@@ -360,7 +360,22 @@ def _env_changes(before: dict[str, str], after: dict[str, str]) -> dict[str, str
     return changes
 
 
-ExecuteLocal = ExecuteProcess
+class ExecuteLocal(ExecuteProcess):
+    """launch's ExecuteLocal: the process given as an ``Executable`` description (its command,
+    prefix, name, folder and environment), with ExecuteProcess's other keywords."""
+
+    def __init__(self, *, process_description: Any, **kwargs: Any) -> None:
+        given = process_description.given
+        super().__init__(
+            cmd=given["cmd"],
+            prefix=given["prefix"],
+            name=given["name"],
+            cwd=given["cwd"],
+            env=given["env"],
+            additional_env=given["additional_env"],
+            **kwargs,
+        )
+        self.process_description = process_description
 
 
 def which(name: str, env: dict[str, str]) -> str | None:

@@ -47,8 +47,17 @@ class Executable:
 
         if isinstance(cmd, str):
             cmd = [cmd]
+        cmd = [*cmd, *(arguments or ())]
+        # As written, for ExecuteLocal, which takes its process from a description.
+        self.given: dict[str, Any] = {
+            "cmd": cmd,
+            "prefix": prefix,
+            "name": name,
+            "cwd": cwd,
+            "env": env,
+            "additional_env": additional_env,
+        }
         self.cmd = [normalize(part) for part in cmd]
-        self.cmd += [normalize(arg) for arg in arguments or ()]
         self.arguments = arguments
         # Without a prefix of its own, the 'launch-prefix' configuration applies, filtered by
         # 'launch-prefix-filter'; a prefix given here always applies.
