@@ -108,17 +108,20 @@ def add_global_remap(context: LaunchContext, action: Any, rule: tuple[str, str])
 def _extend_shared(
     context: LaunchContext, action: Any, key: str, entries: tuple[Any, ...], what: str
 ) -> None:
-    planner = context.planner
+    # A stand-in context of a unit test (launch_configurations only) plans nothing: no options.
+    planner = getattr(context, "planner", None)
     from mlaunch.plan.pragmas import SCOPED_PARAMETERS, file_has
 
     configs = context.launch_configurations
     current = configs.get(key)
     origin = action.origin or ""
-    scoped = getattr(action, "keep_in_scope", False) or planner.options.scoped_parameters
+    scoped = getattr(action, "keep_in_scope", False) or (
+        planner is not None and planner.options.scoped_parameters
+    )
     if scoped or file_has(origin, SCOPED_PARAMETERS):
         configs[key] = (*(current or ()), *entries)
     elif isinstance(current, list):
-        if context.shared_with_outer_scope(current):
+        if planner is not None and context.shared_with_outer_scope(current):
             planner.warn(
                 f"{origin}: this {what} also applies to the nodes after the enclosing"
                 " group, as in ros2 launch (its list is shared with the outer scope);"
