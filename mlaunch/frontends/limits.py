@@ -66,8 +66,14 @@ class IncludeChain:
 
     def enter(self, path: str, origin: str | None, context: LaunchContext) -> _Entered:
         """Record the include of ``path`` (a ``with`` block) or raise if it closes a cycle."""
-        configs = dict(context.launch_configurations)
-        environment = dict(context.environment)
+        return self.enter_state(
+            path, origin, dict(context.launch_configurations), dict(context.environment)
+        )
+
+    def enter_state(
+        self, path: str, origin: str | None, configs: dict[str, object], environment: dict[str, str]
+    ) -> _Entered:
+        """``enter`` for a reader whose state is not a LaunchContext (roslaunch's args, ns)."""
         here = origin or "?"
         for index, (seen, _, seen_configs, seen_env) in enumerate(self.entries):
             if seen == path and seen_configs == configs and seen_env == environment:

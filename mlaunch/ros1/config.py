@@ -17,6 +17,7 @@ from typing import Any
 
 import yaml
 
+from mlaunch.frontends.limits import IncludeChain
 from mlaunch.plan.errors import LaunchFileError, MlaunchError
 from mlaunch.ros1.elements import Element, parse_xml
 from mlaunch.ros1.rosargs import ArgMissing, Substitutions
@@ -183,6 +184,7 @@ class Loader:
         self.config = Config()
         self.default_machine: str | None = None
         self.origin = ""
+        self.includes = IncludeChain()
 
     def load(self, path: str, args: Mapping[str, str], core: bool = False) -> Config:
         """The file's configuration; with ``core``, roslaunch's roscore.xml first (as
@@ -304,6 +306,7 @@ class Loader:
         ctx.add_arg(name, value, default)
 
     def tag_include(self, el: Element, ctx: Context, path: str) -> None:
+        where = f"{path}:{el.line}"
         filename = self.required(el, "file", ctx)
         pass_all = bool_attr(self.attr(el, "pass_all_args", ctx), False, "pass_all_args")
         inner = self.scoped(el, ctx, "include")
@@ -329,8 +332,12 @@ class Loader:
         s = inner.subst
         inner.subst = Substitutions(dict(passed), {}, included, s.environ, s.find)
         inner.arg_names, inner.include_args = [], None
+        # The same file with the same args, namespace and env where it is already being read
+        # would repeat forever: an error naming the chain, as the other readers give.
+        state: dict[str, object] = {**passed, " ns": inner.ns}
         try:
-            self.file(included, inner)
+            with self.includes.enter_state(included, where, state, dict(inner.env)):
+                self.file(included, inner)
         except ArgMissing as e:
             raise LaunchFileError(f"included file {included} requires the {e.name!r} arg to be set")
 
