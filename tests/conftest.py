@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -17,6 +18,19 @@ from mlaunch import compat
 compat.install()
 
 REPO = Path(__file__).resolve().parent.parent
+
+# The venv's own ament prefix holds the real ROS 2 nodes when setup built them (--real-nodes);
+# an activated venv puts it on AMENT_PREFIX_PATH. The suite decides per test which programs run:
+# the stand-in tests must not get the real ones because of the shell they were started from
+# (test_real_nodes adds the prefix back where it wants the real programs).
+VENV_PREFIX = os.path.realpath(sys.prefix)
+_kept = [
+    entry
+    for entry in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep)
+    if entry and os.path.realpath(entry) != VENV_PREFIX
+]
+if "AMENT_PREFIX_PATH" in os.environ:
+    os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(_kept)
 
 HAVE_RCLPY = importlib.util.find_spec("rclpy") is not None
 requires_rclpy = pytest.mark.skipif(

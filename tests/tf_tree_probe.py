@@ -3,7 +3,7 @@
 Subscribes to robot_description (latched), /tf_static (latched) and /tf, and waits, with a
 deadline, until every link of the URDF is reachable from the root frame given as argv[1]
 (``odom`` for a simulated robot) through the transforms seen. Prints the frames seen, each
-child's parent, and what is missing if the deadline passes (exit status 3).
+child's parent and pose, and what is missing if the deadline passes (exit status 3).
 """
 
 from __future__ import annotations
@@ -40,6 +40,7 @@ def main() -> int:
     )
     parents: dict[str, str] = {}
     topics: dict[str, str] = {}
+    poses: dict[str, list[float]] = {}  # child -> x y z qx qy qz qw, rounded
     links: list[str] = []
 
     def keep(topic: str):  # type: ignore[no-untyped-def]
@@ -47,6 +48,9 @@ def main() -> int:
             for t in msg.transforms:
                 parents[t.child_frame_id] = t.header.frame_id
                 topics[t.child_frame_id] = topic
+                move, turn = t.transform.translation, t.transform.rotation
+                values = (move.x, move.y, move.z, turn.x, turn.y, turn.z, turn.w)
+                poses[t.child_frame_id] = [round(v, 6) + 0.0 for v in values]
 
         return on
 
@@ -65,7 +69,7 @@ def main() -> int:
                               "parents": parents}))  # fmt: skip
             return 3
         rclpy.spin_once(node, timeout_sec=0.05)
-    print(json.dumps({"links": links, "parents": parents, "topics": topics}))
+    print(json.dumps({"links": links, "parents": parents, "topics": topics, "poses": poses}))
     node.destroy_node()
     rclpy.shutdown()
     return 0
