@@ -43,9 +43,14 @@ def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
 
 
 def quaternion_from_matrix(m: Sequence[Sequence[float]]) -> Quaternion:
-    """The unit quaternion of the rotation part of a 3x3 or 4x4 matrix (w kept non-negative)."""
+    """The unit quaternion of the rotation part of a 3x3 or 4x4 matrix.
+
+    Computed as KDL's Rotation::GetQuaternion does, sign included (w may be negative), because
+    the real robot_state_publisher publishes what KDL gives: the same rotation with the other
+    sign would be a different /tf message (tests/test_real_nodes.py compares them).
+    """
     trace = m[0][0] + m[1][1] + m[2][2]
-    if trace > 0:
+    if trace > 1e-12:  # KDL's epsilon
         s = 2.0 * math.sqrt(trace + 1.0)
         q = ((m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, s / 4)
     elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
@@ -57,7 +62,7 @@ def quaternion_from_matrix(m: Sequence[Sequence[float]]) -> Quaternion:
     else:
         s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
         q = ((m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4, (m[1][0] - m[0][1]) / s)
-    return q if q[3] >= 0 else (-q[0], -q[1], -q[2], -q[3])
+    return q
 
 
 def transform(
