@@ -82,7 +82,9 @@ LIBPYTHON = Path(
 
 def _load_interfaces_build():  # type: ignore[no-untyped-def]
     """interfaces/build.py, for its cache, key, run and wheel helpers (one copy of each)."""
-    spec = importlib.util.spec_from_file_location("mlaunch_interfaces_build", ROOT / "interfaces" / "build.py")
+    spec = importlib.util.spec_from_file_location(
+        "mlaunch_interfaces_build", ROOT / "interfaces" / "build.py"
+    )
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -105,7 +107,9 @@ def read_manifest(sources: Path) -> dict[str, tuple[str, str]]:
     """MANIFEST.tsv: archive stem -> (repository, commit)."""
     manifest = sources / "MANIFEST.tsv"
     if not manifest.is_file():
-        raise BuildError(f"no {manifest}: the folder of ROS 2 source archives must have one", cannot_run=True)
+        raise BuildError(
+            f"no {manifest}: the folder of ROS 2 source archives must have one", cannot_run=True
+        )
     with manifest.open(newline="") as handle:
         rows = list(csv.DictReader(handle, delimiter="\t"))
     found = {row["archive"].removesuffix(".tar.gz"): (row["repo"], row["commit"]) for row in rows}
@@ -128,9 +132,14 @@ def build_key(sources: Path, interfaces: Path) -> str:
     parts = [ib._interpreter(), _tool_versions(), str(LIBPYTHON).encode()]
     for stem in sorted(read_manifest(sources)):
         parts += [stem.encode(), (sources / f"{stem}.tar.gz").read_bytes()]
-    for path in sorted(HERE.rglob("*")) + [ROOT / "interfaces" / "toolchain.txt", ROOT / "interfaces" / "drop_missing_includes.cmake"]:
-        if path.is_file() and "__pycache__" not in path.parts:
-            parts += [path.name.encode(), path.read_bytes()]
+    shared = [
+        ROOT / "interfaces" / "toolchain.txt",
+        ROOT / "interfaces" / "drop_missing_includes.cmake",
+    ]
+    for path in [*sorted(HERE.rglob("*")), *shared]:
+        # `install` (setup's side: Debian packages, pip) does not change what is built.
+        if path.is_file() and "__pycache__" not in path.parts and path.name != "install":
+            parts += [path.relative_to(ROOT).as_posix().encode(), path.read_bytes()]
     parts.append(interfaces.resolve().name.encode())  # wheels-KEY: the interfaces' own key
     return ib._digest(parts)
 
@@ -149,17 +158,27 @@ def check_tools() -> None:
     }
     missing = [name for name, path in wanted.items() if not path.exists()]
     if missing:
-        names = " ".join(name if name != "libpython3" else LIBPYTHON.name.split(".so")[0] for name in missing)
-        raise BuildError(f"cannot build the real ROS 2 nodes: missing Debian packages (apt-get install {names})", cannot_run=True)
+        names = " ".join(
+            name if name != "libpython3" else LIBPYTHON.name.split(".so")[0] for name in missing
+        )
+        raise BuildError(
+            f"cannot build the real ROS 2 nodes: missing Debian packages (apt-get install {names})",
+            cannot_run=True,
+        )
 
 
 def toolchain_venv(root: Path, interfaces: Path) -> Path:
     """The venv with the pinned libraries and tools to build against, made on first use."""
-    pins = (ROOT / "interfaces" / "toolchain.txt").read_bytes() + (HERE / "toolchain.txt").read_bytes()
+    pins = (ROOT / "interfaces" / "toolchain.txt").read_bytes() + (
+        HERE / "toolchain.txt"
+    ).read_bytes()
     wheels = sorted(interfaces.glob("mlaunch_composition_interfaces-*.whl"))
     if not wheels:
         raise BuildError(f"no composition_interfaces wheel in {interfaces}", cannot_run=True)
-    venv = root / f"toolchain-{ib._digest([ib._interpreter(), pins, interfaces.resolve().name.encode()])}"
+    venv = (
+        root
+        / f"toolchain-{ib._digest([ib._interpreter(), pins, interfaces.resolve().name.encode()])}"
+    )
     if (venv / ".complete").is_file():
         return venv
     shutil.rmtree(venv, ignore_errors=True)
@@ -167,8 +186,18 @@ def toolchain_venv(root: Path, interfaces: Path) -> Path:
     log = root / "toolchain.log"
     log.write_bytes(b"")
     ib._run([sys.executable, "-m", "venv", str(venv)], log)
-    pip = [str(venv / "bin" / "python"), "-m", "pip", "install", "--quiet", "--disable-pip-version-check"]
-    ib._run([*pip, "-r", str(ROOT / "interfaces" / "toolchain.txt"), "-r", str(HERE / "toolchain.txt")], log)
+    pip = [
+        str(venv / "bin" / "python"),
+        "-m",
+        "pip",
+        "install",
+        "--quiet",
+        "--disable-pip-version-check",
+    ]
+    ib._run(
+        [*pip, "-r", str(ROOT / "interfaces" / "toolchain.txt"), "-r", str(HERE / "toolchain.txt")],
+        log,
+    )
     ib._run([*pip, "--no-deps", str(wheels[0])], log)
     (venv / ".complete").write_text("")
     return venv
@@ -227,7 +256,9 @@ def build_package(source: Path, name: str, venv: Path, prefix: Path, work: Path)
     if (build / ".mlaunch-installed").is_file():  # a kept work folder (--work): done already
         return
     env = build_env(venv, prefix)
-    ib._run(["cmake", "-S", str(source), "-B", str(build), *_cmake_arguments(venv, prefix)], log, env)
+    ib._run(
+        ["cmake", "-S", str(source), "-B", str(build), *_cmake_arguments(venv, prefix)], log, env
+    )
     ib._run(["cmake", "--build", str(build), "--parallel", str(JOBS)], log, env)
     ib._run(["cmake", "--install", str(build)], log, env)
     (build / ".mlaunch-installed").write_text("")
@@ -247,7 +278,9 @@ def pack_wheel(prefix: Path, out: Path, manifest: dict[str, tuple[str, str]]) ->
             continue
         arcname = rel[len(SITE) :] if rel.startswith(SITE) else data_dir + rel
         entries.append((arcname, path.read_bytes(), path.stat().st_mode & 0o777))
-    sources = "".join(f"Source: {repo} {commit}\n" for repo, commit in sorted(set(manifest.values())))
+    sources = "".join(
+        f"Source: {repo} {commit}\n" for repo, commit in sorted(set(manifest.values()))
+    )
     names = ", ".join(name for _, _, name in PACKAGES)
     metadata = (
         f"Metadata-Version: 2.1\nName: {DIST.replace('_', '-')}\nVersion: {VERSION}\n"
@@ -255,8 +288,14 @@ def pack_wheel(prefix: Path, out: Path, manifest: dict[str, tuple[str, str]]) ->
         "Requires-Dist: ros-jazzy-rclpy\nRequires-Dist: ros-jazzy-rcl-action\n"
         f"Requires-Dist: ros-jazzy-rcl-lifecycle\n{sources}"
     )
-    wheel = f"Wheel-Version: 1.0\nGenerator: mlaunch scripts/real_nodes/build.py\nRoot-Is-Purelib: false\nTag: {ib.wheel_tag()}\n"
-    entries += [(info_dir + "METADATA", metadata.encode(), 0o644), (info_dir + "WHEEL", wheel.encode(), 0o644)]
+    wheel = (
+        "Wheel-Version: 1.0\nGenerator: mlaunch scripts/real_nodes/build.py\n"
+        f"Root-Is-Purelib: false\nTag: {ib.wheel_tag()}\n"
+    )
+    entries += [
+        (info_dir + "METADATA", metadata.encode(), 0o644),
+        (info_dir + "WHEEL", wheel.encode(), 0o644),
+    ]
     record = io.StringIO()
     writer = csv.writer(record, lineterminator="\n")
     for arcname, data, _ in entries:
@@ -308,8 +347,19 @@ def build_all(sources: Path, interfaces: Path, root: Path, keep: Path | None = N
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("sources", nargs="?", type=Path, default=DEFAULT_SOURCES, help="the folder of source archives with MANIFEST.tsv")
-    parser.add_argument("--interfaces", type=Path, required=True, help="the folder of the interface wheels (interfaces/build.py)")
+    parser.add_argument(
+        "sources",
+        nargs="?",
+        type=Path,
+        default=DEFAULT_SOURCES,
+        help="the folder of source archives with MANIFEST.tsv",
+    )
+    parser.add_argument(
+        "--interfaces",
+        type=Path,
+        required=True,
+        help="the folder of the interface wheels (interfaces/build.py)",
+    )
     parser.add_argument("--key", action="store_true", help="print the cache key and exit")
     parser.add_argument("--work", type=Path, help="build in this folder and keep it (to resume)")
     args = parser.parse_args(argv)
