@@ -208,15 +208,15 @@ def test_resolve_notes_lifecycle_needs_in_deferred_bodies_and_events() -> None:
 
 def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> None:
     """A ChangeState from a handler written as a function: no need was visible before the run."""
-    from mlaunch.app import pipeline
+    from mlaunch.app import parts
     from mlaunch.app.options import Options
     from mlaunch.launch_ros.events import ChangeState
     from mlaunch.parts.lifecycle import LifecycleManager
     from mlaunch.plan.events import LaunchEvent
 
     h = Harness(Plan())
-    run = pipeline.Run(Options("x.launch.py"), h.sup.plan, h.sup, h.printer)
-    watch = pipeline.lifecycle(run)
+    run = parts.Run(Options("x.launch.py"), h.sup.plan, h.sup, h.printer)
+    watch = parts.lifecycle(run)
     assert run.lifecycle is None
     event = ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=3)
     h.sup.events.emit(LaunchEvent(event))

@@ -181,6 +181,7 @@ PIPELINE_RUN = """
 import sys
 from mlaunch import compat
 from mlaunch.app import pipeline
+from mlaunch.app.parts import PartMaker, standard_parts
 from mlaunch.app.options import parse_options
 from mlaunch.engine.part import Part
 from mlaunch.plan.events import Started
@@ -199,8 +200,8 @@ class Broken(Part):
 compat.install()  # as mlaunch's main does: the launch file imports the ROS 2 names
 opts = parse_options([sys.argv[1]])
 essential = sys.argv[2] == "essential"
-extra = pipeline.PartMaker("the broken part", Broken, essential=essential)
-sys.exit(pipeline.launch(opts, [*pipeline.standard_parts(opts), extra]))
+extra = PartMaker("the broken part", Broken, essential=essential)
+sys.exit(pipeline.launch(opts, [*standard_parts(opts), extra]))
 """
 
 

@@ -104,7 +104,7 @@ class Harness:
         self._control: Control | None = None
 
     def control(self) -> Control:
-        """The run's runtime control, made on first use (as mlaunch.app.pipeline.Run does)."""
+        """The run's runtime control, made on first use (as mlaunch.app.parts.Run does)."""
         if self._control is None:
             self._control = Control(self.sup, self.printer)
         return self._control

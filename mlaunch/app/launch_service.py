@@ -190,7 +190,7 @@ class LaunchService:
     # --- running --------------------------------------------------------------------------------
 
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
-        from mlaunch.app.pipeline import components_part
+        from mlaunch.app.parts import components_part
         from mlaunch.engine.guard import Guard, new_run_id
         from mlaunch.engine.logfiles import make_run_log_dir
         from mlaunch.engine.output import Printer, stdout_is_color_terminal

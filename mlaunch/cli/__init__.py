@@ -55,11 +55,12 @@ def report_error(error: BaseException, debug: bool) -> int:
 def run_cli(argv: Sequence[str]) -> int:
     """``mlaunch FILE ...``: the pipeline with what every run attaches (or ``--check``)."""
     from mlaunch.app import pipeline
+    from mlaunch.app.parts import standard_parts
 
     opts = parse_options(argv)
     if opts.check:
         return check_target(opts)
-    return pipeline.launch(opts, pipeline.standard_parts(opts))
+    return pipeline.launch(opts, standard_parts(opts))
 
 
 def check_target(opts: Options) -> int:

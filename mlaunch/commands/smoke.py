@@ -62,7 +62,9 @@ def command(args: Sequence[str]) -> int:
     if opts.print_plan and opts.format == "json":
         return print_plan(opts, settings)
     if opts.show_args or opts.print_plan:
-        return pipeline.launch(opts, pipeline.standard_parts(opts))
+        from mlaunch.app.parts import standard_parts
+
+        return pipeline.launch(opts, standard_parts(opts))
     return run(opts, settings)
 
 
@@ -208,17 +210,18 @@ def supervise(
     ROS graph is shared.
     """
     from mlaunch.app import pipeline
+    from mlaunch.app.parts import PartMaker, Run, standard_parts
 
     runs: list[SmokeRun] = []
 
-    def smoke_checks(run: pipeline.Run) -> SmokeRun:
+    def smoke_checks(run: Run) -> SmokeRun:
         smoke = SmokeRun(run.supervisor, expectations, settings, lifecycle=run.lifecycle)
         runs.append(smoke)
         return smoke
 
     # Without its checks the run proves nothing: if they fail, the run ends (exit status 70).
-    checks = pipeline.PartMaker("the smoke checks", smoke_checks, essential=True)
-    parts = [*pipeline.standard_parts(opts), checks]
+    checks = PartMaker("the smoke checks", smoke_checks, essential=True)
+    parts = [*standard_parts(opts), checks]
     code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
     if not runs:
         return code

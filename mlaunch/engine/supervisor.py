@@ -110,7 +110,7 @@ class Supervisor:
     ) -> None:
         self.plan = plan
         # Subscribed below, and the terminal whose flow control the loop drives; parts are
-        # handed the printer by the run (mlaunch.app.pipeline.Run), never through here.
+        # handed the printer by the run (mlaunch.app.parts.Run), never through here.
         self._printer = printer
         self.options = options or ResolveOptions()
         self.labels = labels or LabelCounter()

@@ -1,7 +1,7 @@
 """Runtime control of a running launch: list, stop, start, restart, mute, unmute, logs.
 
 The core of ``mlaunch ctl`` (through the control socket, mlaunch.parts.control_socket) and of the
-``--status`` keys. The run (``mlaunch.app.pipeline.Run.control``) makes one Control on first
+``--status`` keys. The run (``mlaunch.app.parts.Run.control``) makes one Control on first
 use; it asks the printer for what only the printer knows (mutes, log tails). Every method
 runs on the supervisor's loop thread and never blocks: call it from a selector callback, a timer
 (``Supervisor.schedule``) or an event subscriber. Another thread must hand its request to the

@@ -1,0 +1,265 @@
+"""What attaches to a run of the pipeline (mlaunch.app.pipeline): the Run a part is made from,
+``PartMaker`` (a part's name, how it is made, whether the run can go on without it) and
+``standard_parts``, what every run gets: lifecycle driving (when the plan needs it, as resolve
+noted), the LoadNode driver, the control socket, the ``--status`` view (when asked for) and the
+exit summary. Each part is imported only when it is attached.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from mlaunch.app.options import Options
+from mlaunch.engine.part import Part
+from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Said, Started
+from mlaunch.plan.steps import Need, Plan
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.engine.output import Printer
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.components import ComponentDriver
+    from mlaunch.parts.control import Control
+    from mlaunch.parts.control_socket import ControlSocket
+    from mlaunch.parts.lifecycle import LifecycleManager
+
+
+class Run:
+    """What an attached part sees of the run: the command line, the plan, the supervisor and
+    the printer.
+
+    ``lifecycle`` is the LifecycleManager once lifecycle driving is attached (the smoke checks
+    share its ROS graph), else None. ``control`` is the run's runtime control, made on first
+    use (a run that is never controlled imports nothing for it).
+    """
+
+    __slots__ = ("_control", "lifecycle", "opts", "plan", "printer", "supervisor")
+
+    def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor, printer: Printer) -> None:
+        self.opts = opts
+        self.plan = plan
+        self.supervisor = supervisor
+        self.printer = printer
+        self.lifecycle: LifecycleManager | None = None
+        self._control: Control | None = None
+
+    def control(self) -> Control:
+        """Stop, start, restart, mute, unmute a process by label, list them, read their last
+        lines (mlaunch.parts.control); loop thread only."""
+        if self._control is None:
+            from mlaunch.parts.control import Control, ControlError
+
+            # A part of its own, whichever part first asks for it (the socket, the keys).
+            make = lambda: Control(self.supervisor, self.printer)  # noqa: E731
+            control = self.supervisor.reactor.attach("runtime control", make)
+            if not isinstance(control, Control):
+                raise ControlError("runtime control failed when it was made (said above)")
+            self._control = control
+        return self._control
+
+
+class PartMaker:
+    """One entry of what attaches to a run: its name (errors name it), how to make it from the
+    Run (None: nothing to attach), and whether the run can go on without it."""
+
+    __slots__ = ("essential", "make", "name")
+
+    def __init__(
+        self, name: str, make: Callable[[Run], Part | None], *, essential: bool = False
+    ) -> None:
+        self.name = name
+        self.make = make
+        self.essential = essential
+
+    def attach(self, run: Run) -> Part | None:
+        """Made behind the run's wall (mlaunch.engine.reactor): a failure is said, not raised."""
+        return run.supervisor.reactor.attach(
+            self.name, lambda: self.make(run), essential=self.essential
+        )
+
+
+# --- what every run attaches ---------------------------------------------------------------------
+
+
+def standard_parts(opts: Options) -> list[PartMaker]:
+    """Lifecycle driving, composable node loading, the control socket, the ``--status`` view if
+    asked for, then the exit summary.
+
+    Closed in this order at the end: the status view leaves the screen before the summary.
+    """
+    parts = [
+        PartMaker("lifecycle driving", lifecycle),
+        PartMaker("the LoadNode driver", components),
+        PartMaker("the control socket", control_socket),
+    ]
+    if opts.status:
+        parts.append(PartMaker("the status view", status_view))
+    parts.append(PartMaker("the exit summary", exit_summary))
+    return parts
+
+
+def lifecycle(run: Run) -> Part:
+    """Lifecycle (managed) node driving: at once when the plan needs it, else on demand.
+
+    Resolve records in ``plan.needs`` whatever the description says about lifecycle nodes;
+    a handler written as a function can still start one nobody could see before it ran, so
+    without that need a watch (a few isinstance checks per record) attaches the manager the
+    moment a lifecycle node starts or a ChangeState is emitted.
+    """
+    from mlaunch.plan.steps import SEQUENCE_ARGUMENT
+
+    plan = run.plan
+    if (
+        Need.LIFECYCLE in plan.needs
+        or SEQUENCE_ARGUMENT in plan.arguments
+        or SEQUENCE_ARGUMENT in run.opts.arguments
+    ):
+        from mlaunch.parts.lifecycle import attach
+
+        run.lifecycle = attach(run.opts.arguments, run.supervisor)
+        return run.lifecycle
+    return _LifecycleWatch(run)
+
+
+class _LifecycleWatch(Part):
+    """Attaches lifecycle driving the moment the run turns out to need it.
+
+    Until then it only looks at each record's class: a process of a lifecycle node starting,
+    or a launch event that needs lifecycle (ChangeState). The record that triggered it is
+    handed to the new manager, which sees every later record itself.
+    """
+
+    def __init__(self, run: Run) -> None:
+        self.run = run
+        run.supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if isinstance(event, Started):
+            node = event.process.spec.node
+            if node is None or not node.lifecycle:
+                return
+        elif not (isinstance(event, LaunchEvent) and getattr(event.event, "needs", None)):
+            return
+        from mlaunch.parts.lifecycle import attach
+
+        run = self.run
+        run.supervisor.events.unsubscribe(self._on_event)
+        run.lifecycle = attach(run.opts.arguments, run.supervisor)
+        run.lifecycle.on_event(event)
+
+    def close(self) -> None:
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        if self.run.lifecycle is not None:
+            self.run.lifecycle.close()
+
+
+def components(run: Run) -> Part:
+    """Composable node loading (``components_part``)."""
+    return components_part(run.plan, run.supervisor)
+
+
+def components_part(plan: Plan, supervisor: Supervisor) -> Part:
+    """The LoadNode driver: at once when the plan needs it, else on demand.
+
+    Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
+    LoadComposableNodes in timers and handlers not yet fired; a handler written as a function
+    (or a description a LaunchService includes later) can still make one, so without that need
+    a watch attaches the driver at the first LoadComponents the supervisor hands over.
+    """
+    if Need.COMPONENTS in plan.needs:
+        from mlaunch.parts.components import ComponentDriver
+
+        return ComponentDriver(supervisor)
+    return _ComponentsWatch(supervisor)
+
+
+class _ComponentsWatch(Part):
+    """Attaches the LoadNode driver at the first LoadComponents step handed over.
+
+    Until then it only looks at each record's class; the record that triggered it is handed to
+    the new driver, which sees every later record itself.
+    """
+
+    def __init__(self, supervisor: Supervisor) -> None:
+        self.supervisor = supervisor
+        self.driver: ComponentDriver | None = None
+        supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if not isinstance(event, HandedOff) or Need.COMPONENTS not in event.step.needs:
+            return
+        from mlaunch.parts.components import ComponentDriver
+
+        self.supervisor.events.unsubscribe(self._on_event)
+        driver = self.driver = ComponentDriver(self.supervisor)
+        driver.on_event(event)
+
+    def close(self) -> None:
+        self.supervisor.events.unsubscribe(self._on_event)
+        if self.driver is not None:
+            self.driver.close()
+
+
+def control_socket(run: Run) -> Part | None:
+    """``mlaunch ctl``'s socket in the run's log folder (mlaunch.parts.control_socket)."""
+    log_dir = run.printer.log_dir
+    return _ControlSocketPart(run, log_dir) if log_dir else None
+
+
+class _ControlSocketPart(Part):
+    """Opens the control socket on the loop's first turn, and removes it at close.
+
+    After the first children have started: ``socket`` and ``json`` cost milliseconds, which
+    opening it at attach time would spend before the first child.
+    """
+
+    def __init__(self, run: Run, log_dir: str) -> None:
+        self.run = run
+        self.log_dir = log_dir
+        self.server: ControlSocket | None = None
+        run.supervisor.schedule(0.0, self._open, keeps_alive=False)
+
+    def _open(self) -> None:
+        from mlaunch.parts.control_socket import ControlSocket
+
+        supervisor = self.run.supervisor
+        server = ControlSocket(supervisor, self.run.control, self.log_dir)
+        if server.open():
+            self.server = server
+        else:
+            text = f"{server.error}; mlaunch ctl cannot reach this run"
+            supervisor.events.emit(Said("WARNING", "launch", text))
+
+    def close(self) -> None:
+        if self.server is not None:
+            self.server.close()
+
+
+def status_view(run: Run) -> Part | None:
+    """``--status``: the live table pinned below the output (rich and psutil, only then)."""
+    from mlaunch.parts.status import attach_status_view
+
+    return attach_status_view(run.supervisor, run.printer, run.control)
+
+
+class _ExitSummary(Part):
+    """Prints mlaunch.parts.summary's exit summary at close, importing it only then.
+
+    Importing it costs start-up time that attaching before the run would spend before the first
+    child starts.
+    """
+
+    def __init__(self, supervisor: Supervisor, *, quiet: bool) -> None:
+        self.supervisor = supervisor
+        self.quiet = quiet
+
+    def close(self) -> None:
+        from mlaunch.parts.summary import ExitSummary
+
+        supervisor = self.supervisor
+        ExitSummary(supervisor.process_records, supervisor.events.emit, quiet=self.quiet).close()
+
+
+def exit_summary(run: Run) -> Part:
+    """The table of every process at the end (more than one process, or any failure)."""
+    return _ExitSummary(run.supervisor, quiet=run.opts.quiet)
