@@ -196,3 +196,17 @@ def test_matches_node_name_takes_a_relative_name_from_the_root() -> None:
 
     assert matches_node_name("foo")(Named("/foo"))
     assert not matches_node_name("foo")(Named("/foo/bar"))
+
+
+def test_node_perform_substitutions_resolves_its_names_as_launch_ros() -> None:
+    from launch import LaunchContext
+    from launch_ros.actions import Node, PushROSNamespace
+
+    context = LaunchContext()
+    PushROSNamespace("ns1").execute(context)
+    node = Node(package="p", executable="e", name="my_node")
+    node._perform_substitutions(context)
+    assert (node.node_name, node.expanded_node_namespace) == ("/ns1/my_node", "/ns1")
+    unnamed = Node(package="p", executable="e")
+    unnamed._perform_substitutions(LaunchContext())
+    assert unnamed.node_name == f"{Node.UNSPECIFIED_NODE_NAMESPACE}/{Node.UNSPECIFIED_NODE_NAME}"

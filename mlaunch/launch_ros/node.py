@@ -167,8 +167,11 @@ class Node(ExecuteProcess):
         names = self.resolved_names
         if names is None:
             raise RuntimeError("cannot access 'node_name' before executing action")
+        # launch_ros's rule: an unspecified namespace leaves the name relative.
+        from mlaunch.launch_ros.utilities.namespace_utils import prefix_namespace as upstreams
+
         return (
-            prefix_namespace(
+            upstreams(
                 names.namespace or self.UNSPECIFIED_NODE_NAMESPACE,
                 names.name or self.UNSPECIFIED_NODE_NAME,
             )
@@ -185,6 +188,11 @@ class Node(ExecuteProcess):
         if names is None or names.namespace is None:
             return self.UNSPECIFIED_NODE_NAMESPACE
         return names.namespace
+
+    def _perform_substitutions(self, context: LaunchContext) -> None:
+        """launch_ros's step that resolves the name and the namespace, which its unit tests call
+        on their own: ``node_name`` and ``expanded_node_namespace`` give them afterwards."""
+        self.resolved_names = self._names(context)
 
     # --- resolving ------------------------------------------------------------------------------
 
