@@ -297,6 +297,7 @@ def test_a_log_folder_that_takes_no_socket_sends_it_to_the_runtime_folder(tmp_pa
 
 def test_options_go_anywhere_as_the_readme_writes_them(live: Live) -> None:
     """``mlaunch ctl logs -n 3 talker`` (the README's form) was a usage error."""
+    wait_until(lambda: live.last_tick() >= 2, timeout=20)  # three ticks to ask for
     for args in (
         ("logs", "-n", "3", "talker"),
         ("-n", "3", "logs", "talker"),
