@@ -34,6 +34,7 @@ from mlaunch.smoke.watch import SmokeRun
 if TYPE_CHECKING:
     from mlaunch.app.options import Options
     from mlaunch.engine.lifeline import Lifeline
+    from mlaunch.parts.ros1_native import NativeRun
     from mlaunch.plan.steps import Plan, ProcessSpec
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
 
@@ -78,8 +79,9 @@ def run(opts: Options, settings: Settings) -> int:
 
     with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
         log_dir = make_run_log_dir(os.environ)
-        path, plan, options, labels, expectations = prepare(opts, settings, life, log_dir)
-        return supervise(opts, settings, plan, options, labels, log_dir, path, expectations, life)
+        path, plan, options, labels, expectations, native = prepare(opts, settings, life, log_dir)
+        checked = (path, expectations, native)
+        return supervise(opts, settings, plan, options, labels, log_dir, checked, life)
 
 
 def print_plan(opts: Options, settings: Settings) -> int:
@@ -88,7 +90,7 @@ def print_plan(opts: Options, settings: Settings) -> int:
     from mlaunch.resolve.plan_json import plan_json
 
     with Lifeline() as life:  # a launch file's code and Command substitutions may run
-        path, plan, _options, _labels, expectations = prepare(opts, settings, life, "")
+        path, plan, _options, _labels, expectations, _ = prepare(opts, settings, life, "")
         test = {
             "timeout": settings.timeout,
             "hold": settings.hold,
@@ -101,13 +103,14 @@ def print_plan(opts: Options, settings: Settings) -> int:
 
 def prepare(
     opts: Options, settings: Settings, life: Lifeline, log_dir: str
-) -> tuple[str, Plan, ResolveOptions, LabelCounter, list[Expectation]]:
+) -> tuple[str, Plan, ResolveOptions, LabelCounter, list[Expectation], NativeRun | None]:
     """Load and resolve as ``mlaunch FILE`` does, with the launch configurations collected;
-    (path, plan, resolve options, labels, the expectations of the run)."""
+    (path, plan, resolve options, labels, the expectations of the run, the native ROS 1 run
+    it is, if it is one)."""
     from mlaunch.app import pipeline
     from mlaunch.launch.actions import LaunchDescription
 
-    path, description = pipeline.load_target(opts)
+    path, description = pipeline.load_target(opts, temp_dir=life.temp_dir)
     collector = _CollectConfigurations()
     plan, options, labels = pipeline.resolve_for_run(
         opts,
@@ -118,9 +121,52 @@ def prepare(
     )
     # use_sim_time:=true is an ordinary launch argument; a file that declares it is
     # expected to run on simulated time, as --use-sim-time is.
+    native = _native_ros1(description)
+    if native is not None:
+        expectations = ros1_expectations(plan, settings, collector, native)
+        return path, plan, options, labels, expectations, native
     sim_time = bool(opts.use_sim_time) or _true(opts.arguments.get("use_sim_time", "false"))
     expectations = build_expectations(plan, settings, collector, sim_time)
-    return path, plan, options, labels, expectations
+    return path, plan, options, labels, expectations, None
+
+
+def _native_ros1(description: object) -> NativeRun | None:
+    """The native ROS 1 run ``description`` is, if it is one. Only the pipeline imports
+    ros1_native, and only for a roslaunch file: any other run does not pay for it."""
+    module = sys.modules.get("mlaunch.parts.ros1_native")
+    return None if module is None else module.native_run(description)
+
+
+# What a native ROS 1 run can check: its master knows nodes and services, not messages.
+ROS1_KINDS = ("process", "output", "node", "service")
+
+
+def ros1_expectations(
+    plan: Plan, settings: Settings, collector: _CollectConfigurations, native: NativeRun
+) -> list[Expectation]:
+    """A native ROS 1 run's checks: its processes, every node it starts registered with the
+    master (the nodes start once the parameter server is loaded: they are not in the plan),
+    then the launch file's and the command line's."""
+    out: dict[tuple[str, str], Expectation] = {}
+    for spec in plan.processes():
+        out[("process", spec.label)] = Expectation("process", spec.label, labels=[spec.label])
+    for node in native.nodes:
+        out.setdefault(("node", node.full_name), Expectation("node", node.full_name))
+        out[("node", node.full_name)].labels = [node.name]
+    explicit = [s.expectation for s in plan.steps if isinstance(s, ExpectStep) and s.expectation]
+    for expectation in [*explicit, *collector.found, *settings.expectations]:
+        if expectation.kind not in ROS1_KINDS:
+            raise UsageError(
+                f"{expectation.kind} expectation ({expectation.origin}): a native ROS 1 run"
+                f" checks {', '.join(ROS1_KINDS)} (its master is asked which nodes and services"
+                " are registered; topics' messages, /clock and lifecycle states are not read)"
+            )
+        out[expectation.key()] = expectation
+        if expectation.kind == "output":
+            _involve(expectation, plan.processes())
+    found = list(out.values())
+    found.append(Expectation("shutdown", "", status="pending", seen="the launch was not stopped"))
+    return found
 
 
 def build_expectations(
@@ -200,8 +246,7 @@ def supervise(
     options: ResolveOptions,
     labels: LabelCounter,
     log_dir: str,
-    path: str,
-    expectations: list[Expectation],
+    checked: tuple[str, list[Expectation], NativeRun | None],
     life: Lifeline,
 ) -> int:
     """Run the plan as ``mlaunch FILE`` would (the same parts attached), plus the smoke checks.
@@ -214,8 +259,17 @@ def supervise(
 
     runs: list[SmokeRun] = []
 
+    path, expectations, native = checked
+    master = None
+    if native is not None:  # its master is the graph the checks look at
+        from mlaunch.parts.ros1_graph import SharedMaster
+
+        master = SharedMaster(native.master_uri)
+
     def smoke_checks(run: Run) -> SmokeRun:
-        smoke = SmokeRun(run.supervisor, expectations, settings, lifecycle=run.lifecycle)
+        smoke = SmokeRun(
+            run.supervisor, expectations, settings, lifecycle=run.lifecycle, graph=master
+        )
         runs.append(smoke)
         return smoke
 

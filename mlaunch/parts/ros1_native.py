@@ -73,14 +73,38 @@ def description(
     nodes = [*(config.core_nodes if start_master else []), *config.nodes]
     finder = package_finder(path, env)
     processes: list[Any] = []
+    started: list[Ros1Node] = []
     for number, node in enumerate(nodes, start=1):
         process, message = node_process(node, finder, env, f"{run_id}", number)
         if message:
             actions.append(MappingWarning(message, node.origin))
         if process is not None:
             processes.append(process)
+            started.append(node)
     actions.append(after_loading(loader, processes))
-    return LaunchDescription(actions)
+    out = LaunchDescription(actions)
+    out.__dict__[_RUN] = NativeRun(uri, tuple(started))
+    return out
+
+
+_RUN = "_mlaunch_ros1_run"
+
+
+class NativeRun:
+    """What a native ROS 1 run's description starts: its master's URI and the nodes it
+    starts (those whose program was found), for ``mlaunch test``'s checks."""
+
+    __slots__ = ("master_uri", "nodes")
+
+    def __init__(self, master_uri: str, nodes: tuple[Ros1Node, ...]) -> None:
+        self.master_uri = master_uri
+        self.nodes = nodes
+
+
+def native_run(description: object) -> NativeRun | None:
+    """The NativeRun of a description ``description()`` made (None: any other)."""
+    found = getattr(description, "__dict__", {}).get(_RUN)
+    return found if isinstance(found, NativeRun) else None
 
 
 def master_process(uri: str, env: dict[str, str]) -> Any:

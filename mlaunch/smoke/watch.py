@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.handoff import SharedGraph
     from mlaunch.parts.lifecycle import LifecycleManager, Outcome
+    from mlaunch.parts.ros1_graph import SharedMaster
     from mlaunch.plan.events import ProcessView
     from mlaunch.plan.steps import Plan, ProcessSpec
 
@@ -61,6 +62,7 @@ class SmokeRun(Part):
         settings: Settings,
         *,
         lifecycle: LifecycleManager | None = None,
+        graph: SharedMaster | None = None,
     ) -> None:
         from mlaunch.parts.handoff import LoopCall, SharedGraph
 
@@ -73,13 +75,16 @@ class SmokeRun(Part):
         self.loop = LoopCall(supervisor.selector)
         self.started_at = supervisor.clock()
         self._stop = threading.Event()
-        graph_env = _graph_environ(supervisor.plan)
-        self.graph: SharedGraph = (
-            lifecycle.graph
-            if lifecycle is not None
-            else SharedGraph(graph_env, f"_mlaunch_test_{os.getpid()}")
-        )
-        self._own_graph = lifecycle is None
+        # ``graph``: a native ROS 1 run's master, checked instead of the ROS 2 graph.
+        self.graph: SharedGraph | SharedMaster
+        if graph is not None:
+            self.graph = graph
+        elif lifecycle is not None:
+            self.graph = lifecycle.graph
+        else:
+            graph_env = _graph_environ(supervisor.plan)
+            self.graph = SharedGraph(graph_env, f"_mlaunch_test_{os.getpid()}")
+        self._own_graph = lifecycle is None or graph is not None
         self._checker: threading.Thread | None = None
         supervisor.events.subscribe(self._on_event)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
@@ -132,6 +137,7 @@ class SmokeRun(Part):
             e = Expectation("process", label, origin="started later", labels=[label])
             self.expectations.insert(len(self.expectations) - 1, e)
         if not exited:
+            _name_label(self.expectations, process)
             if e.status == "pending":
                 self._met(e, f"running (pid {process.pid})")
             return
@@ -362,6 +368,16 @@ class SmokeRun(Part):
             self._checker.join(timeout=2.0)
         if self._own_graph:
             self.graph.close()
+
+
+def _name_label(expectations: list[Expectation], process: ProcessView) -> None:
+    """A node started later (a native ROS 1 run's) was expected under its process's name:
+    its output is the started process's, under its label."""
+    base = process.spec.base_name
+    for e in expectations:
+        if e.kind == "node" and base in e.labels and process.label not in e.labels:
+            e.labels = [process.label if x == base else x for x in e.labels]
+            return
 
 
 def _messages(count: int) -> str:

@@ -1,0 +1,105 @@
+"""The ROS 1 graph as a native ROS 1 run's master knows it, read over its XML-RPC API.
+
+``mlaunch test`` on a native ROS 1 run (``mlaunch.parts.ros1_native``) checks it instead of the
+ROS 2 graph: a node is up once it is registered with the master (what ``rosnode list`` reads,
+``getSystemState``), a service once the master lists it. Python's ``xmlrpc.client`` is all it
+needs: no rospy in mlaunch's own environment.
+"""
+
+from __future__ import annotations
+
+import threading
+import xmlrpc.client
+from typing import Any
+
+from mlaunch.parts.graph_types import GraphNotRunning, RosBridgeError
+
+# Each call to the master is given this long (a master that does not answer is not up yet).
+CALL_TIMEOUT = 2.0
+CALLER_ID = "/mlaunch_test"
+
+
+class MasterGraph:
+    """The graph of one ROS 1 master: its registered nodes, topics and services."""
+
+    def __init__(self, uri: str) -> None:
+        self.uri = uri
+
+    def _call(self, method: str, *args: Any) -> Any:
+        """One master API call; its value, or RosBridgeError saying why there is none."""
+        proxy = xmlrpc.client.ServerProxy(self.uri, transport=_TimeoutTransport())
+        try:
+            reply = getattr(proxy, method)(CALLER_ID, *args)
+        except (OSError, xmlrpc.client.Error) as e:
+            raise RosBridgeError(f"the ROS master at {self.uri} does not answer: {e}") from e
+        except Exception as e:  # a garbled reply: whatever the parser raised
+            raise RosBridgeError(f"the ROS master at {self.uri} sent a bad reply: {e}") from e
+        try:
+            code, message, value = reply
+        except (TypeError, ValueError):
+            raise RosBridgeError(f"the ROS master at {self.uri} sent a bad reply: {reply!r}")
+        if code != 1:
+            raise RosBridgeError(f"the ROS master at {self.uri} refused {method}: {message}")
+        return value
+
+    def _system_state(self) -> tuple[list[Any], list[Any], list[Any]]:
+        state = self._call("getSystemState")
+        try:
+            publishers, subscribers, services = state
+            return list(publishers), list(subscribers), list(services)
+        except (TypeError, ValueError):
+            raise RosBridgeError(f"the ROS master at {self.uri} sent a bad system state")
+
+    def node_names(self) -> set[str]:
+        """Every node the master has registered (a publisher, subscriber or service of it)."""
+        names: set[str] = set()
+        for group in self._system_state():
+            names.update(_nodes(group))
+        return names
+
+    def topic_types(self) -> dict[str, list[str]]:
+        out: dict[str, list[str]] = {}
+        for entry in self._call("getTopicTypes"):
+            if isinstance(entry, list) and len(entry) == 2:
+                out.setdefault(str(entry[0]), []).append(str(entry[1]))
+        return out
+
+    def service_names(self) -> set[str]:
+        return {str(e[0]) for e in self._system_state()[2] if isinstance(e, list) and e}
+
+
+def _nodes(group: list[Any]) -> set[str]:
+    """The node names of one getSystemState list ([name, [node, ...]] entries)."""
+    found: set[str] = set()
+    for entry in group:
+        if isinstance(entry, list) and len(entry) == 2 and isinstance(entry[1], list):
+            found.update(str(n) for n in entry[1])
+    return found
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    def make_connection(self, host: Any) -> Any:
+        connection = super().make_connection(host)
+        connection.timeout = CALL_TIMEOUT
+        return connection
+
+
+class SharedMaster:
+    """What the smoke checks hold instead of the ROS 2 graph on a native ROS 1 run (the
+    interface of ``mlaunch.parts.handoff.SharedGraph``)."""
+
+    def __init__(self, uri: str) -> None:
+        self._graph = MasterGraph(uri)
+        self._closed = threading.Event()
+
+    def get(self) -> MasterGraph:
+        if self._closed.is_set():
+            raise GraphNotRunning("the launch is over: the ROS master is no longer watched")
+        return self._graph
+
+    @property
+    def started(self) -> bool:
+        return True
+
+    def close(self) -> None:
+        self._closed.set()
