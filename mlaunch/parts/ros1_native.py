@@ -34,7 +34,10 @@ from mlaunch.ros1.lookup import package_finder
 
 DEFAULT_MASTER = "http://localhost:11311/"
 # Programs of older ROS 1 releases the seeds use -> what replaced them.
-RENAMED = {("robot_state_publisher", "state_publisher"): "robot_state_publisher"}
+RENAMED = {
+    ("robot_state_publisher", "state_publisher"): "robot_state_publisher",
+    ("xacro", "xacro.py"): "xacro",
+}
 
 
 def wants_native(path: str, environ: Mapping[str, str]) -> bool:

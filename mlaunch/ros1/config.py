@@ -414,6 +414,11 @@ class Loader:
             if source == "textfile":
                 with open(text, encoding="utf-8") as f:
                     return convert_value(f.read(), kind)
+            from mlaunch.ros1 import lookup
+
+            note = lookup.renamed_command(text)
+            if note:
+                self.config.warnings.append(f"{self.origin}: {note}")
             return convert_value(self.run_command(text), kind)
         except OSError as e:
             raise LaunchFileError(f"cannot read {source} {text!r}: {e.strerror}")

@@ -83,6 +83,7 @@ def command_runner(environ: Mapping[str, str], launch_file: str) -> Callable[[st
         argv = shlex.split(command)
         if not argv:
             raise LaunchFileError("<param command> is empty")
+        argv[0] = installed_xacro(argv[0]) or argv[0]
         if os.path.basename(argv[0]) in XACRO_PROGRAMS and not _is_program(argv[0]):
             from mlaunch.launch_ros import xacro
             from mlaunch.ros import packages
@@ -104,6 +105,31 @@ def command_runner(environ: Mapping[str, str], launch_file: str) -> Callable[[st
         return done.stdout.decode("utf-8")
 
     return run
+
+
+def installed_xacro(program: str) -> str | None:
+    """``.../xacro.py`` (xacro's name before ROS Melodic) that is not there: the ``xacro``
+    beside it when that is a program (the installed ROS 1 xacro), else None."""
+    if os.path.basename(program) != "xacro.py" or _is_program(program):
+        return None
+    sibling = os.path.join(os.path.dirname(program), "xacro")
+    return sibling if _is_program(sibling) else None
+
+
+def renamed_command(command: str) -> str | None:
+    """The warning for a ``<param command>`` that runs xacro by its old name, ``xacro.py``
+    (what runs instead), or None."""
+    try:
+        program = shlex.split(command)[0]
+    except (ValueError, IndexError):
+        return None
+    if os.path.basename(program) != "xacro.py" or _is_program(program):
+        return None
+    instead = installed_xacro(program) or "xacro (the PyPI xacro, inside mlaunch)"
+    return (
+        f"{program} is xacro's name in ROS 1 releases before Melodic:"
+        f" running {instead}, which replaced it"
+    )
 
 
 def _is_program(path: str) -> bool:
