@@ -71,6 +71,7 @@ def description(
         actions.append(master_process(uri, env))
     loader = params_process(config, uri, run_id, temp_dir, env)
     actions.append(loader)
+    actions += machines(config, path)
     for action in actions:
         action.origin = f"{os.path.abspath(path)}:1"
     nodes = [*(config.core_nodes if start_master else []), *config.nodes]
@@ -78,7 +79,8 @@ def description(
     processes: list[Any] = []
     started: list[Ros1Node] = []
     for number, node in enumerate(nodes, start=1):
-        process, message = node_process(node, finder, env, f"{run_id}", number)
+        remote = is_remote(config, node)
+        process, message = node_process(node, finder, env, f"{run_id}", number, remote)
         if message:
             actions.append(MappingWarning(message, node.origin))
         if process is not None:
@@ -134,6 +136,22 @@ def master_process(uri: str, env: dict[str, str]) -> Any:
     )
 
 
+def machines(config: Config, path: str) -> list[Any]:
+    """The file's ``<machine>``s as mlaunch's machines (docs/machines.md): the nodes that name
+    one run there over ssh. ``default`` is already each node's machine (roslaunch's rule)."""
+    from mlaunch.machines.actions import Machine
+    from mlaunch.ros1.model import MACHINE_FIELDS
+
+    out: list[Any] = []
+    for name, found in config.machines.items():
+        options = {k: found[a] for k, a in MACHINE_FIELDS if k != "default" and found.get(a)}
+        out.append(Machine(name=name, address=found["address"], **options))
+        if found.get("password"):
+            note = f"<machine name={name!r} password> is ignored: mlaunch's ssh uses keys only"
+            out.append(MappingWarning(note, f"{os.path.abspath(path)}:1"))
+    return out
+
+
 def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: Any) -> Any:
     from mlaunch.launch.actions import ExecuteProcess
 
@@ -170,7 +188,7 @@ def after_loading(loader: Any, processes: list[Any]) -> Any:
 
 
 def node_process(
-    node: Ros1Node, finder: Any, env: dict[str, str], run_id: str, number: int
+    node: Ros1Node, finder: Any, env: dict[str, str], run_id: str, number: int, remote: bool
 ) -> tuple[Any, str]:
     """The node's process as roslaunch starts it (its ``number``-th), and a warning: why it
     cannot start (in roslaunch's words), or what it runs instead of an old name."""
@@ -192,16 +210,25 @@ def node_process(
     ]
     node_env = system_python_env(env)
     node_env.pop("ROS_NAMESPACE", None)
-    if node.namespace.rstrip("/"):
-        node_env["ROS_NAMESPACE"] = node.namespace.rstrip("/")
+    namespace = node.namespace.rstrip("/")
+    if namespace:
+        node_env["ROS_NAMESPACE"] = namespace
     node_env.update({str(k): str(v) for k, v in node.env})
-    cwd = os.path.dirname(program) if node.cwd == "node" else ros_home(env)
-    os.makedirs(cwd, exist_ok=True)
+    cwd: str | None = os.path.dirname(program) if node.cwd == "node" else ros_home(env)
+    env_arg: dict[str, str] | None = node_env
+    if remote:
+        # On another computer: its own login environment and home, plus what roslaunch gives
+        # a node there (the master, the namespace, the node's <env>), set by env(1) on it.
+        cwd, env_arg = None, None
+        argv = [*remote_env(node, env["ROS_MASTER_URI"]), *argv]
+    else:
+        os.makedirs(str(cwd), exist_ok=True)
     process = ExecuteProcess(
         cmd=argv,
         name=node.name,
-        env=node_env,
+        env=env_arg,
         cwd=cwd,
+        machine=node.machine if remote else None,
         output="screen" if node.output == "screen" else "log",
         respawn=node.respawn,
         respawn_delay=node.respawn_delay or None,
@@ -209,6 +236,22 @@ def node_process(
     )
     process.origin = node.origin
     return process, note
+
+
+def is_remote(config: Config, node: Ros1Node) -> bool:
+    """Whether the node runs on another computer: a machine that is this one runs it here,
+    as roslaunch did (the address is local and the user is ours or not given)."""
+    from mlaunch.plan.machine import is_local
+
+    machine = config.machines.get(node.machine or "")
+    return machine is not None and not is_local(machine["address"], machine.get("user") or None)
+
+
+def remote_env(node: Ros1Node, uri: str) -> list[str]:
+    """``env`` setting a remote node's ROS 1 environment before its command line."""
+    namespace = node.namespace.rstrip("/")
+    scope = [f"ROS_NAMESPACE={namespace}"] if namespace else ["-u", "ROS_NAMESPACE"]
+    return ["env", *scope, f"ROS_MASTER_URI={uri}", *(f"{k}={v}" for k, v in node.env)]
 
 
 def find_node(node: Ros1Node, finder: Any) -> tuple[str | None, str]:
