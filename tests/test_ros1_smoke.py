@@ -6,7 +6,6 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import socket
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -15,6 +14,7 @@ from pathlib import Path
 
 import pytest
 from ros1tree import package_tree, requires_roslaunch
+from test_ros1_native import free_port
 
 REPO = Path(__file__).resolve().parent.parent
 NODES = (
@@ -49,13 +49,6 @@ SLEEPER = """<launch>
   <node name="sleeper" pkg="sleepy" type="sleeper" ns="idle"/>
 </launch>
 """
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port: int = s.getsockname()[1]
-        return port
 
 
 def master_answers(port: int) -> bool:
