@@ -84,13 +84,18 @@ def run_test(
 def test_smartcar_nodes_pass_when_registered_with_the_master(tmp_path: Path) -> None:
     junit = tmp_path / "junit.xml"
     done, port = run_test(
-        tmp_path, SMARTCAR_NODES, "--hold", "1", "--timeout", "60", "--junit", str(junit)
+        tmp_path,
+        SMARTCAR_NODES,
+        *("--hold", "1", "--timeout", "60", "--junit", str(junit)),
+        *("--expect-service", "/car/robot_state_publisher/get_loggers"),
     )
     out = done.stdout + done.stderr
     assert done.returncode == 0, out
     for node in ("/joint_state_publisher", "/car/robot_state_publisher", "/rosout"):
         line = next(x for x in done.stdout.splitlines() if f"node {node} " in x)
         assert "in the graph" in line, line
+    service = next(x for x in done.stdout.splitlines() if "service /car/" in x)
+    assert "offered" in service and "not offered" not in service, service  # the master's list
     cases = {c.get("name", ""): c for c in ET.parse(junit).getroot().iter("testcase")}
     assert any("/car/robot_state_publisher" in name for name in cases), cases
     assert not any(c.find("failure") is not None for c in cases.values())
