@@ -251,7 +251,11 @@ class Screen:
     def _marks(self) -> tuple[int, int, int | None]:
         """(hold mark, release mark, drop cap) of one process's queued bytes for this reader."""
         high, low = self.source_high_water, self.source_low_water
-        rate = None if self.pace is None else self.pace.rate
+        if self.pace is None:  # a file, or an fd that cannot say: no pacing
+            return high, low, None
+        rate = self.pace.rate
+        if rate is None and self.pace.ahead >= MAX_AHEAD:
+            return high, low, None  # a reader that keeps up: the ordinary marks
         if rate is None:  # maybe a slow reader: hold early
             return min(high, UNKNOWN_SOURCE_HIGH), min(low, UNKNOWN_SOURCE_HIGH // 4), None
         cap = max(MIN_AHEAD, int(rate * SOURCE_SECONDS))
@@ -263,6 +267,10 @@ class Screen:
         be 64 KiB: queued whole, a quiet process's line would wait behind all of it."""
         if source in self._overflow:
             self._overflow[source] += data
+            return
+        pace = self.pace
+        if pace is not None and pace.rate is None and pace.ahead >= MAX_AHEAD:
+            self._enqueue(data, source=source)  # a reader that keeps up: as it comes
             return
         queued = self.queued(source)
         high, _, cap = self._marks()
