@@ -77,3 +77,43 @@ def test_the_resolver_is_the_planner_of_a_run_and_of_its_contexts():
 
     resolve(LaunchDescription([Probe()]), path=None, arguments={}, environ={})
     assert seen == ["Resolver"]
+
+
+def test_a_bare_context_holds_the_events_it_was_given_in_upstreams_queue():
+    import asyncio
+
+    from mlaunch.launch.actions import Shutdown
+    from mlaunch.launch.conditions import IfCondition
+    from mlaunch.launch.events import Shutdown as ShutdownEvent
+
+    context = LaunchContext()
+    assert isinstance(context._event_queue, asyncio.Queue) and context._event_queue.empty()
+    assert Shutdown(reason="no", condition=IfCondition("false")).visit(context) is None
+    assert context._event_queue.qsize() == 0
+    assert Shutdown(reason="done").visit(context) is None
+    other = object()
+    asyncio.run(context.emit_event(other))
+    queued = [context._event_queue.get_nowait() for _ in range(context._event_queue.qsize())]
+    assert isinstance(queued[0], ShutdownEvent) and queued[0].reason == "done"
+    assert queued[1] is other
+    # The same events are steps of the standalone plan, in the same order.
+    steps = context.planner.plan.steps  # type: ignore[attr-defined]
+    assert [type(s).__name__ for s in steps] == ["RequestShutdown", "EmitEvent"]
+    assert steps[0].reason == "done" and steps[1].event is other
+
+
+def test_a_runs_context_plans_the_events_it_is_given_and_queues_none():
+    from mlaunch.launch.actions import Shutdown
+
+    sizes: list[int] = []
+
+    class Probe(Action):
+        def execute(self, context: LaunchContext) -> None:
+            context.emit_event_sync(object())
+            sizes.append(context._event_queue.qsize())
+
+    plan = resolve(
+        LaunchDescription([Probe(), Shutdown(reason="end")]), path=None, arguments={}, environ={}
+    )
+    assert sizes == [0]
+    assert [type(s).__name__ for s in plan.steps] == ["EmitEvent", "RequestShutdown"]

@@ -85,6 +85,7 @@ class LaunchContext:
         self._scopes: list[tuple[dict[str, Any], dict[str, str]]] = []
         self._warn = warn
         self._planner = planner
+        self._events: Any = None  # the asyncio.Queue of _event_queue, made when first asked for
 
     # --- the seam to planning (mlaunch.plan.planner) ----------------------------------------
 
@@ -184,7 +185,10 @@ class LaunchContext:
         return any(handler.matches(event) for handler in self._event_handlers)
 
     def emit_event_sync(self, event: Any) -> None:
-        """Emit ``event`` when the plan reaches this point (a Shutdown shuts the run down)."""
+        """Emit ``event`` when the plan reaches this point (a Shutdown shuts the run down).
+
+        A context that no run plans also holds the event in ``_event_queue``, as upstream's.
+        """
         from mlaunch.launch.actions import emit_event_entities
 
         more = emit_event_entities(self, event, "")
@@ -192,8 +196,20 @@ class LaunchContext:
             self.planner.visit_all(more)
 
     async def emit_event(self, event: Any) -> None:
-        """``emit_event_sync`` for coroutines, as upstream's awaitable spelling."""
+        """``emit_event_sync`` for coroutines, as upstream's awaitable spelling (the queue is
+        unbounded: putting never waits)."""
         self.emit_event_sync(event)
+
+    @property
+    def _event_queue(self) -> Any:
+        """The events given to this context while no run plans it (an ``asyncio.Queue``, as
+        upstream's): a standalone planner puts them here, since nothing will emit its steps.
+        A run's events are steps of its plan and never pass through this queue."""
+        if self._events is None:
+            import asyncio  # only a context that no run plans gets here: not at start-up
+
+            self._events = asyncio.Queue()
+        return self._events
 
     @property
     def current_launch_file_path(self) -> str | None:

@@ -59,6 +59,13 @@ class StandalonePlanner:
     def spawn(self, spec: ProcessSpec) -> None:
         self.add(Spawn(origin=spec.origin, spec=spec))
 
+    def emit(self, event: object, step: Step | None) -> None:
+        """Plan the step, and hold the event in the context's queue as upstream's bare context
+        does: nothing runs the plan, so a caller can see what the actions emitted."""
+        if step is not None:
+            self.add(step)
+        self.context._event_queue.put_nowait(event)
+
     def warn(self, message: str) -> None:
         self.plan.warnings.append(message)
         self.context.warn(message)

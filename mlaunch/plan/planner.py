@@ -54,6 +54,10 @@ class Planner(Protocol):
     def spawn(self, spec: ProcessSpec) -> None:
         """Append the start of a process."""
 
+    def emit(self, event: object, step: Step | None) -> None:
+        """An event given to the context: ``step`` emits it in the plan (None: nothing to add,
+        an included description is visited instead); a standalone planner also holds it."""
+
     def warn(self, message: str) -> None:
         """A warning of planning, said once before the run."""
 

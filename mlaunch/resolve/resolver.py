@@ -196,6 +196,10 @@ class Resolver:
     def spawn(self, spec: ProcessSpec) -> None:
         self.add(Spawn(origin=spec.origin, spec=spec))
 
+    def emit(self, event: object, step: Step | None) -> None:
+        if step is not None:
+            self.add(step)
+
     def warn(self, message: str) -> None:
         self.plan.warnings.append(message)
 

@@ -438,13 +438,14 @@ def emit_event_entities(context: LaunchContext, event: Any, origin: str) -> list
     from mlaunch.launch.events import IncludeLaunchDescription
     from mlaunch.launch.events import Shutdown as ShutdownEvent
 
+    step: RequestShutdown | EmitEventStep | None = None
     if isinstance(event, ShutdownEvent):
-        context.planner.add(RequestShutdown(origin=origin, reason=event.reason))
-    elif isinstance(event, IncludeLaunchDescription):
-        return [event.launch_description]
-    else:
-        context.planner.add(EmitEventStep(origin=origin, event=event))
-    return None
+        step = RequestShutdown(origin=origin, reason=event.reason)
+    elif not isinstance(event, IncludeLaunchDescription):
+        step = EmitEventStep(origin=origin, event=event)
+    context.planner.emit(event, step)
+    # An included description is planned here and now, where the event was given.
+    return [event.launch_description] if step is None else None
 
 
 class Shutdown(Action):
@@ -455,9 +456,10 @@ class Shutdown(Action):
         self.reason = normalize(reason)
 
     def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
+        from mlaunch.launch.events import Shutdown as ShutdownEvent
+
         reason = perform_substitutions(context, self.reason)
-        planner.add(RequestShutdown(origin=self.origin, reason=reason))
+        emit_event_entities(context, ShutdownEvent(reason=reason), self.origin)
 
 
 class LogInfo(Action):
