@@ -3,6 +3,8 @@ them (issue 25: gaps 1, 6, 7, 8, 12)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from mlaunch import compat
@@ -238,3 +240,97 @@ def test_if_else_reads_a_typed_bool_and_completion_handlers_check_entities() -> 
     assert IfElseSubstitution("0", "a", "b").perform(LaunchContext()) == "b"
     with pytest.raises(TypeError):
         OnExecutionComplete(target_action=LogInfo(msg="m"), on_completion="not an action")
+
+
+class _ContextLike:
+    """Offers only what upstream's code reads of a context (as a test's mock does)."""
+
+    def __init__(self) -> None:
+        self.launch_configurations: dict[str, str] = {}
+
+    def get_locals_as_dict(self) -> dict[str, object]:
+        return {}
+
+    def perform_substitution(self, substitution: object) -> str:
+        return substitution.perform(self)  # type: ignore[attr-defined,no-any-return]
+
+
+def test_descriptions_and_sources_work_with_a_context_that_has_no_planner(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    from launch import LaunchDescription
+    from launch.actions import LogInfo
+    from launch.launch_description_sources import (
+        LaunchDescriptionSource,
+        PythonLaunchDescriptionSource,
+    )
+
+    described = LaunchDescription([LogInfo(msg="x")], deprecated_reason="use other.launch.py")
+    assert described.visit(_ContextLike()) == described.entities  # type: ignore[arg-type]
+    assert "deprecated: use other.launch.py" in caplog.text
+    with pytest.raises(RuntimeError, match="no launch description was given"):
+        LaunchDescriptionSource().get_launch_description(_ContextLike())  # type: ignore[arg-type]
+    given = LaunchDescriptionSource(described, "somewhere")
+    assert given.get_launch_description(_ContextLike()) is described  # type: ignore[arg-type]
+    assert given.location == "somewhere"
+    path = tmp_path / "one.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import DeclareLaunchArgument\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([DeclareLaunchArgument('a')])\n"
+    )
+    source = PythonLaunchDescriptionSource([str(tmp_path), "/one.launch.py"])
+    assert source.location == f"{tmp_path} + /one.launch.py"  # as written until loaded
+    loaded = source.get_launch_description(_ContextLike())  # type: ignore[arg-type]
+    assert [e.name for e in loaded.entities] == ["a"] and source.location == str(path)
+
+
+def test_launch_arguments_say_whether_something_may_leave_them_out(tmp_path: Path) -> None:
+    from launch import LaunchDescription
+    from launch.actions import (
+        DeclareLaunchArgument,
+        GroupAction,
+        IncludeLaunchDescription,
+        ResetLaunchConfigurations,
+        TimerAction,
+    )
+    from launch.conditions import IfCondition
+    from launch.launch_description_sources import (
+        LaunchDescriptionSource,
+        PythonLaunchDescriptionSource,
+    )
+
+    path = tmp_path / "inner.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import DeclareLaunchArgument\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([DeclareLaunchArgument('from_file')])\n"
+    )
+    maybe = IfCondition("true")
+    described = LaunchDescription(
+        [
+            DeclareLaunchArgument("plain"),
+            DeclareLaunchArgument("own", condition=maybe),
+            GroupAction([GroupAction([DeclareLaunchArgument("nested")])], condition=maybe),
+            TimerAction(period=1.0, actions=[DeclareLaunchArgument("later")]),
+            IncludeLaunchDescription(
+                LaunchDescriptionSource(LaunchDescription([DeclareLaunchArgument("given")]))
+            ),
+            IncludeLaunchDescription(PythonLaunchDescriptionSource(str(path)), condition=maybe),
+            DeclareLaunchArgument("plain", condition=maybe),  # the first declaration wins
+            ResetLaunchConfigurations(),
+            DeclareLaunchArgument("unreachable"),
+        ]
+    )
+    found = {a.name: a._conditionally_included for a in described.get_launch_arguments()}
+    assert found == {
+        "plain": False,
+        "own": True,
+        "nested": True,
+        "later": True,
+        "given": False,
+        "from_file": True,
+    }
+    assert all(a._conditionally_included for a in described.get_launch_arguments(True))

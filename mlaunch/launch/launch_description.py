@@ -138,28 +138,51 @@ class LaunchDescription(LaunchDescriptionEntity):
 
     def visit(self, context: LaunchContext) -> list[Any] | None:
         if self.deprecated_reason:
-            context.planner.warn(f"launch description is deprecated: {self.deprecated_reason}")
+            from mlaunch.launch.planning import planner_of  # any context-like object, as upstream
+
+            planner_of(context).warn(f"launch description is deprecated: {self.deprecated_reason}")
         return list(self.entities)
 
     def get_launch_arguments(self, conditional_inclusion: bool = False) -> list[Any]:
-        """The DeclareLaunchArgument actions in this description, includes not followed."""
-        # launch.actions builds on this module's classes, so its classes are looked up when a
-        # caller asks for the arguments, not at import.
-        from mlaunch.launch import actions
+        """The DeclareLaunchArgument actions in this description and in the descriptions it
+        includes that load without a context; the first declaration of a name only.
 
-        found: list[Any] = []
+        As upstream's, each gets ``_conditionally_included``: whether something may leave it
+        out (its own condition, an enclosing one, a timer or an event handler), as
+        ``--show-args`` marks it; ``conditional_inclusion`` says so of this whole description.
+        Declarations after a ResetLaunchConfigurations in the same list are not reachable
+        from the command line and are left out, as upstream's.
+        """
+        found: dict[str, Any] = {}
+        _collect_arguments(self.entities, conditional_inclusion, found)
+        return list(found.values())
 
-        def walk(entities: Iterable[Any]) -> None:
-            for entity in entities:
-                if isinstance(entity, actions.DeclareLaunchArgument):
-                    found.append(entity)
-                elif isinstance(entity, (LaunchDescription, actions.GroupAction)):
-                    walk(
-                        entity.entities if isinstance(entity, LaunchDescription) else entity.actions
-                    )
 
-        walk(self.entities)
-        return found
+def _collect_arguments(entities: Iterable[Any], conditional: bool, found: dict[str, Any]) -> None:
+    """Note in ``found`` the declarations below ``entities`` (see get_launch_arguments)."""
+    # launch.actions builds on this module's classes: looked up when asked, not at import.
+    from mlaunch.launch import actions
+    from mlaunch.launch.walk import children
+
+    for entity in entities:
+        if isinstance(entity, actions.DeclareLaunchArgument) and entity.name not in found:
+            entity._conditionally_included = conditional or entity.condition is not None
+            found[entity.name] = entity
+        if isinstance(entity, actions.ResetLaunchConfigurations):
+            return
+        inner = conditional or getattr(entity, "condition", None) is not None
+        if isinstance(entity, (actions.TimerAction, actions.RegisterEventHandler)):
+            # Run only if the timer fires or the event comes: conditional, as in launch.
+            _collect_arguments([e for e, _ in children(entity)], True, found)
+            continue
+        if isinstance(entity, actions.IncludeLaunchDescription):
+            source = entity.launch_description_source
+            described = source.try_get_launch_description_without_context()
+            _collect_arguments([] if described is None else [described], inner, found)
+            continue
+        _collect_arguments(entity.describe_sub_entities(), inner, found)
+        for _why, more in entity.describe_conditional_sub_entities():
+            _collect_arguments(more, True, found)
 
 
 __all__ = ["Action", "LaunchDescription", "LaunchDescriptionEntity"]

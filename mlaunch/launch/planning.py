@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from typing import TypeVar
 
     from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.plan.planner import Planner
     from mlaunch.plan.steps import ArgumentInfo, ProcessSpec, Step
 
     R = TypeVar("R")
@@ -68,7 +69,13 @@ class StandalonePlanner:
 
     def warn(self, message: str) -> None:
         self.plan.warnings.append(message)
-        self.context.warn(message)
+        warn = getattr(self.context, "warn", None)
+        if warn is not None:
+            warn(message)
+        else:  # an object that only looks like a context: say it as upstream does, by logging
+            import logging
+
+            logging.getLogger("launch").warning(message)
 
     def new_label(self, base: str) -> str:
         return f"{base}-{next(self._labels)}"
@@ -133,6 +140,18 @@ class StandalonePlanner:
 
     def float_value(self, value: object, what: str, origin: str) -> float:
         return number(self.context, value, what, origin)
+
+
+def planner_of(context: object) -> Planner:
+    """The planner of ``context``, or a standalone one for an object that only offers what
+    upstream's code reads (a mock context of a test: launch configurations, locals ...).
+
+    Such an object cannot keep a planner, so each call plans apart: what it plans is not kept.
+    """
+    planner: Planner | None = getattr(context, "planner", None)
+    if planner is None:
+        planner = StandalonePlanner(context)  # type: ignore[arg-type]
+    return planner
 
 
 def number(context: LaunchContext, value: object, what: str, origin: str) -> float:

@@ -58,6 +58,7 @@ class DeclareLaunchArgument(Action):
     ) -> None:
         super().__init__(**kwargs)
         self.name = name
+        self._conditionally_included = False  # LaunchDescription.get_launch_arguments sets it
         self.default_value = None if default_value is None else normalize(default_value)
         # A list, as upstream's DeclareLaunchArgument.choices reads back.
         self.choices = None if choices is None else [str(c) for c in choices]

@@ -23,24 +23,42 @@ class LaunchDescriptionSource:
         method: str = "",
     ) -> None:
         self.launch_description = launch_description
-        self.location = normalize(location)
+        self._location = normalize(location)
+        self._expanded_location: str | None = None
         self.method = method
+
+    @property
+    def location(self) -> str:
+        """Where the description comes from: as written until it was got with a context, then
+        the location that context gave, as upstream's."""
+        if self._expanded_location is not None:
+            return self._expanded_location
+        return " + ".join(getattr(s, "text", None) or s.describe() for s in self._location)
 
     def get_launch_file_location(self, context: LaunchContext) -> str | None:
         if self.launch_description is not None:
             return None
         import os
 
-        return os.path.abspath(perform_substitutions(context, self.location))
+        return os.path.abspath(perform_substitutions(context, self._location))
 
     def describe(self) -> str:
-        return describe(self.location)
+        return describe(self._location)
 
     def get_launch_description(self, context: LaunchContext) -> Any:
-        """The description: the one given, or the file's, loaded by the context's planner."""
+        """The description given; RuntimeError without one, as upstream's base class (the
+        sources of a file load it: AnyLaunchDescriptionSource)."""
+        self._expand(context)
         if self.launch_description is None:
-            self.launch_description = context.planner.load_source(self, "")
+            raise RuntimeError(
+                f"{type(self).__name__}.get_launch_description(): no launch description was"
+                " given, and this kind of source loads no file"
+            )
         return self.launch_description
+
+    def _expand(self, context: LaunchContext) -> None:
+        if self._expanded_location is None:
+            self._expanded_location = perform_substitutions(context, self._location)
 
     def try_get_launch_description_without_context(self) -> Any:
         """The description when it was given (a file needs a context to be located)."""
@@ -52,6 +70,28 @@ class AnyLaunchDescriptionSource(LaunchDescriptionSource):
 
     def __init__(self, launch_file_path: Any) -> None:
         super().__init__(None, launch_file_path)
+
+    def get_launch_description(self, context: LaunchContext) -> Any:
+        """The file's description, loaded once by the context's planner (a standalone one for a
+        context-like object that has none)."""
+        self._expand(context)
+        if self.launch_description is None:
+            from mlaunch.launch.planning import planner_of
+
+            self.launch_description = planner_of(context).load_source(self, "")
+        return self.launch_description
+
+    def try_get_launch_description_without_context(self) -> Any:
+        """The description given, or the file's loaded with a fresh context (kept apart from
+        what a run loads); None when that fails, e.g. its path needs a launch argument."""
+        if self.launch_description is not None:
+            return self.launch_description
+        from mlaunch.launch.launch_context import LaunchContext
+
+        try:
+            return LaunchContext().planner.load_source(self, "")
+        except Exception:  # introspection only: the include itself will say what is wrong
+            return None
 
 
 class PythonLaunchDescriptionSource(AnyLaunchDescriptionSource):
