@@ -287,3 +287,32 @@ def test_composable_node_at_top_level_says_where_it_belongs(tmp_path: Path) -> N
     path.write_text('<launch><composable_node pkg="p" plugin="p::P" name="n"/></launch>')
     with pytest.raises(LaunchFileError, match="inside <node_container> or <load_composable_node>"):
         readers.load(str(path))
+
+
+def test_a_substituted_params_file_copy_is_removed_once_the_request_is_built(
+    tmp_path: Path, prefix: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The copy with substitutions performed is read into the request and not needed after:
+    it is removed (it was left in the temp folder, one per load, by every run)."""
+    from mlaunch.launch_ros.parameter_descriptions import ParameterFile
+
+    temp = tmp_path / "tmp"
+    temp.mkdir()
+    monkeypatch.setenv("TMPDIR", str(temp))
+    monkeypatch.setattr("tempfile.tempdir", None)  # tempfile caches the folder it chose
+    params = tmp_path / "p.yaml"
+    params.write_text("/**:\n  ros__parameters:\n    rate: $(var x)\n")
+    load = LoadComposableNodes(
+        target_container="c",
+        composable_node_descriptions=[
+            ComposableNode(
+                package="p",
+                plugin="p::P",
+                name="n",
+                parameters=[ParameterFile(str(params), allow_substs=True)],
+            )
+        ],
+    )
+    ((_, (request,)),) = loads(plan_of(LaunchDescription([load]), None, prefix, x="3"))
+    assert request.parameters == (p("rate", INTEGER, 3),)
+    assert list(temp.iterdir()) == []

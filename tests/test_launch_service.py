@@ -188,7 +188,10 @@ def test_run_async_leaves_the_event_loop_free() -> None:
         # This coroutine runs while the launch does: the loop is not blocked.
         seen = await asyncio.to_thread(screen.wait_for, "up")
         assert service.event_loop is asyncio.get_running_loop()
-        service.shutdown()
+        # On the loop's thread shutdown() gives a coroutine to await, as ROS 2's does.
+        requested = service.shutdown()
+        assert requested is not None
+        await requested
         return await asyncio.wait_for(task, DEADLINE), seen
 
     code, seen = asyncio.run(main())

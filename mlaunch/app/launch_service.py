@@ -5,6 +5,10 @@ thread and ``shutdown()`` from anywhere. Here ``run()`` resolves what was includ
 and hands it to mlaunch's Supervisor (with its guard, stop ladder and log folder), so a script
 gets the same processes, argv and events as ``mlaunch FILE``.
 
+Nothing outlives the service: ``run()`` ends when everything it started has ended; a cancelled
+``run_async`` shuts the launch down first; a threaded run still going when the interpreter
+exits is stopped by mlaunch.app.service_exit's exit hook.
+
 Thread safety: ``include_launch_description``, ``emit_event`` and ``shutdown`` may be called
 from any thread. While the service runs, they are queued and the supervisor's loop is woken
 through a pipe in its own selector; the loop runs them between two turns, so nothing outside
@@ -30,7 +34,7 @@ from mlaunch.plan.events import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable, Iterable
+    from collections.abc import Callable, Coroutine, Iterable
     from typing import Any
 
     from mlaunch.engine.supervisor import Supervisor
@@ -39,6 +43,9 @@ if TYPE_CHECKING:
 
 # A service kept alive when idle re-arms a timer this often (a timer keeps the loop running).
 KEEP_ALIVE_PERIOD = 3600.0
+# At interpreter exit, how long a threaded run is given to stop before it is SIGKILLed (the
+# stop ladder's default SIGINT -> SIGTERM -> SIGKILL takes 10 s at most).
+EXIT_WAIT = 15.0
 
 
 class LaunchService:
@@ -76,6 +83,8 @@ class LaunchService:
         self._running = False
         self._error = False
         self._event_loop: Any = None
+        self._thread: threading.Thread | None = None
+        self._loop_thread = 0  # the thread of the loop awaiting run_async()
         self.return_code: int | None = None
 
     # --- the public API of launch.LaunchService ------------------------------------------------
@@ -107,16 +116,18 @@ class LaunchService:
 
         self.include_launch_description(LaunchDescription([EmitEvent(event=event)]))
 
-    def shutdown(self, force_sync: bool = False) -> None:
+    def shutdown(self, force_sync: bool = False) -> Coroutine[Any, Any, None] | None:
         """Shut the running launch down (its processes get the stop ladder); thread-safe.
 
         Does nothing if the service is not running. ``force_sync`` is accepted for ROS 2
         compatibility: the request is always queued to the loop, which acts on it at once.
+        Called from the thread of the asyncio loop awaiting ``run_async()``, it returns a
+        coroutine for that loop to await, as ROS 2's does (the request is made already).
         """
-        with self._lock:
-            if not self._running:
-                return
-        self._call_soon(self._shutdown_now)
+        self._request_shutdown("LaunchService.shutdown() called")
+        if self._event_loop is None or threading.get_ident() != self._loop_thread:
+            return None
+        return _requested()
 
     def run(self, *, shutdown_when_idle: bool = True) -> int:
         """Run everything included until the launch ends; the return code (see the module).
@@ -144,18 +155,64 @@ class LaunchService:
     async def run_async(self, *, shutdown_when_idle: bool = True) -> int:
         """``run()`` for callers inside a coroutine, as ROS 2's run_async.
 
-        The launch runs on a worker thread, so the asyncio loop keeps serving its other
+        The launch runs on a thread of its own, so the asyncio loop keeps serving its other
         coroutines meanwhile. mlaunch then installs no signal handlers (the caller's own loop
         owns Ctrl-C: call ``shutdown()`` from it) and notices exits by polling every 50 ms.
+        Cancelled (``task.cancel()``, ``asyncio.wait_for`` timing out), the launch is shut down
+        as ROS 2's is (its processes get the stop ladder) and, once it has ended, the task
+        returns 1 as ROS 2's does; a second cancel SIGKILLs what is left. A task dropped
+        unfinished (its loop closed) shuts the launch down too.
         """
         import asyncio
+        import weakref
 
         loop = asyncio.get_running_loop()
+        ended: asyncio.Future[int] = loop.create_future()
+        # The run's thread holds the future weakly: a task dropped unfinished must be
+        # collectable, so that its coroutine is closed and shuts the launch down.
+        awaited = weakref.ref(ended)
+
+        def settle(code: int, error: BaseException | None) -> None:
+            future = awaited()
+            if future is None or future.done():
+                return
+            if error is not None:
+                future.set_exception(error)
+            else:
+                future.set_result(code)
+
+        def finished(code: int, error: BaseException | None) -> None:
+            try:
+                loop.call_soon_threadsafe(settle, code, error)
+            except RuntimeError:
+                pass  # the loop is closed: nobody awaits the result any more
+
+        self._start_thread(shutdown_when_idle, finished)
         self._event_loop = loop
+        self._loop_thread = threading.get_ident()
         try:
-            return await loop.run_in_executor(None, self._run_checked, shutdown_when_idle)
+            return await asyncio.shield(ended)
+        except asyncio.CancelledError:
+            self._request_shutdown("run task was canceled")
+            await self._outlast_cancels(ended)
+            return 1
+        except GeneratorExit:
+            self._request_shutdown("the run_async task was dropped unfinished")
+            raise
         finally:
             self._event_loop = None
+
+    async def _outlast_cancels(self, ended: Any) -> None:
+        """Wait for a cancelled run to end; a cancel meanwhile SIGKILLs everything at once."""
+        import asyncio
+
+        while not ended.done():
+            try:
+                await asyncio.shield(ended)
+            except asyncio.CancelledError:
+                self._call_if_running(self._kill_now)
+            except Exception:
+                return  # the run failed while stopping: a cancelled task returns 1 anyway
 
     def run_in_thread(self, *, shutdown_when_idle: bool = True) -> threading.Thread:
         """Start the launch on a thread of its own and return it (an mlaunch extension).
@@ -163,17 +220,52 @@ class LaunchService:
         As with ``run_async``, no signal handlers are installed; ``shutdown()`` ends it.
         ``return_code`` holds what ``run()`` would have returned once the thread has ended.
         """
+        return self._start_thread(shutdown_when_idle, None)
+
+    def _start_thread(
+        self,
+        shutdown_when_idle: bool,
+        finished: Callable[[int, BaseException | None], None] | None,
+    ) -> threading.Thread:
+        """Run on a daemon thread (the interpreter does not wait for it at exit: the exit hook
+        of mlaunch.app.service_exit stops it); ``finished(code, error)`` is called at its end."""
+        from mlaunch.app import service_exit
+
         with self._lock:
             if self._running:
                 raise RuntimeError("LaunchService.run() is already running")
             self._running = True  # now, so a shutdown() right after this call is not lost
 
         def target() -> None:
-            self.return_code = self._run_checked(shutdown_when_idle, claimed=True)
+            code, error = 1, None
+            try:
+                code = self._run_checked(shutdown_when_idle, claimed=True)
+            except BaseException as e:
+                error = e
+                if finished is None:
+                    raise
+            finally:
+                self.return_code = code
+                service_exit.forget(self)
+                if finished is not None:
+                    finished(code, error)
 
         thread = threading.Thread(target=target, name="LaunchService", daemon=True)
+        self._thread = thread
+        service_exit.watch(self)
         thread.start()
         return thread
+
+    def stop_at_exit(self) -> None:
+        """The interpreter exits while the run goes on: stop it and wait for it, bounded."""
+        thread = self._thread
+        if thread is None or not thread.is_alive():
+            return
+        self._request_shutdown("the Python interpreter is exiting")
+        thread.join(EXIT_WAIT)
+        if thread.is_alive():
+            self._call_if_running(self._kill_now)
+            thread.join(EXIT_WAIT)
 
     @property
     def event_loop(self) -> Any:
@@ -342,6 +434,25 @@ class LaunchService:
             supervisor.events.emit(Said("WARNING", "launch", warning))
         supervisor.execute(plan.steps)
 
-    def _shutdown_now(self) -> None:
+    def _request_shutdown(self, reason: str) -> None:
+        """Queue the shutdown of a running launch, ``reason`` its log line; thread-safe."""
+        self._call_if_running(lambda: self._shutdown_now(reason))
+
+    def _call_if_running(self, call: Callable[[], None]) -> None:
+        with self._lock:
+            if not self._running:
+                return
+        self._call_soon(call)
+
+    def _shutdown_now(self, reason: str) -> None:
         if self._supervisor is not None:
-            self._supervisor.begin_shutdown("LaunchService.shutdown() called")
+            self._supervisor.begin_shutdown(reason)
+
+    def _kill_now(self) -> None:
+        """The stop ladder at once (SIGKILL) for a run that must end now."""
+        if self._supervisor is not None:
+            self._supervisor.kill_everything()
+
+
+async def _requested() -> None:
+    """What ``shutdown()`` gives a caller on the loop: the shutdown is already on its way."""

@@ -17,6 +17,7 @@ message only by the driver (``to_message``), so ``--print`` works without rclpy.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from mlaunch.launch.substitutions import perform_substitutions
@@ -180,8 +181,7 @@ def flatten(
     current: dict[str, Any] = {}
     for entry in entries:
         if isinstance(entry, ParameterFile):
-            path = entry.evaluate(context)
-            section = _file_section(context, path, key)
+            section = _file_entry_section(context, entry, key)
             if section is not None:
                 current = section
             # else: launch_ros adds the entries before this file again (see the module text).
@@ -197,6 +197,22 @@ def flatten(
             kind = parameter_type(name, value)
             out.append(TypedParameter(name, kind, tuple(value) if kind >= BYTE_ARRAY else value))
     return out
+
+
+def _file_entry_section(
+    context: LaunchContext, entry: ParameterFile, key: str
+) -> dict[str, Any] | None:
+    """``_file_section`` of a ParameterFile entry; its substituted copy, read here and nowhere
+    else (the request carries the values), is removed once read."""
+    path = entry.evaluate(context)
+    try:
+        return _file_section(context, path, key)
+    finally:
+        if entry.created:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass  # already gone: nothing to tidy
 
 
 def _file_section(context: LaunchContext, path: Path, key: str) -> dict[str, Any] | None:
