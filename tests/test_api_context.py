@@ -160,8 +160,9 @@ def test_an_action_describes_its_sub_entities() -> None:
     from launch.conditions import IfCondition
 
     inner = LogInfo(msg="x")
-    assert GroupAction([inner]).describe_sub_entities() == [inner]
-    conditional = GroupAction([inner], condition=IfCondition("true"))
+    # A scoped group's are its actions between what scopes them (tests/test_group_returns.py).
+    assert GroupAction([inner], scoped=False).describe_sub_entities() == [inner]
+    conditional = GroupAction([inner], scoped=False, condition=IfCondition("true"))
     assert conditional.describe_sub_entities() == []
     ((why, entities),) = conditional.describe_conditional_sub_entities()
     assert why.startswith("Conditionally included by") and list(entities) == [inner]

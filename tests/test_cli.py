@@ -197,7 +197,7 @@ def test_respawn_on_failure_with_retries(tmp_path: Path, env: dict[str, str]) ->
         (
             "DeclareLaunchArgument('robot'),",
             [],
-            "required launch argument 'robot' was not provided",
+            "Required launch argument 'robot' was not provided",
         ),
         (
             "DeclareLaunchArgument('m', default_value='a', choices=['a', 'b']),",

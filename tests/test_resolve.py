@@ -124,7 +124,7 @@ def test_arguments_defaults_override_choices_and_required() -> None:
     with pytest.raises(LaunchArgumentError, match="'z', which is not one of its choices: x, y"):
         run(ld, m="z")
     required = LaunchDescription([DeclareLaunchArgument("must")])
-    with pytest.raises(LaunchArgumentError, match="required launch argument 'must'") as err:
+    with pytest.raises(LaunchArgumentError, match="Required launch argument 'must'") as err:
         run(required)
     assert err.value.where and err.value.where.endswith(".py:" + err.value.where.split(":")[-1])
 

@@ -180,7 +180,7 @@ def test_args_defaults_constants_and_command_line(tmp_path: Path) -> None:
 
 def test_required_arg_and_undeclared_arg_are_errors_with_the_line(tmp_path: Path) -> None:
     path = write(tmp_path, "req.launch", '<launch>\n  <arg name="must"/>\n</launch>\n')
-    with pytest.raises(MlaunchError, match="required launch argument 'must'"):
+    with pytest.raises(MlaunchError, match="Required launch argument 'must'"):
         plan_of(path)
     assert plan_of(path, {"must": "x"}).processes() == []
     bad = write(

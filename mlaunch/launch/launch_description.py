@@ -153,12 +153,37 @@ class LaunchDescription(LaunchDescriptionEntity):
         Declarations after a ResetLaunchConfigurations in the same list are not reachable
         from the command line and are left out, as upstream's.
         """
-        found: dict[str, Any] = {}
-        _collect_arguments(self.entities, conditional_inclusion, found)
-        return list(found.values())
+        found = self.get_launch_arguments_with_include_launch_description_actions(
+            conditional_inclusion
+        )
+        return [argument for argument, _ in found]
+
+    def get_launch_arguments_with_include_launch_description_actions(
+        self, conditional_inclusion: bool = False
+    ) -> list[tuple[Any, list[Any] | None]]:
+        """``get_launch_arguments``, each with the includes on the way to it (None: declared in
+        this description itself), as upstream's."""
+        return declared_arguments(self, conditional_inclusion, files=True)
 
 
-def _collect_arguments(entities: Iterable[Any], conditional: bool, found: dict[str, Any]) -> None:
+def declared_arguments(
+    description: LaunchDescription, conditional: bool = False, *, files: bool
+) -> list[tuple[Any, list[Any] | None]]:
+    """The declarations of ``description`` with the includes on the way to each (see
+    get_launch_arguments); ``files``: also in the files includes name, loaded without a
+    context (an include's check of what it must pass leaves them to their own includes)."""
+    found: dict[str, tuple[Any, list[Any] | None]] = {}
+    _collect_arguments(description.entities, conditional, found, None, files)
+    return list(found.values())
+
+
+def _collect_arguments(
+    entities: Iterable[Any],
+    conditional: bool,
+    found: dict[str, tuple[Any, list[Any] | None]],
+    via: list[Any] | None,
+    files: bool,
+) -> None:
     """Note in ``found`` the declarations below ``entities`` (see get_launch_arguments)."""
     # launch.actions builds on this module's classes: looked up when asked, not at import.
     from mlaunch.launch import actions
@@ -167,22 +192,26 @@ def _collect_arguments(entities: Iterable[Any], conditional: bool, found: dict[s
     for entity in entities:
         if isinstance(entity, actions.DeclareLaunchArgument) and entity.name not in found:
             entity._conditionally_included = conditional or entity.condition is not None
-            found[entity.name] = entity
+            found[entity.name] = (entity, via)
         if isinstance(entity, actions.ResetLaunchConfigurations):
             return
         inner = conditional or getattr(entity, "condition", None) is not None
         if isinstance(entity, (actions.TimerAction, actions.RegisterEventHandler)):
             # Run only if the timer fires or the event comes: conditional, as in launch.
-            _collect_arguments([e for e, _ in children(entity)], True, found)
+            later = [e for e, _ in children(entity)]
+            _collect_arguments(later, True, found, via, files)
             continue
         if isinstance(entity, actions.IncludeLaunchDescription):
             source = entity.launch_description_source
-            described = source.try_get_launch_description_without_context()
-            _collect_arguments([] if described is None else [described], inner, found)
+            described = source.launch_description
+            if described is None and files:
+                described = source.try_get_launch_description_without_context()
+            included = [] if described is None else [described]
+            _collect_arguments(included, inner, found, [*(via or ()), entity], files)
             continue
-        _collect_arguments(entity.describe_sub_entities(), inner, found)
+        _collect_arguments(entity.describe_sub_entities(), inner, found, via, files)
         for _why, more in entity.describe_conditional_sub_entities():
-            _collect_arguments(more, True, found)
+            _collect_arguments(more, True, found, via, files)
 
 
 __all__ = ["Action", "LaunchDescription", "LaunchDescriptionEntity"]

@@ -36,14 +36,6 @@ class StandaloneOptions:
     scoped_parameters = False
 
 
-class _NoInclude:
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, *exc_info: object) -> None:
-        return None
-
-
 class StandalonePlanner:
     """Collects the steps of actions visited with one context (see the module docstring)."""
 
@@ -108,8 +100,8 @@ class StandalonePlanner:
     def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
         return function(*args, **kwargs)
 
-    def including(self, path: str, origin: str) -> _NoInclude:
-        return _NoInclude()
+    def include(self, description: object, path: str | None, origin: str) -> None:
+        """Nothing to track: the include's locals stay the included file's, as upstream's."""
 
     def load_source(self, source: object, origin: str) -> object:
         built = getattr(source, "launch_description", None)

@@ -32,11 +32,20 @@ class Visit:
 
 def children(entity: object) -> list[tuple[object, bool]]:
     """The entities directly inside ``entity``, each with whether it runs later (deferred)."""
-    from mlaunch.launch.actions import RegisterEventHandler, TimerAction
+    from mlaunch.launch.actions import (
+        GroupAction,
+        IncludeLaunchDescription,
+        RegisterEventHandler,
+        TimerAction,
+    )
     from mlaunch.launch.launch_description import LaunchDescription
 
     if isinstance(entity, LaunchDescription):
         return [(e, False) for e in entity.entities]
+    if isinstance(entity, GroupAction):
+        return [(e, False) for e in entity.actions]  # as written, without what scopes them
+    if isinstance(entity, IncludeLaunchDescription):
+        return []  # what it brings in is the caller's to say (``include`` of walk)
     if isinstance(entity, TimerAction):
         return [(e, True) for e in entity.actions]
     if isinstance(entity, RegisterEventHandler):

@@ -139,8 +139,9 @@ class InvalidConditionExpressionError(SubstitutionFailure, ValueError):
     """An if/unless expression is not one of true, false, 1, 0 (a ValueError, as launch's)."""
 
 
-class LaunchArgumentError(MlaunchError):
-    """A launch argument is missing, malformed or outside its choices."""
+class LaunchArgumentError(MlaunchError, RuntimeError):
+    """A launch argument is missing, malformed or outside its choices (a RuntimeError too, as
+    launch raises)."""
 
 
 class PackageNotFoundError(MlaunchError):

@@ -15,7 +15,6 @@ the seam types them itself. Only type checkers import this module (typing costs 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from contextlib import AbstractContextManager
 from typing import Protocol, TypeVar
 
 from mlaunch.plan.steps import ArgumentInfo, Deferred, ProcessSpec, Step
@@ -84,8 +83,10 @@ class Planner(Protocol):
     def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
         """Call launch-file code, locating its exceptions in the user's file."""
 
-    def including(self, path: str, origin: str) -> AbstractContextManager[None]:
-        """While an included file is visited (include cycles are errors, not recursion)."""
+    def include(self, description: object, path: str | None, origin: str) -> None:
+        """``description`` (what an include returns to visit next) is the file at ``path``
+        (None: a description given as such): visited as an include (a cycle is an error, not
+        recursion), the includer's locals back after it."""
 
     def load_source(self, source: object, origin: str) -> object:
         """The LaunchDescription an include's source names, built or loaded from its file."""

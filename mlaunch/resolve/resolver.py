@@ -37,7 +37,6 @@ from mlaunch.plan.steps import (
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Mapping
-    from contextlib import AbstractContextManager
     from typing import Any, TypeVar
 
     R = TypeVar("R")
@@ -105,6 +104,8 @@ class Resolver:
         self.labels = labels
         self.options = options
         self.includes = IncludeChain()  # include cycles are errors, not a RecursionError
+        # The descriptions includes returned, not visited yet -> (file or None, include's origin)
+        self.included: dict[int, tuple[str | None, str]] = {}
         self.depth = 0
         allow_deep_trees()
         context.planner = self  # the seam: actions plan through their context (plan.planner)
@@ -118,9 +119,25 @@ class Resolver:
             raise too_deep(origin, "launch actions (groups, includes)", includes=self.includes)
         self.depth += 1
         try:
-            self._visit(entity)
+            included = self.included.pop(id(entity), None)
+            if included is None:
+                self._visit(entity)
+            else:
+                self._visit_included(entity, *included)
         finally:
             self.depth -= 1
+
+    def _visit_included(self, description: object, path: str | None, origin: str) -> None:
+        """An included description: in the chain of includes when it is a file's, with the
+        includer's locals back after it (the include pointed them at the file)."""
+        try:
+            if path is None:
+                self._visit(description)
+            else:
+                with self.includes.enter(path, origin, self.context):
+                    self._visit(description)
+        finally:
+            self.context._pop_locals()
 
     def _visit(self, entity: object) -> None:
         visit = getattr(entity, "visit", None)
@@ -206,8 +223,9 @@ class Resolver:
     def declare_argument(self, info: ArgumentInfo) -> ArgumentInfo:
         return self.plan.arguments.setdefault(info.name, info)
 
-    def including(self, path: str, origin: str) -> AbstractContextManager[None]:
-        return self.includes.enter(path, origin, self.context)
+    def include(self, description: object, path: str | None, origin: str) -> None:
+        self.context._push_locals()  # the includer's, before the include points them at the file
+        self.included[id(description)] = (path, origin)
 
     def new_label(self, base: str) -> str:
         return self.labels.next(base)

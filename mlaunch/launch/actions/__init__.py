@@ -11,26 +11,34 @@ from __future__ import annotations
 
 import os
 
+from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
+from mlaunch.launch.actions.group_action import GroupAction
+from mlaunch.launch.actions.include_launch_description import IncludeLaunchDescription
+from mlaunch.launch.actions.pop_environment import PopEnvironment
+from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
+from mlaunch.launch.actions.push_environment import PushEnvironment
+from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
+from mlaunch.launch.actions.reset_environment import ResetEnvironment
+from mlaunch.launch.actions.reset_launch_configurations import ResetLaunchConfigurations
+from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
 from mlaunch.launch.event_handlers import register_step
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
-    TextSubstitution,
     normalize,
     perform,
     perform_substitutions,
     to_bool,
 )
-from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError
+from mlaunch.plan.errors import LaunchFileError
 from mlaunch.plan.origin import caller_origin
+from mlaunch.plan.steps import EmitEvent as EmitEventStep
 from mlaunch.plan.steps import (
-    ArgumentInfo,
     Log,
     RemoveHandler,
     RequestShutdown,
     StartTimer,
 )
-from mlaunch.plan.steps import EmitEvent as EmitEventStep
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -44,92 +52,6 @@ if TYPE_CHECKING:
 # --- arguments and configurations ------------------------------------------------------------
 
 
-class DeclareLaunchArgument(Action):
-    """A launch argument: the command line or an includer may set it, else its default applies."""
-
-    def __init__(
-        self,
-        name: str,
-        *,
-        default_value: SomeSubstitutionsType | None = None,
-        description: str | None = None,
-        choices: Iterable[str] | None = None,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        self.name = name
-        self._conditionally_included = False  # LaunchDescription.get_launch_arguments sets it
-        self.default_value = None if default_value is None else normalize(default_value)
-        # A list, as upstream's DeclareLaunchArgument.choices reads back.
-        self.choices = None if choices is None else [str(c) for c in choices]
-        if self.choices is not None and not self.choices:
-            raise LaunchArgumentError(
-                f"argument {name!r} declares an empty list of choices", where=self.origin
-            )
-        if description is None:
-            description = (
-                f"One of: {list(self.choices)}" if self.choices else "no description given"
-            )
-        elif self.choices:
-            sep = "" if description.endswith(".") else "."
-            description = f"{description}{sep} Valid choices are: {list(self.choices)}"
-        self.description = description
-
-    def argument_info(self, conditional: bool) -> ArgumentInfo:
-        default = None
-        if self.default_value is not None:
-            default = " + ".join(
-                s.text if isinstance(s, TextSubstitution) else s.describe()
-                for s in self.default_value
-            )
-        return ArgumentInfo(
-            name=self.name,
-            default=default,
-            description=self.description,
-            choices=None if self.choices is None else tuple(self.choices),
-            origin=self.origin,
-            conditional=conditional or self.condition is not None,
-        )
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        info = planner.declare_argument(self.argument_info(conditional=False))
-        if self.name not in context.launch_configurations:
-            if self.default_value is None:
-                raise LaunchArgumentError(
-                    f"required launch argument {self.name!r} was not provided"
-                    f" (pass {self.name}:=<value>)"
-                    + (f"; valid choices: {', '.join(self.choices)}" if self.choices else ""),
-                    where=self.origin,
-                )
-            context.launch_configurations[self.name] = perform_substitutions(
-                context, self.default_value
-            )
-        value = context.launch_configurations[self.name]
-        if self.choices is not None and value not in self.choices:
-            raise LaunchArgumentError(
-                f"argument {self.name!r} got {value!r}, which is not one of its choices:"
-                f" {', '.join(self.choices)}",
-                where=self.origin,
-            )
-        if info.value is None:  # the first declaration's value, as --print --format json shows
-            info.value = str(value)
-
-    def describe_short(self) -> str:
-        return f"DeclareLaunchArgument({self.name!r})"
-
-
-class SetLaunchConfiguration(Action):
-    def __init__(self, name: SomeSubstitutionsType, value: SomeSubstitutionsType, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.name = normalize(name)
-        self.value = normalize(value)
-
-    def execute(self, context: LaunchContext) -> None:
-        name = perform_substitutions(context, self.name)
-        context.launch_configurations[name] = perform_substitutions(context, self.value)
-
-
 class UnsetLaunchConfiguration(Action):
     def __init__(self, name: SomeSubstitutionsType, **kwargs: Any):
         super().__init__(**kwargs)
@@ -137,39 +59,6 @@ class UnsetLaunchConfiguration(Action):
 
     def execute(self, context: LaunchContext) -> None:
         context.launch_configurations.pop(perform_substitutions(context, self.name), None)
-
-
-class PushLaunchConfigurations(Action):
-    def execute(self, context: LaunchContext) -> None:
-        context.push_scope()
-
-
-class PopLaunchConfigurations(Action):
-    def execute(self, context: LaunchContext) -> None:
-        context.pop_scope()
-
-
-PushEnvironment = PushLaunchConfigurations
-PopEnvironment = PopLaunchConfigurations
-
-
-class ResetLaunchConfigurations(Action):
-    """Forget every configuration, then set the given ones (performed before forgetting)."""
-
-    def __init__(self, launch_configurations: dict[Any, Any] | None = None, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.launch_configurations = launch_configurations or {}
-
-    def execute(self, context: LaunchContext) -> None:
-        keep = {
-            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
-        }
-        context.launch_configurations = keep
-
-
-class ResetEnvironment(Action):
-    def execute(self, context: LaunchContext) -> None:
-        context.environment = dict(context.initial_environment)
 
 
 # --- environment -----------------------------------------------------------------------------
@@ -228,95 +117,6 @@ class AppendEnvironmentVariable(Action):
 
 
 # --- structure -------------------------------------------------------------------------------
-
-
-class GroupAction(Action):
-    """Actions in a scope: by default configuration and environment changes stay inside."""
-
-    def __init__(
-        self,
-        actions: Iterable[Any],
-        *,
-        scoped: Any = True,
-        forwarding: Any = True,
-        launch_configurations: dict[Any, Any] | None = None,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        self.actions = list(actions)
-        self.scoped = scoped
-        self.forwarding = forwarding
-        self.launch_configurations = launch_configurations or {}
-
-    def get_sub_entities(self) -> list[Any]:
-        return list(self.actions)
-
-    def _flag(self, ctx: LaunchContext, value: Any, what: str) -> bool:
-        return value if isinstance(value, bool) else to_bool(perform(ctx, value), what)
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        configs = {
-            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
-        }
-        if not self._flag(context, self.scoped, "scoped"):
-            context.launch_configurations.update(configs)
-            planner.visit_all(self.actions)
-            return
-        with context.scope(
-            forwarding=self._flag(context, self.forwarding, "forwarding"), configs=configs
-        ):
-            planner.visit_all(self.actions)
-
-
-class IncludeLaunchDescription(Action):
-    """Another launch file (any format), with arguments; not scoped, as in ROS 2.
-
-    ``scoped=True`` (an mlaunch extension, like rolling's ScopedIncludeLaunchDescription) keeps
-    the included file's configurations and environment changes from leaking out.
-    """
-
-    def __init__(
-        self,
-        launch_description_source: Any,
-        *,
-        launch_arguments: Iterable[tuple[Any, Any]] | dict[Any, Any] | None = None,
-        scoped: bool = False,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        from mlaunch.launch.launch_description_sources import LaunchDescriptionSource, source_for
-
-        if not isinstance(launch_description_source, LaunchDescriptionSource):
-            launch_description_source = source_for(launch_description_source)
-        self.launch_description_source = launch_description_source
-        if isinstance(launch_arguments, dict):
-            launch_arguments = list(launch_arguments.items())
-        self.launch_arguments = list(launch_arguments or [])
-        self.scoped = scoped
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        source = self.launch_description_source
-        path = source.get_launch_file_location(context)
-        args = [(perform(context, k), perform(context, v)) for k, v in self.launch_arguments]
-        description = planner.load_source(source, origin=self.origin)
-        if self.scoped:
-            context.push_scope()
-        try:
-            for name, value in args:
-                context.launch_configurations[name] = value
-            if path is None:
-                planner.visit(description)
-            else:
-                with planner.including(path, self.origin), context.file_locals(path):
-                    planner.visit(description)
-        finally:
-            if self.scoped:
-                context.pop_scope()
-
-    def describe_short(self) -> str:
-        return f"IncludeLaunchDescription({self.launch_description_source.describe()})"
 
 
 class OpaqueFunction(Action):

@@ -1,5 +1,125 @@
-"""``launch.actions.include_launch_description``, where upstream defines it."""
+"""``launch.actions.include_launch_description``: another launch description, with arguments.
 
-from mlaunch.launch.actions import IncludeLaunchDescription
+Its visit returns what to visit next, as upstream's: a SetLaunchConfiguration for each argument
+given, then the included description. Before returning, it checks that each argument the
+description requires is given, and points the locals (ThisLaunchFile, ThisLaunchFileDir ...) at
+the included file. The planner is told which description is the included file's
+(``Planner.include``): the resolver visits it in the chain of includes (a cycle is an error)
+and gives the includer its own locals back after it.
+"""
+
+from __future__ import annotations
+
+import os
+
+from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
+from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
+from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
+from mlaunch.launch.launch_description import Action
+from mlaunch.launch.substitutions import perform, perform_substitutions
+from mlaunch.plan.errors import LaunchArgumentError
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+
+
+class IncludeLaunchDescription(Action):
+    """Another launch file (any format), with arguments; not scoped, as in ROS 2.
+
+    ``scoped=True`` (an mlaunch extension, like rolling's ScopedIncludeLaunchDescription) keeps
+    the included file's configurations and environment changes from leaking out.
+    """
+
+    def __init__(
+        self,
+        launch_description_source: Any,
+        *,
+        launch_arguments: Iterable[tuple[Any, Any]] | dict[Any, Any] | None = None,
+        scoped: bool = False,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        from mlaunch.launch.launch_description_sources import LaunchDescriptionSource, source_for
+
+        if not isinstance(launch_description_source, LaunchDescriptionSource):
+            launch_description_source = source_for(launch_description_source)
+        self.launch_description_source = launch_description_source
+        if isinstance(launch_arguments, dict):
+            launch_arguments = list(launch_arguments.items())
+        self.launch_arguments = list(launch_arguments or [])
+        self.scoped = scoped
+
+    def get_sub_entities(self) -> list[Any]:
+        """The included description when it is known without a context."""
+        found = self.launch_description_source.try_get_launch_description_without_context()
+        return [] if found is None else [found]
+
+    def execute(self, context: LaunchContext) -> list[Any]:
+        planner = context.planner
+        source = self.launch_description_source
+        path = source.get_launch_file_location(context)
+        # The arguments are the includer's: performed here, before the locals are the file's.
+        args = [(perform(context, k), perform(context, v)) for k, v in self.launch_arguments]
+        description = planner.load_source(source, origin=self.origin)
+        self._check_required(description, [name for name, _ in args])
+        planner.include(description, path, self.origin)
+        location = source.expand_location(context)
+        absolute = os.path.abspath(location)
+        directory = os.path.dirname(absolute) if os.path.exists(absolute) else location
+        context.extend_locals(
+            {"current_launch_file_path": absolute, "current_launch_file_directory": directory}
+        )
+        sets: list[Action] = [SetLaunchConfiguration(name, value) for name, value in args]
+        if self.scoped:
+            sets.insert(0, PushLaunchConfigurations())
+        for action in sets:
+            action.origin = self.origin
+        if not self.scoped:
+            return [*sets, description]
+        closing = PopLaunchConfigurations()
+        closing.origin = self.origin
+        return [*sets, description, closing]
+
+    def _check_required(self, description: Any, given: list[str]) -> None:
+        """Each argument the description declares without a default (not under a condition)
+        must be given by this include, or by an include inside it on the way to it."""
+        from mlaunch.launch.launch_description import LaunchDescription, declared_arguments
+
+        if not isinstance(description, LaunchDescription):  # an entity a source made
+            return
+        for argument, includes in declared_arguments(description, files=False):
+            if argument._conditionally_included or argument.default_value is not None:
+                continue
+            names = list(given)
+            for include in includes or ():
+                names.extend(include.argument_names_without_context())
+            if argument.name not in names:
+                raise LaunchArgumentError(
+                    f"Included launch description missing required argument {argument.name!r}"
+                    f" ({argument.description}); the include gives: [{', '.join(names)}]",
+                    where=self.origin,
+                )
+
+    def argument_names_without_context(self) -> list[str]:
+        """The names of the arguments this include gives, those a bare context can perform."""
+        from mlaunch.launch.launch_context import LaunchContext
+        from mlaunch.plan.errors import MlaunchError
+
+        context = LaunchContext()
+        names = []
+        for name, _ in self.launch_arguments:
+            try:
+                names.append(perform(context, name))
+            except (MlaunchError, LookupError, ValueError):
+                continue
+        return names
+
+    def describe_short(self) -> str:
+        return f"IncludeLaunchDescription({self.launch_description_source.describe()})"
+
 
 __all__ = ["IncludeLaunchDescription"]

@@ -1,5 +1,19 @@
-"""``launch.actions.pop_environment``, where upstream defines it."""
+"""``launch.actions.pop_environment``: restore the environment the matching Push kept."""
 
-from mlaunch.launch.actions import PopEnvironment
+from __future__ import annotations
+
+from mlaunch.launch.launch_description import Action
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.launch.launch_context import LaunchContext
+
+
+class PopEnvironment(Action):
+    """Restore the environment the matching PushEnvironment kept."""
+
+    def execute(self, context: LaunchContext) -> None:
+        context.pop_scope()
+
 
 __all__ = ["PopEnvironment"]

@@ -60,6 +60,12 @@ class LaunchDescriptionSource:
         if self._expanded_location is None:
             self._expanded_location = perform_substitutions(context, self._location)
 
+    def expand_location(self, context: LaunchContext) -> str:
+        """The location performed with ``context`` now (what an include visited there points
+        the locals at); ``location`` reads it back from then on."""
+        self._expanded_location = perform_substitutions(context, self._location)
+        return self._expanded_location
+
     def try_get_launch_description_without_context(self) -> Any:
         """The description when it was given (a file needs a context to be located)."""
         return self.launch_description
