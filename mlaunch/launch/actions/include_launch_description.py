@@ -16,7 +16,7 @@ from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurat
 from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
 from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
 from mlaunch.launch.launch_description import Action
-from mlaunch.launch.substitutions import perform, perform_substitutions
+from mlaunch.launch.substitutions import perform
 from mlaunch.plan.errors import LaunchArgumentError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
