@@ -253,3 +253,24 @@ def test_a_run_that_ends_by_itself_leaves_nothing(way: str) -> None:
     service.include_launch_description(LaunchDescription(entities))
     assert service.run() == (0 if way == "idle" else 1)
     assert_nothing_left(before)
+
+
+def test_two_threaded_runs_and_the_hosts_own_child_keep_their_exits() -> None:
+    """Each run waits for its own children only: neither takes the other's exits (both hung
+    so), nor the exit status of a child the host script started itself."""
+    before = descendants()
+    services = []
+    for word in ("one", "two"):
+        service = LaunchService(screen=Screen())
+        service.include_launch_description(
+            LaunchDescription([python(f"import time; time.sleep(0.3); print({word!r})")])
+        )
+        services.append(service)
+    threads = [service.run_in_thread() for service in services]
+    own = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.5); exit(7)"])
+    for thread in threads:
+        thread.join(DEADLINE)
+    assert [thread.is_alive() for thread in threads] == [False, False]
+    assert [service.return_code for service in services] == [0, 0]
+    assert own.wait(DEADLINE) == 7
+    assert_nothing_left(before)

@@ -418,11 +418,12 @@ class Supervisor:
         self.events.emit(Output(process, stream, data))
 
     def _reap(self) -> None:
+        # A subreaper waits for any child (adopted orphans too); an embedder's supervisor only
+        # for its own, so it never takes the exit of its host's children or of another run's
+        # (two LaunchServices on threads hung, each waiting for a child the other had reaped).
+        mine = None if self.strays.adopt else self.by_pid
         while True:
-            try:
-                pid, status, rusage = os.wait4(-1, os.WNOHANG)
-            except ChildProcessError:
-                return
+            pid, status, rusage = _wait_child(mine)
             if pid == 0:
                 return
             process = self.by_pid.pop(pid, None)
@@ -475,3 +476,20 @@ class Supervisor:
     def _forget(self, old: Process) -> None:
         if not old.streams and old not in self.lingering and old in self.processes:
             self.processes.remove(old)  # a crash loop must not grow the list forever
+
+
+def _wait_child(pids: Mapping[int, object] | None) -> tuple[int, int, object]:
+    """An exited child not yet reaped (any child, or one of ``pids``); pid 0 when none."""
+    if pids is None:
+        try:
+            return os.wait4(-1, os.WNOHANG)
+        except ChildProcessError:
+            return 0, 0, None
+    for pid in list(pids):
+        try:
+            found = os.wait4(pid, os.WNOHANG)
+        except ChildProcessError:
+            continue  # not ours to wait for (any more)
+        if found[0]:
+            return found
+    return 0, 0, None
