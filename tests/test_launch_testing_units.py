@@ -129,3 +129,23 @@ def test_retry_on_failure_retries_assertions_only() -> None:
     assert result.wasSuccessful() and len(calls) == 3
     with pytest.raises(ValueError, match="times is 0"):
         retry_on_failure(times=0)
+
+
+def test_a_process_proxy_splits_what_a_prepared_process_printed_by_stream() -> None:
+    from mlaunch.launch.events import ProcessStarted, ProcessStderr, ProcessStdout
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch_testing.io_handler import ActiveIoHandler
+    from mlaunch.launch_testing.proc_info_handler import ActiveProcInfoHandler
+    from mlaunch.launch_testing.tools import ProcessProxy
+
+    output, info = ActiveIoHandler(), ActiveProcInfoHandler()
+    action = ExecuteProcess(cmd=["ls", "-l"], name="lister")
+    proxy = ProcessProxy(action, info, output)
+    action.prepare(LaunchContext())
+    facts = {"action": action, "name": action.name, "cmd": action.cmd, "pid": 7}
+    assert not proxy.running and action.name.startswith("lister-")
+    info.append(ProcessStarted(**facts))
+    output.append(ProcessStdout(text=b"out\n", **facts))
+    output.append(ProcessStderr(text=b"err\n", **facts))
+    assert proxy.running and not proxy.terminated
+    assert (proxy.stdout, proxy.stderr, proxy.output) == ("out\n", "err\n", "out\nerr\n")

@@ -117,3 +117,32 @@ def test_a_runs_context_plans_the_events_it_is_given_and_queues_none():
     )
     assert sizes == [0]
     assert [type(s).__name__ for s in plan.steps] == ["EmitEvent", "RequestShutdown"]
+
+
+def test_prepare_and_execute_fill_process_details_with_the_final_command():
+    context = LaunchContext(environment={"PATH": "/usr/bin:/bin"})
+    context.launch_configurations["launch-prefix"] = "nice -n 5"
+    context.launch_configurations["launch-prefix-filter"] = "py.*"
+    matched = ExecuteProcess(cmd=["python3", "-c", "pass"], name="m")
+    missed = ExecuteProcess(cmd=["true"])
+    own = ExecuteProcess(cmd=["true"], prefix="echo")
+    assert matched.process_details is None  # as written before: substitutions
+    assert [s.text for s in matched.name] == ["m"]
+    assert [[s.text for s in item] for item in matched.cmd] == [["python3"], ["-c"], ["pass"]]
+    matched.prepare(context)
+    details = matched.process_details
+    assert details is not None and details["action"] is matched
+    assert details["cmd"] == ["nice", "-n", "5", "python3", "-c", "pass"]
+    assert (matched.name, matched.cmd, matched.env) == (
+        details["name"],
+        details["cmd"],
+        details["env"],
+    )
+    assert details["name"] == "m-1" and "pid" not in details
+    assert context.planner.plan.steps == []  # type: ignore[attr-defined]  # prepared, not planned
+    missed.visit(context)
+    own.visit(context)
+    assert missed.cmd == ["true"]  # the filter leaves a program it does not match alone
+    assert own.cmd == ["echo", "true"]  # the action's own prefix is not filtered
+    spawned = [s.spec.argv for s in context.planner.plan.steps]  # type: ignore[attr-defined]
+    assert spawned == [tuple(missed.cmd), tuple(own.cmd)]

@@ -52,8 +52,9 @@ class ExecuteProcess(Action):
     """
 
     completes_later = True  # ExecutionComplete when it exits for good (the engine says)
-    # ROS 2's name, cmd, cwd, env and pid of the running process; None until it has started
-    # (mlaunch.app.launch_service fills it in; launch_testing looks processes up by it).
+    # ROS 2's action, name, cmd, cwd and env of the process, as executing (or ``prepare``) made
+    # them; None before. The pid comes when it starts (mlaunch.app.launch_service fills it in;
+    # launch_testing looks processes up by it).
     process_details: dict[str, Any] | None = None
     # The exit status of its last run (negative: killed by that signal); None until it exits.
     return_code: int | None = None
@@ -88,11 +89,12 @@ class ExecuteProcess(Action):
         super().__init__(**kwargs)
         if isinstance(cmd, (str, Substitution)):
             cmd = [cmd]
-        self.cmd = [normalize(item) for item in cmd]
+        # As written; the properties of the same names give the final values once prepared.
+        self._cmd = [normalize(item) for item in cmd]
         self.prefix = None if prefix is None else normalize(prefix)
-        self.name = None if name is None else normalize(name)
-        self.cwd = None if cwd is None else normalize(cwd)
-        self.env = env
+        self._name = None if name is None else normalize(name)
+        self._cwd = None if cwd is None else normalize(cwd)
+        self._env = env
         self.additional_env = additional_env
         self.shell = shell
         # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s.
@@ -121,13 +123,47 @@ class ExecuteProcess(Action):
         # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
         self.machine = None if machine is None else normalize(machine)
 
+    # Upstream's getters: the final value once executed (or prepared), else as written.
+
+    @property
+    def name(self) -> Any:
+        return self._name if self.process_details is None else self.process_details["name"]
+
+    @property
+    def cmd(self) -> Any:
+        return self._cmd if self.process_details is None else self.process_details["cmd"]
+
+    @property
+    def cwd(self) -> Any:
+        return self._cwd if self.process_details is None else self.process_details["cwd"]
+
+    @property
+    def env(self) -> Any:
+        return self._env if self.process_details is None else self.process_details["env"]
+
     def command(self, context: LaunchContext) -> list[str]:
         """The argv before any prefix: each cmd item performed to one element."""
-        return [perform_substitutions(context, item) for item in self.cmd]
+        return [perform_substitutions(context, item) for item in self._cmd]
 
     def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        planner.spawn(self.build_spec(context))
+        context.planner.spawn(self._prepared(context))
+
+    def prepare(self, context: LaunchContext) -> None:
+        """Work out the process for ``context`` (substitutions, the launch prefix and its
+        filter, the name with launch's number) into ``process_details``, as upstream's; it
+        starts nothing. Executing prepares again, so the number counts on, as in launch."""
+        self._prepared(context)
+
+    def _prepared(self, context: LaunchContext) -> ProcessSpec:
+        spec = self.build_spec(context)
+        self.process_details = {
+            "action": self,
+            "name": spec.label,
+            "cmd": list(spec.argv),
+            "cwd": spec.cwd,
+            "env": dict(spec.env),
+        }
+        return spec
 
     def build_spec(self, context: LaunchContext) -> ProcessSpec:
         machine = self._machine(context)
@@ -161,8 +197,8 @@ class ExecuteProcess(Action):
             argv, located = planner.locate_program(argv, shell=self.shell, origin=self.origin)
         prefix = self._prefix(context, named)
         # The label comes from the program the launch file named, not from its stand-in.
-        if self.name is not None:
-            base = perform_substitutions(context, self.name)
+        if self._name is not None:
+            base = perform_substitutions(context, self._name)
         elif replaced_label is not None and not prefix:
             base = replaced_label
         else:
@@ -175,7 +211,7 @@ class ExecuteProcess(Action):
             launch_prefix=tuple(prefix),
             env=env,
             env_changes=_env_changes(context.initial_environment, env),
-            cwd=None if self.cwd is None else perform_substitutions(context, self.cwd),
+            cwd=None if self._cwd is None else perform_substitutions(context, self._cwd),
             shell=self.shell,
             emulate_tty=self._emulate_tty(context),
             output=self._output(context),
@@ -226,8 +262,8 @@ class ExecuteProcess(Action):
         return shlex.split(text)
 
     def _environment(self, ctx: LaunchContext) -> dict[str, str]:
-        if self.env is not None:
-            env = {perform(ctx, k): perform(ctx, v) for k, v in _items(self.env)}
+        if self._env is not None:
+            env = {perform(ctx, k): perform(ctx, v) for k, v in _items(self._env)}
         else:
             env = dict(ctx.environment)
         if self.additional_env:
@@ -323,7 +359,7 @@ class ExecuteProcess(Action):
         return parse_cmdline(cmd, parser)
 
     def describe_short(self) -> str:
-        return "ExecuteProcess(" + " ".join(describe(c) for c in self.cmd) + ")"
+        return "ExecuteProcess(" + " ".join(describe(c) for c in self._cmd) + ")"
 
 
 def _items(mapping: Any) -> list[tuple[Any, Any]]:

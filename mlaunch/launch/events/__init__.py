@@ -141,11 +141,17 @@ class ProcessStdin(ProcessIO):
 
 
 class ProcessStdout(ProcessIO):
-    pass
+    """Text a process wrote to its stdout (fd 1)."""
+
+    def __init__(self, *, text: bytes, **kwargs: Any) -> None:
+        super().__init__(text=text, **{"fd": 1, **kwargs})
 
 
 class ProcessStderr(ProcessIO):
-    pass
+    """Text a process wrote to its stderr (fd 2, unless the caller says otherwise)."""
+
+    def __init__(self, *, text: bytes, **kwargs: Any) -> None:
+        super().__init__(text=text, **{"fd": 2, **kwargs})
 
 
 class IncludeLaunchDescription(Event):
