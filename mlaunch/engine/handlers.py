@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 from mlaunch.engine.process import Process
 from mlaunch.launch import events as ev
-from mlaunch.launch.event_handlers import returned_entities
+from mlaunch.launch.event_handlers import MATCHER_KIND, returned_entities
 from mlaunch.plan.events import (
     Completed,
     Event,
@@ -74,7 +74,7 @@ class LaunchHandlers:
         launch asks this as it visits an action: ExecutionComplete is emitted for it (when it
         completes) only if so, and then every matching handler of that moment handles it.
         """
-        return any(_completes(h, action) for h in self.handlers)
+        return any(_completes(h, action) or h.kind == MATCHER_KIND for h in self.handlers)
 
     def _completed(self, action: object) -> None:
         event = ev.ExecutionComplete(action=action)
@@ -85,6 +85,38 @@ class LaunchHandlers:
                 self.handlers.remove(handler)
             if handler.body is not None:
                 self.supervisor.fire(handler.body, event)
+        self.general(event)
+
+    def general(self, event: object) -> bool:
+        """Fire the handlers of no kind the engine dispatches whose ``matches(event)`` accepts
+        ``event`` (launch's general path: ``EventHandler(matcher=...)``); whether one did.
+
+        A matcher is launch-file code: one that raises is said once, as the handler's failure,
+        and the handler is dropped (the run shuts down)."""
+        fired = False
+        for handler in list(self.handlers):
+            if handler.kind != MATCHER_KIND:
+                continue
+            try:
+                matched = bool(handler.handler.matches(event))
+            except Exception as e:
+                from mlaunch.plan.origin import user_location
+
+                if handler in self.handlers:
+                    self.handlers.remove(handler)
+                where = user_location(e.__traceback__) or handler.origin
+                self.supervisor.handler_failed(
+                    f"{where}: the matcher of an event handler failed: {type(e).__name__}: {e}"
+                )
+                continue
+            if not matched:
+                continue
+            fired = True
+            if handler.once and handler in self.handlers:
+                self.handlers.remove(handler)
+            if handler.body is not None:
+                self.supervisor.fire(handler.body, event)
+        return fired
 
     def _launch_event(self, record: LaunchEvent) -> None:
         """launch's own events: Shutdown, ShutdownProcess, SignalProcess.
@@ -94,19 +126,27 @@ class LaunchHandlers:
         """
         event, supervisor = record.event, self.supervisor
         if isinstance(event, ev.Shutdown):
-            supervisor.begin_shutdown(event.reason)
-        elif isinstance(event, ev.ShutdownProcess):
-            for p in self._running(event.process_matcher):
-                supervisor.stop(p)
-        elif isinstance(event, ev.SignalProcess):
-            for p in self._running(event.process_matcher):
-                p.signal_group(int(event.signal_number))
+            supervisor.begin_shutdown(event.reason)  # its handlers get it as the shutdown begins
         elif isinstance(event, ev.ExecutionComplete):  # an action without a process or timer
             self._completed(event.action)
         else:
-            supervisor.events.emit(Unclaimed(record))
-            return
+            acted = self._act_on_processes(event)
+            if not self.general(event) and not acted:
+                supervisor.events.emit(Unclaimed(record))
+                return
         record.taken = True
+
+    def _act_on_processes(self, event: object) -> bool:
+        """ShutdownProcess and SignalProcess carried out; whether ``event`` was one."""
+        if isinstance(event, ev.ShutdownProcess):
+            for p in self._running(event.process_matcher):
+                self.supervisor.stop(p)
+        elif isinstance(event, ev.SignalProcess):
+            for p in self._running(event.process_matcher):
+                p.signal_group(int(event.signal_number))
+        else:
+            return False
+        return True
 
     def _running(self, matcher: Callable[[Any], bool] | None) -> list[Process]:
         processes = self.supervisor.processes
@@ -136,6 +176,7 @@ class LaunchHandlers:
                 self.handlers.remove(handler)
             if handler.body is not None:
                 self.supervisor.fire(handler.body, record.event)
+        self.general(record.event)
 
     def dispatch(self, kind: str, process: ProcessView | None, event: Any) -> None:
         """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec."""
@@ -152,6 +193,7 @@ class LaunchHandlers:
                 self.handlers.remove(handler)
             if handler.body is not None:
                 self.supervisor.fire(handler.body, event)
+        self.general(event)
 
     def output(self, process: ProcessView, stream: str, data: bytes) -> None:
         """Complete lines of a child to the OnProcessIO handlers that want its ``stream``."""
@@ -166,14 +208,7 @@ class LaunchHandlers:
                 continue
             if handler.once:
                 self.handlers.remove(handler)
-            event = event_type(
-                action=process.spec.action,
-                name=process.label,
-                cmd=list(process.argv),
-                pid=process.pid,
-                text=data,
-                fd=1 if stream == "stdout" else 2,
-            )
+            event = _io_event(event_type, process, stream, data)
             try:
                 result = callback(event)
             except Exception as e:  # launch-file code: report it where it was written
@@ -189,6 +224,20 @@ class LaunchHandlers:
                 body = handler.body
                 deferred = Deferred(entities, body.context, body.origin, captured=body.captured)
                 self.supervisor.fire(deferred, event)
+        if any(h.kind == MATCHER_KIND for h in self.handlers):
+            self.general(_io_event(event_type, process, stream, data))
+
+
+def _io_event(event_type: type, process: ProcessView, stream: str, data: bytes) -> Any:
+    """launch's ProcessStdout/ProcessStderr of ``data`` (bytes) from ``process``."""
+    return event_type(
+        action=process.spec.action,
+        name=process.label,
+        cmd=list(process.argv),
+        pid=process.pid,
+        text=data,
+        fd=1 if stream == "stdout" else 2,
+    )
 
 
 class _Target:

@@ -18,10 +18,11 @@ from mlaunch.launch.actions.pop_environment import PopEnvironment
 from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
 from mlaunch.launch.actions.push_environment import PushEnvironment
 from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
+from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
 from mlaunch.launch.actions.reset_environment import ResetEnvironment
 from mlaunch.launch.actions.reset_launch_configurations import ResetLaunchConfigurations
 from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
-from mlaunch.launch.event_handlers import register_step
+from mlaunch.launch.actions.unregister_event_handler import UnregisterEventHandler
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (
@@ -35,7 +36,6 @@ from mlaunch.plan.origin import caller_origin
 from mlaunch.plan.steps import EmitEvent as EmitEventStep
 from mlaunch.plan.steps import (
     Log,
-    RemoveHandler,
     RequestShutdown,
     StartTimer,
 )
@@ -197,32 +197,6 @@ class TimerAction(Action):
 
 
 # --- events ----------------------------------------------------------------------------------
-
-
-class RegisterEventHandler(Action):
-    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.event_handler = event_handler
-
-    def execute(self, context: LaunchContext) -> None:
-        handler = self.event_handler
-        step = register_step(context, handler, self.origin)
-        if step is None:
-            raise LaunchFileError(
-                f"event handler {type(handler).__name__} is not supported by mlaunch",
-                where=self.origin,
-            )
-        context.planner.add(step)
-
-
-class UnregisterEventHandler(Action):
-    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.event_handler = event_handler
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        planner.add(RemoveHandler(origin=self.origin, handler=self.event_handler))
 
 
 class EmitEvent(Action):

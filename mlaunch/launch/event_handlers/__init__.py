@@ -153,18 +153,32 @@ class EventHandler:
         return text, list(self.entities)
 
 
+# The kind of a handler the engine does not dispatch by itself: its ``matches(event)`` decides
+# for each event of the run, as every handler of launch's does (the general path).
+MATCHER_KIND = "matcher"
+
+
 def handler_step(handler: Any, planner: Any, origin: str) -> AddHandler | None:
-    """The plan step that registers ``handler``, or None for a handler of no kind mlaunch runs."""
+    """The plan step that registers ``handler``; None for an object that is no event handler
+    (no kind mlaunch dispatches, and no ``matches(event)``)."""
     kind = getattr(handler, "kind", "")
     if not kind:
-        return None
+        if not callable(getattr(handler, "matches", None)):
+            return None
+        kind = MATCHER_KIND
+    entities, callback = getattr(handler, "entities", []), getattr(handler, "callback", None)
+    matcher = handler.process_matcher() if hasattr(handler, "process_matcher") else None
+    if kind == MATCHER_KIND:
+        matcher = None  # its matches(event) decides, event by event
+        if getattr(type(handler), "handle", EventHandler.handle) is not EventHandler.handle:
+            entities, callback = [], handler.handle  # a handler of its own: its handle() says
     return AddHandler(
         origin=origin,
         kind=kind,
-        matcher=handler.process_matcher() if hasattr(handler, "process_matcher") else None,
-        body=planner.defer(handler.entities, origin, callback=handler.callback),
+        matcher=matcher,
+        body=planner.defer(entities, origin, callback=callback),
         io_callbacks=dict(getattr(handler, "io_callbacks", {})),
-        once=handler.handle_once,
+        once=bool(getattr(handler, "handle_once", False)),
         handler=handler,
     )
 
@@ -173,7 +187,7 @@ def register_step(context: Any, handler: Any, origin: str) -> AddHandler | None:
     """``handler_step`` for a handler registered with ``context``; the run notes from then on
     that actions' completions may be awaited (ExecutionComplete)."""
     step = handler_step(handler, context.planner, origin)
-    if step is not None and step.kind == "execution_complete":
+    if step is not None and step.kind in ("execution_complete", MATCHER_KIND):
         from mlaunch.launch.launch_description import COMPLETION_HANDLERS
 
         context.run_state[COMPLETION_HANDLERS] = True
@@ -320,6 +334,7 @@ BaseEventHandler = EventHandler
 OnActionEventBase = EventHandler
 
 __all__ = [
+    "MATCHER_KIND",
     "BaseEventHandler",
     "EventHandler",
     "OnActionEventBase",

@@ -19,8 +19,8 @@ class LaunchDescriptionSource:
     def __init__(
         self,
         launch_description: Any = None,
-        location: Any = "<script>",
-        method: str = "",
+        location: Any = "<string>",
+        method: str = "unspecified mechanism from a script",
     ) -> None:
         self.launch_description = launch_description
         self._location = normalize(location)
@@ -74,8 +74,11 @@ class LaunchDescriptionSource:
 class AnyLaunchDescriptionSource(LaunchDescriptionSource):
     """A launch file of any format, chosen by its suffix."""
 
+    # How the description is made, as upstream's sources say it (``method``).
+    method_text = "interpreted launch file"
+
     def __init__(self, launch_file_path: Any) -> None:
-        super().__init__(None, launch_file_path)
+        super().__init__(None, launch_file_path, self.method_text)
 
     def get_launch_description(self, context: LaunchContext) -> Any:
         """The file's description, loaded once by the context's planner (a standalone one for a
@@ -102,18 +105,21 @@ class AnyLaunchDescriptionSource(LaunchDescriptionSource):
 
 class PythonLaunchDescriptionSource(AnyLaunchDescriptionSource):
     format_hint = "python"
+    method_text = "interpreted python launch file"
 
 
 class FrontendLaunchDescriptionSource(AnyLaunchDescriptionSource):
-    pass
+    method_text = "interpreted frontend launch file"
 
 
 class XMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
     format_hint = "xml"
+    method_text = "interpreted XML launch file"
 
 
 class YAMLLaunchDescriptionSource(AnyLaunchDescriptionSource):
     format_hint = "yaml"
+    method_text = "interpreted YAML launch file"
 
 
 def source_for(value: Any) -> LaunchDescriptionSource:
