@@ -3,9 +3,11 @@
 LaunchHandlers subscribes to the supervisor's EventStream: each record of a process starting,
 printing or exiting, of the launch shutting down, or of a managed node's transition becomes
 the launch event launch_ros's handlers expect (mlaunch.launch.events), and every matching
-handler fires. The events a launch file emits (EmitEvent: Shutdown, ShutdownProcess,
-SignalProcess) are acted on here too. A handler's body is resolved when it fires, with the
-same resolve code as the launch file (``Supervisor.fire``), and what it gives is carried out.
+handler fires; a handler of no kind dispatched here (``EventHandler(matcher=...)``) is offered
+every event, and its ``matches(event)`` decides (``general``). The events a launch file
+emits (EmitEvent: Shutdown, ShutdownProcess, SignalProcess) are acted on here too. A
+handler's body is resolved when it fires, with the same resolve code as the launch file
+(``Supervisor.fire``), and what it gives is carried out.
 """
 
 from __future__ import annotations
