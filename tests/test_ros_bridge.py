@@ -343,6 +343,25 @@ def test_sigint_just_before_spin_exits_0(ros_env: dict[str, str], tmp_path: Path
 
 
 @requires_rclpy
+def test_a_second_signal_ends_a_node_stuck_in_its_teardown(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """Python runs no handler while the main thread is in native code (a middleware teardown
+    that hangs): the first signal is recorded, and the second must end the program by its
+    default action, or the supervisor's ladder needs SIGKILL."""
+    children = Children(ros_env, tmp_path)
+    try:
+        child = children.start("stuck", "talker.py", "--slow-teardown", "60")
+        assert wait_until(lambda: "Publishing" in child.err(), STARTUP), child.err()
+        child.proc.send_signal(signal.SIGINT)
+        assert wait_until(lambda: "tearing down" in child.err(), 10), child.err()
+        child.proc.send_signal(signal.SIGTERM)
+        assert child.proc.wait(timeout=10) == -signal.SIGTERM
+    finally:
+        children.stop_all()
+
+
+@requires_rclpy
 def test_absent_node_times_out_at_the_deadline(ros_env: dict[str, str]) -> None:
     with RosGraph(environ=ros_env) as graph:
         started = time.monotonic()

@@ -28,22 +28,27 @@ class StopNode(Exception):
 class _Signals:
     """Our own SIGINT/SIGTERM handling; rclpy's handlers are not installed at all.
 
-    Before rclpy.init the handler raises KeyboardInterrupt: nothing ROS exists yet, so
-    abandoning the start-up is clean. Afterwards it only records the signal and the spin loop,
-    which wakes at least every SPIN_PERIOD, ends. Why not rclpy's handlers: an exception raised
-    at an arbitrary bytecode inside rclpy leaves half-built objects (an Executor whose __del__
-    prints an "Exception ignored" traceback), and relying on rclpy's handler to shut the
-    context down lost about one signal in 40 that landed just before spin() (measured).
+    The handler only records the signal; the program looks at it where stopping is clean: after
+    ``import rclpy``, after ``rclpy.init`` and in the spin loop, which wakes at least every
+    SPIN_PERIOD. It raises nothing: a KeyboardInterrupt raised at an arbitrary bytecode inside
+    rclpy (its import, ``rclpy.init`` returning with the middleware's participant made) leaves
+    half-built objects and a context never shut down, whose teardown at exit is native code.
+    Why not rclpy's handlers: relying on them to shut the context down lost about one signal
+    in 40 that landed just before spin() (measured).
+
+    A recorded signal is only acted on when Python runs, and Python runs no handler while the
+    main thread is in native code (rcl, the middleware's teardown): there a SIGTERM after the
+    SIGINT was ignored as well and the supervisor needed SIGKILL. So after the first signal
+    both get their default action back: the supervisor's next step ends the program at once.
     """
 
     def __init__(self) -> None:
-        self.rclpy_ready = False
         self.received = False
 
     def __call__(self, signum: int, frame: object) -> None:
         self.received = True
-        if not self.rclpy_ready:
-            raise KeyboardInterrupt
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
     def install(self) -> None:
         # A parent may have left SIGINT ignored (background jobs of a non-interactive shell),
@@ -64,10 +69,7 @@ def run(build: Callable[[list[str]], Any], argv: list[str] | None = None) -> int
     argv = list(sys.argv if argv is None else argv)
     signals = _Signals()
     signals.install()
-    try:
-        return _spin(build, argv, signals)
-    except KeyboardInterrupt:
-        return 0  # a signal before rclpy was up: still a clean stop
+    return _spin(build, argv, signals)
 
 
 def _spin(build: Callable[[list[str]], Any], argv: list[str], signals: _Signals) -> int:
@@ -75,10 +77,13 @@ def _spin(build: Callable[[list[str]], Any], argv: list[str], signals: _Signals)
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
 
+    if signals.received:
+        return 0  # stopped while rclpy loaded: nothing of ROS exists yet
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    signals.rclpy_ready = True
     node = None
     try:
+        if signals.received:
+            return 0  # stopped during rclpy.init: the finally shuts the context down
         node = build(argv)
         executor = SingleThreadedExecutor()
         executor.add_node(node)

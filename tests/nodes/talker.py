@@ -8,6 +8,8 @@
 - `--die-after S` ends the program S seconds after start with status `--exit-code` (default 1),
   to test crash handling; SIGINT/SIGTERM still end it with 0.
 - `--count N` stops publishing after N messages (the node stays up).
+- `--slow-teardown S` takes S seconds to tear down after a stop signal, as a middleware whose
+  teardown hangs does (a second signal must still end it).
 - `--best-effort` publishes with BEST_EFFORT reliability; `--latched` with TRANSIENT_LOCAL
   durability (a late subscriber still gets the last message).
 Each message is also logged at INFO (stderr), like demo_nodes_py's talker.
@@ -26,6 +28,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--die-after", type=float, metavar="SECONDS")
     parser.add_argument("--exit-code", type=int, metavar="N")
     parser.add_argument("--count", type=int, metavar="N")
+    parser.add_argument("--slow-teardown", type=float, metavar="SECONDS")
     qos = parser.add_mutually_exclusive_group()
     qos.add_argument("--best-effort", action="store_true")
     qos.add_argument("--latched", action="store_true")
@@ -75,7 +78,23 @@ def build(argv: list[str]) -> Any:
     node.create_timer(1.0 / float(rate), publish)
     if options.die_after is not None:
         node.create_timer(options.die_after, die)
+    if options.slow_teardown is not None:
+        _slow_teardown(node, options.slow_teardown)
     return node
+
+
+def _slow_teardown(node: Any, seconds: float) -> None:
+    """Make destroying ``node`` take ``seconds`` first (signals are only recorded meanwhile)."""
+    import time
+
+    destroy = node.destroy_node
+
+    def slow() -> None:
+        node.get_logger().info(f"tearing down for {seconds} s")
+        time.sleep(seconds)
+        destroy()
+
+    node.destroy_node = slow
 
 
 if __name__ == "__main__":
