@@ -68,7 +68,9 @@ class LaunchService:
         self.noninteractive = noninteractive
         self.debug = debug
         self.screen = screen
-        self._context = LaunchContext(environment=os.environ, argv=tuple(self.argv))
+        self._context = LaunchContext(
+            environment=os.environ, argv=tuple(self.argv), noninteractive=noninteractive
+        )
         for item in self.argv:
             name, sep, value = item.partition(":=")
             if sep and name:

@@ -61,6 +61,7 @@ class Options:
         self.log_max_bytes = log_max_bytes
         self.log_keep = log_keep
         self.format = "text"  # --format: how --print and --show-args write (text or json)
+        self.noninteractive = False  # -n: the launch context's noninteractive, as ros2 launch
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -143,7 +144,11 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
     )
     parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
     parser.add_argument(
-        "-n", "--noninteractive", action="store_true", help="accepted for ros2 launch compatibility"
+        "-n",
+        "--noninteractive",
+        action="store_true",
+        help="as ros2 launch: a launch file's Shutdown due to SIGINT still sends its processes"
+        " SIGINT (interactive: SIGTERM after sigterm_timeout)",
     )
     parser.add_argument(
         "-a",
@@ -314,6 +319,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         log_keep=_log_keep(ns.log_keep),
     )
     opts.capture = ns.capture_at_definition
+    opts.noninteractive = ns.noninteractive
     opts.format = ns.format
     if opts.format != "text" and not (opts.print_plan or opts.show_args):
         raise UsageError(

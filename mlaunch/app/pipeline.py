@@ -138,6 +138,7 @@ def resolve_for_run(
         log_dir=log_dir,
         options=options,
         labels=labels,
+        noninteractive=opts.noninteractive,
     )
     return plan, options, labels
 

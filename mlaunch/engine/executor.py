@@ -108,7 +108,11 @@ class Executor:
         elif isinstance(step, RemoveHandler):
             self.handlers.remove(step.handler)
         elif isinstance(step, RequestShutdown):
-            self.shutdown.begin(step.reason)
+            self.shutdown.begin(
+                step.reason,
+                due_to_signal=2 if step.due_to_sigint else None,  # SIGINT, as the event said
+                send_sigint=step.send_sigint,
+            )
         elif isinstance(step, EmitEvent):
             self.events.emit(LaunchEvent(step.event))
         elif isinstance(step, Handoff):

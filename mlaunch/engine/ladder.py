@@ -29,21 +29,24 @@ class StopLadder:
         self.emit = emit
         self.records = records
 
-    def stop(self, process: Process) -> None:
-        """SIGINT now, then SIGTERM and SIGKILL while the group lives on."""
+    def stop(self, process: Process, *, sigint: bool = True) -> None:
+        """SIGINT now (unless not ``sigint``), then SIGTERM and SIGKILL while the group lives on."""
         if process.stopping:
             return
         process.stopping = True
         if process.running:
             self.records[process.label].state = STOPPING
         spec = process.spec
-        if not process.signal_group(signal.SIGINT, wake=True):
+        if sigint:
+            if not process.signal_group(signal.SIGINT, wake=True):
+                return
+        elif not (process.running or process.check_group()):
             return
 
         def escalate(sig: int, waited: float, next_step: Callable[[], None] | None) -> None:
             if not (process.running or process.check_group()):
                 return
-            previous = process.signals_sent[-1]
+            previous = process.signals_sent[-1] if process.signals_sent else 0
             process.signal_group(sig, wake=True)
             self.emit(Escalated(process, sig, previous, waited))
             if next_step is not None:

@@ -257,7 +257,9 @@ class Process:
         try:
             self.popen = subprocess.Popen(
                 args,
-                stdin=subprocess.DEVNULL,
+                # A pipe nobody writes to, open while the child lives, as launch gives: a
+                # child that reads its stdin waits (DEVNULL would hand it EOF at once).
+                stdin=subprocess.PIPE,
                 stdout=subprocess.PIPE if ttys is None else ttys[0][1],
                 stderr=subprocess.PIPE if ttys is None else ttys[1][1],
                 env=env,
@@ -340,6 +342,11 @@ class Process:
         if self.popen is not None:
             # We reaped it ourselves; tell Popen so it never waits for this pid again.
             self.popen.returncode = code
+            if self.popen.stdin is not None:
+                try:  # what is left of its group reads EOF from now on
+                    self.popen.stdin.close()
+                except OSError:
+                    pass  # something written to it (a subclass's) found no reader
 
     def signal_group(self, sig: int, *, wake: bool = False) -> bool:
         """Send ``sig`` to the child's process group; False when nothing is left in it.

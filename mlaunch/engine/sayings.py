@@ -151,7 +151,8 @@ class Sayings:
         self.message(
             "WARNING",
             process.label,
-            f"failed to terminate {event.waited:g} s after {signal_name(event.previous)},"
+            f"failed to terminate {event.waited:g} s after "
+            f"{signal_name(event.previous) if event.previous else 'the shutdown began'},"
             f" escalating to {signal_name(event.signal)} [pid {process.pid}]",
         )
 

@@ -57,18 +57,23 @@ class Shutdown:
         self.kill_now = False
         self._held: set[Process] = set()
         self._presses = 0
+        # Whether the stop ladders of this shutdown start with SIGINT (RequestShutdown says).
+        self.send_sigint = True
 
-    def begin(self, reason: str, *, due_to_signal: int | None = None) -> None:
+    def begin(
+        self, reason: str, *, due_to_signal: int | None = None, send_sigint: bool = True
+    ) -> None:
         """Shut the launch down, in two phases on the stream.
 
         ShutdownBegun: the printer says why, OnShutdown handlers run (and may ``hold`` a
         process); then StoppingAll: every process not held gets its stop ladder (``stop_all``,
-        the supervisor's reaction).
+        the supervisor's reaction), from SIGTERM after its timeout when not ``send_sigint``.
         """
         if self.active:
             return
         self.active = True
         self.reason = reason
+        self.send_sigint = send_sigint
         self.timers.shutting_down()  # pending respawns and TimerActions included
         for record in self.records.values():
             if record.state == RESTARTING:
@@ -80,10 +85,10 @@ class Shutdown:
         """The stop ladder for every process not held, and for groups left by their leader."""
         for process in self.processes:
             if process.running and process not in self._held:
-                self.ladder.stop(process)
+                self.ladder.stop(process, sigint=self.send_sigint)
         for process in self.lingering:
             if process.check_group() and not process.stopping:
-                self.ladder.stop(process)
+                self.ladder.stop(process, sigint=self.send_sigint)
 
     def hold(self, process: Process) -> None:
         """Keep ``process`` out of the stop ladder until ``release`` (or a second Ctrl-C).
@@ -98,7 +103,7 @@ class Shutdown:
         """Hand a held process to the stop ladder (now, if the launch is shutting down)."""
         self._held.discard(process)
         if self.active and process.running:
-            self.ladder.stop(process)
+            self.ladder.stop(process, sigint=self.send_sigint)
 
     def kill_everything(self) -> None:
         """A second Ctrl-C: SIGKILL every group and every stray at once."""

@@ -251,7 +251,11 @@ class LaunchContext:
         the value it had where it was written, not whatever was set last.
         """
         copy = LaunchContext(
-            environment=self.environment, argv=self.argv, log_dir=self.log_dir, warn=self._warn
+            environment=self.environment,
+            argv=self.argv,
+            noninteractive=self.noninteractive,
+            log_dir=self.log_dir,
+            warn=self._warn,
         )
         copy.initial_environment = self.initial_environment
         # Lists (launch_ros's global parameters, extended in place as in launch) are copied too.

@@ -208,12 +208,7 @@ class RemoteProcess(Process):
         clock: Callable[[], float] = time.monotonic,
         rusage: object | None = None,
     ) -> None:
-        super().reaped(status, clock, rusage)
-        if self.popen is not None and self.popen.stdin is not None:
-            try:
-                self.popen.stdin.close()
-            except OSError:
-                pass
+        super().reaped(status, clock, rusage)  # which closes the control pipe (its stdin)
         self._apply_status()
         self.connection.release()
 

@@ -129,7 +129,8 @@ class Exited(Event):
 
 
 class Escalated(Event):
-    """A step of the stop ladder: ``signal`` sent, as ``previous`` went unheeded ``waited`` s."""
+    """A step of the stop ladder: ``signal`` sent, as ``previous`` went unheeded ``waited`` s
+    (``previous`` 0: none was sent, the shutdown began ``waited`` s ago)."""
 
     __slots__ = ("previous", "process", "signal", "waited")
 

@@ -314,12 +314,25 @@ class RemoveHandler(Step):
 
 
 class RequestShutdown(Step):
-    __slots__ = ("reason",)
-    _fields = (*Step._fields, "reason")
+    """Shut the run down. ``due_to_sigint``: the Shutdown event said so (OnShutdown handlers
+    see it); ``send_sigint``: whether the stop ladder starts with SIGINT. launch leaves SIGINT
+    out for a Shutdown due to SIGINT in an interactive launch (the terminal is taken to have
+    sent it to the process group): SIGTERM then comes after ``sigterm_timeout``."""
 
-    def __init__(self, origin: str = "", reason: str = "reason not given") -> None:
+    __slots__ = ("due_to_sigint", "reason", "send_sigint")
+    _fields = (*Step._fields, "reason", "due_to_sigint", "send_sigint")
+
+    def __init__(
+        self,
+        origin: str = "",
+        reason: str = "reason not given",
+        due_to_sigint: bool = False,
+        send_sigint: bool = True,
+    ) -> None:
         self.origin = origin
         self.reason = reason
+        self.due_to_sigint = due_to_sigint
+        self.send_sigint = send_sigint
 
 
 class EmitEvent(Step):

@@ -343,6 +343,7 @@ def resolve(
     log_dir: str = "",
     options: ResolveOptions | None = None,
     labels: LabelCounter | None = None,
+    noninteractive: bool = False,
 ) -> Plan:
     """Resolve a whole launch description, as the top-level include of the command line."""
     options = options or ResolveOptions()
@@ -350,6 +351,7 @@ def resolve(
     context = LaunchContext(
         environment=environ,
         argv=tuple(f"{k}:={v}" for k, v in arguments.items()),
+        noninteractive=noninteractive,
         log_dir=log_dir,
         warn=plan.warnings.append,
     )

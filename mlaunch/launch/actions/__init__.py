@@ -215,7 +215,13 @@ def emit_event_entities(context: LaunchContext, event: Any, origin: str) -> list
 
     step: RequestShutdown | EmitEventStep | None = None
     if isinstance(event, ShutdownEvent):
-        step = RequestShutdown(origin=origin, reason=event.reason)
+        sigint = bool(event.due_to_sigint)
+        step = RequestShutdown(
+            origin=origin,
+            reason=event.reason,
+            due_to_sigint=sigint,
+            send_sigint=not sigint or context.noninteractive,
+        )
     elif not isinstance(event, IncludeLaunchDescription):
         step = EmitEventStep(origin=origin, event=event)
     context.planner.emit(event, step)
