@@ -89,27 +89,30 @@ class ExecuteProcess(Action):
         super().__init__(**kwargs)
         if isinstance(cmd, (str, Substitution)):
             cmd = [cmd]
-        # As written; the properties of the same names give the final values once prepared.
-        self._cmd = [normalize(item) for item in cmd]
-        self.prefix = None if prefix is None else normalize(prefix)
-        self._name = None if name is None else normalize(name)
-        self._cwd = None if cwd is None else normalize(cwd)
-        self._env = env
-        self.additional_env = additional_env
+        # As written, normalized as upstream's (substitution lists, (key, value) pairs of
+        # them); the properties of the same names give the final values once prepared.
+        self._cmd = [_subs(item) for item in cmd]
+        self.prefix = None if prefix is None else _subs(prefix)
+        self._name = None if name is None else _subs(name)
+        self._cwd = None if cwd is None else _subs(cwd)
+        self._env = _pairs(env)
+        self.additional_env = _pairs(additional_env)
         self.shell = shell
         # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s.
-        self.sigterm_timeout = (
+        self.sigterm_timeout = _subs(
             LaunchConfiguration("sigterm_timeout", default=5)
             if sigterm_timeout is None
             else sigterm_timeout
         )
-        self.sigkill_timeout = (
+        self.sigkill_timeout = _subs(
             LaunchConfiguration("sigkill_timeout", default=5)
             if sigkill_timeout is None
             else sigkill_timeout
         )
         self.emulate_tty = emulate_tty
-        self.output = output
+        # A dict of streams to destinations stays a dict, as upstream's.
+        self.output = output if isinstance(output, dict) else _subs(output)
+        self._process_description: Any = None
         self.log_cmd = log_cmd
         # Kept for launch_pytest.tools, which reads output only of processes that cache it.
         self.cached_output = cached_output
@@ -122,6 +125,27 @@ class ExecuteProcess(Action):
         self.required = required
         # mlaunch's: the name of a declared Machine to run on (mlaunch.machines).
         self.machine = None if machine is None else normalize(machine)
+
+    @property
+    def process_description(self) -> Any:
+        """The process as upstream's ``Executable`` describes it (cmd, prefix, name, cwd, env),
+        made when first asked (the first child's path does not import it)."""
+        if self._process_description is None:
+            from mlaunch.launch.descriptions.executable import Executable
+
+            self._process_description = Executable(
+                cmd=self._cmd,
+                prefix=self.prefix,
+                name=self._name,
+                cwd=self._cwd,
+                env=_mapping(self._env),
+                additional_env=_mapping(self.additional_env),
+            )
+        return self._process_description
+
+    @process_description.setter
+    def process_description(self, description: Any) -> None:
+        self._process_description = description
 
     # Upstream's getters: the final value once executed (or prepared), else as written.
 
@@ -284,9 +308,9 @@ class ExecuteProcess(Action):
     def _output(self, ctx: LaunchContext) -> str:
         override = ctx.environment.get("OVERRIDE_LAUNCH_PROCESS_OUTPUT")
         value = self.output
-        if isinstance(value, dict):
-            value = _output_from_dict(value)
-        text = override or perform(ctx, value)
+        text = override or (
+            _output_from_dict(value) if isinstance(value, dict) else perform(ctx, value)
+        )
         if text not in OUTPUT_MODES:
             raise MlaunchError(
                 f"output is {text!r}; valid: {', '.join(OUTPUT_MODES)}", where=self.origin
@@ -366,6 +390,27 @@ def _items(mapping: Any) -> list[tuple[Any, Any]]:
     if isinstance(mapping, dict):
         return list(mapping.items())
     return list(mapping)
+
+
+def _subs(value: Any) -> list[Substitution]:
+    """``value`` as upstream's normalized list of substitutions; a number (mlaunch reads YAML
+    numbers where launch wants text) as its text."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        value = str(value)
+    return list(normalize(value))
+
+
+def _mapping(pairs: list[tuple[list[Any], list[Any]]] | None) -> dict[Any, Any] | None:
+    """Normalized pairs back as the mapping an ``Executable`` takes (keys made hashable)."""
+    return None if pairs is None else {tuple(key): value for key, value in pairs}
+
+
+def _pairs(mapping: Any) -> list[tuple[list[Substitution], list[Substitution]]] | None:
+    """An environment mapping (or pairs) as upstream's list of (name, value) substitution
+    lists; None stays None."""
+    if mapping is None:
+        return None
+    return [(_subs(key), _subs(value)) for key, value in _items(mapping)]
 
 
 def _truthy(ctx: LaunchContext, value: Any) -> bool:
