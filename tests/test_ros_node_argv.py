@@ -733,10 +733,18 @@ def test_parameter_file_with_substitutions_is_written_substituted(
     assert given == str(source)
 
 
-def test_global_params_file_must_exist(prefix: Path, temp_dir: str) -> None:
+def test_a_missing_global_params_file_fails_the_node_naming_where_it_was_given(
+    prefix: Path, temp_dir: str
+) -> None:
     action = SetParametersFromFile("/no/such/params.yaml")
-    with pytest.raises(LaunchFileError, match="parameters file '/no/such/params.yaml' does not"):
-        run([action], prefix, temp_dir)
+    assert not run([action], prefix, temp_dir).processes()  # as ros2 launch: no node, no error
+    node = Node(package="demo", executable="talker")
+    with pytest.raises(
+        SubstitutionFailure,
+        match=r"file '/no/such/params.yaml' does not exist \(given by SetParametersFromFile at"
+        r" .*test_ros_node_argv.py:\d+\)",
+    ):
+        run([action, node], prefix, temp_dir)
 
 
 def test_without_a_run_directory_params_files_go_to_a_private_one(prefix: Path) -> None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.fields import Value, as_key, required_text
-from mlaunch.launch.substitutions import Substitution, to_bool
+from mlaunch.launch.substitutions import Substitution, TextSubstitution, to_bool
 from mlaunch.plan.errors import MlaunchError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -101,6 +101,11 @@ def parameter_value(p: Entity, *, typed: bool) -> Any:
     # A node param's YAML string (quoted, or text YAML reads as text) stays text in launch_ros;
     # set_parameter's value is read as a substitution and typed as YAML.
     keep_text = typed and not isinstance(attr.value, str)
+    if not typed and sep is None and _is_text(attr.value):
+        # launch_ros keeps it as a substitution: SetParameter.value is that, and YAML types the
+        # performed text when the action runs.
+        text = p.template(attr, p.scalar_text(attr, "value"))
+        return [TextSubstitution(text=text)] if isinstance(text, str) else text
     value = _typed_value(p, attr, element, is_list, sep, keep_text=keep_text)
     if not typed:
         return value
@@ -138,6 +143,13 @@ def _typed_value(
     if keep_text and element is None:
         return text
     return _coerce(p, attr, text, element, is_list)
+
+
+def _is_text(node: Any) -> bool:
+    """An XML attribute, or a YAML scalar written as a string."""
+    return isinstance(node, str) or (
+        type(node).__name__ == "ScalarNode" and node.tag == "tag:yaml.org,2002:str"
+    )
 
 
 def _yaml_item(p: Entity, attr: Attr, item: Any, element: type | None) -> Any:

@@ -9,10 +9,10 @@ in ``mlaunch.launch_ros.load_request``; the actions that load it are in
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 
 from mlaunch.launch.substitutions import normalize
-from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.errors import LaunchFileTypeError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -68,12 +68,16 @@ def remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
     """``[(from, to), ...]`` or a dict, each side normalized to substitutions (Node's too)."""
     if remappings is None:
         return []
-    items = list(remappings.items()) if isinstance(remappings, Mapping) else list(remappings)
+    if isinstance(remappings, (str, Mapping)) or not isinstance(remappings, Iterable):
+        raise LaunchFileTypeError(
+            f"remappings must be a list of (from, to) tuples, got {type(remappings).__name__}:"
+            f" {remappings!r:.80} (write remappings=[('from', 'to'), ...])"
+        )
     rules = []
-    for item in items:
-        if not isinstance(item, (tuple, list)) or len(item) != 2:
-            raise LaunchFileError(
-                f"a remapping must be a (from, to) pair, got {item!r:.80}"
+    for item in remappings:
+        if not isinstance(item, tuple) or len(item) != 2:
+            raise LaunchFileTypeError(
+                f"a remapping must be a (from, to) pair, a tuple, got {item!r:.80}"
                 " (write remappings=[('from', 'to'), ...])"
             )
         rules.append((normalize(item[0]), normalize(item[1])))

@@ -21,8 +21,10 @@ from collections.abc import Iterable
 from mlaunch import standins
 from mlaunch.launch.execute_process import ExecuteProcess
 from mlaunch.launch.substitutions import (
+    LocalSubstitution,
     SomeSubstitutionsType,
     Substitution,
+    TextSubstitution,
     describe,
     normalize,
     perform_substitutions,
@@ -122,6 +124,59 @@ class NodeCommand(Record):
         self.temp_files = temp_files  # params files to remove with the process
 
 
+class RosPart(Record):
+    """The command line of a node after its name and namespace, as launch_ros's
+    ``_perform_substitutions`` works it out: the scope's params arguments (SetParameter,
+    SetParametersFromFile), the node's own, then the remapping rules."""
+
+    _fields = ("scope", "own", "remaps", "temp_files")
+    __slots__ = _fields
+
+    def __init__(
+        self,
+        scope: list[str],
+        own: list[str],
+        remaps: list[tuple[str, str]],
+        temp_files: tuple[str, ...],
+    ) -> None:
+        self.scope = scope  # ["-p", "name:=value", "--params-file", path, ...]
+        self.own = own
+        self.remaps = remaps
+        self.temp_files = temp_files  # params files to remove with the process
+
+    @property
+    def argv(self) -> list[str]:
+        rules = [item for src, dst in self.remaps for item in ("-r", f"{src}:={dst}")]
+        return [*self.scope, *self.own, *rules]
+
+
+# launch_ros's local substitutions for the name and namespace arguments in a Node's ``cmd``.
+_NAME_ARGUMENT = "ros_specific_arguments['name']"
+_NAMESPACE_ARGUMENT = "ros_specific_arguments['ns']"
+# The context globals' table of where each SetParametersFromFile file was given.
+PARAMS_FILE_ORIGINS_KEY = "mlaunch_params_file_origins"
+
+
+def note_params_file_origin(context: Any, filename: str, origin: str | None) -> None:
+    """Remember where a SetParametersFromFile gave ``filename``: a node that cannot find the
+    file names that line (the file is looked for when a node uses it, as in launch_ros)."""
+    if not origin or not hasattr(context, "extend_globals"):
+        return  # a stand-in context of a unit test
+    origins: dict[str, str] | None = context.locals.get(PARAMS_FILE_ORIGINS_KEY)
+    if origins is None:
+        origins = {}
+        context.extend_globals({PARAMS_FILE_ORIGINS_KEY: origins})
+    origins.setdefault(filename, origin)
+
+
+def params_file_origin(context: Any, filename: str) -> str:
+    """`` (given by SetParametersFromFile at FILE:LINE)``, or nothing when unknown."""
+    locals_ = getattr(context, "locals", None)
+    origins = None if locals_ is None else locals_.get(PARAMS_FILE_ORIGINS_KEY)
+    origin = None if origins is None else origins.get(filename)
+    return f" (given by SetParametersFromFile at {origin})" if origin else ""
+
+
 class Node(ExecuteProcess):
     """A ROS node: an executable of a package (or a path) with launch_ros's command line."""
 
@@ -158,6 +213,18 @@ class Node(ExecuteProcess):
         # launch_ros's node_name and friends: the names of the last resolution (for launch-file
         # code that reads them after the node was visited; resolving itself never reads them).
         self.resolved_names: NodeNames | None = None
+        # ``cmd`` as launch_ros holds it: before a resolution, up to the node's name argument.
+        self.cmd += self.arguments
+        if self.ros_arguments is not None:
+            self.cmd += [normalize("--ros-args"), *self.ros_arguments]
+        self.cmd.append(normalize("--ros-args"))
+        if self._node_name is not None:
+            self.cmd += [normalize("-r"), (LocalSubstitution(_NAME_ARGUMENT),)]
+        self._given_cmd = list(self.cmd)
+        # launch_ros's record of the last resolution's params arguments ((value, is a file)) and
+        # remapping rules (None: none); its unit tests read the first by its private name.
+        self.__expanded_parameter_arguments: list[tuple[str, bool]] | None = None
+        self.__expanded_remappings: list[tuple[str, str]] | None = None
 
     # --- what launch_ros exposes ------------------------------------------------------------
 
@@ -189,10 +256,39 @@ class Node(ExecuteProcess):
             return self.UNSPECIFIED_NODE_NAMESPACE
         return names.namespace
 
+    @property
+    def expanded_remapping_rules(self) -> list[tuple[str, str]] | None:
+        """The remapping rules of the last resolution, SetRemap's first (None: there were none)."""
+        return self.__expanded_remappings
+
     def _perform_substitutions(self, context: LaunchContext) -> None:
-        """launch_ros's step that resolves the name and the namespace, which its unit tests call
-        on their own: ``node_name`` and ``expanded_node_namespace`` give them afterwards."""
-        self.resolved_names = self._names(context)
+        """launch_ros's step that works out the names, the params arguments (writing the params
+        files) and the remappings, without finding the executable; its unit tests call it on its
+        own, then read ``node_name``, ``expanded_remapping_rules`` and ``cmd``."""
+        names = self._names(context)
+        self._record(names, self._ros_part(context, names))
+
+    def _ros_part(self, context: LaunchContext, names: NodeNames) -> RosPart:
+        """The command line after the name and namespace: parameters, then remappings."""
+        scope = self._global_parameter_arguments(context)
+        own, temp_files = self._parameter_arguments(context, names)
+        remaps = self._remap_arguments(context)
+        return RosPart(scope, own, remaps, temp_files)
+
+    def _record(self, names: NodeNames, part: RosPart) -> None:
+        """Keep what launch_ros exposes of a resolution: names, params arguments, remappings,
+        and ``cmd`` as launch_ros holds it (the name and namespace as its local substitutions)."""
+        self.resolved_names = names
+        self.__expanded_parameter_arguments = [
+            *((value, True) for flag, value in _pairs(part.scope) if flag == "--params-file"),
+            *((value, flag == "--params-file") for flag, value in _pairs(part.own)),
+        ]
+        self.__expanded_remappings = list(part.remaps) if part.remaps else None
+        cmd = list(self._given_cmd)
+        if names.namespace is not None:
+            cmd += [normalize("-r"), (LocalSubstitution(_NAMESPACE_ARGUMENT),)]
+        cmd += [(TextSubstitution(text=item),) for item in part.argv]
+        self.cmd = cmd
 
     # --- resolving ------------------------------------------------------------------------------
 
@@ -212,12 +308,10 @@ class Node(ExecuteProcess):
             argv += ["-r", f"__node:={names.name}"]
         if names.namespace is not None:
             argv += ["-r", f"__ns:={names.namespace}"]
-        argv += self._global_parameter_arguments(context)
-        own, temp_files = self._parameter_arguments(context, names)
-        argv += own
-        for src, dst in self._remap_arguments(context):
-            argv += ["-r", f"{src}:={dst}"]
-        return NodeCommand(names, package, executable, exe_argv, standin, argv, temp_files)
+        part = self._ros_part(context, names)
+        argv += part.argv
+        self._record(names, part)
+        return NodeCommand(names, package, executable, exe_argv, standin, argv, part.temp_files)
 
     def command(self, context: LaunchContext) -> list[str]:
         return self.node_command(context).argv
@@ -244,7 +338,6 @@ class Node(ExecuteProcess):
             machine=machine,
         )
         self._track_name(context, found.names)
-        self.resolved_names = found.names
         return spec
 
     # --- pieces -------------------------------------------------------------------------------
@@ -306,7 +399,10 @@ class Node(ExecuteProcess):
                 continue
             path = os.path.abspath(str(entry))
             if not os.path.isfile(path):
-                raise SubstitutionFailure(f"global parameters file {path!r} does not exist")
+                raise SubstitutionFailure(
+                    f"global parameters file {path!r} does not exist"
+                    f"{params_file_origin(ctx, str(entry))}"
+                )
             out += ["--params-file", path]
         return out
 
@@ -314,19 +410,25 @@ class Node(ExecuteProcess):
         self, context: LaunchContext, names: NodeNames
     ) -> tuple[list[str], tuple[str, ...]]:
         """The node's own params arguments and the temporary files to remove (if mlaunch must)."""
-        planner = context.planner
+        # A stand-in context of a unit test (launch_configurations only) has no planner.
+        planner = getattr(context, "planner", None)
         if not self.parameters:
             return [], ()
-        temp_dir = planner.options.temp_dir
+        temp_dir = None if planner is None else planner.options.temp_dir
         private = None
-        if temp_dir is None and _writes_files(self.parameters):
+        if planner is not None and temp_dir is None and _writes_files(self.parameters):
             # No run directory to write into: a private one, removed with the process's files.
             import tempfile
 
             temp_dir = private = tempfile.mkdtemp(prefix="mlaunch-params-")
 
         def warn(message: str) -> None:
-            planner.warn(f"{self.origin}: {message}")
+            if planner is not None:
+                planner.warn(f"{self.origin}: {message}")
+            else:
+                from mlaunch.launch.logging import get_logger
+
+                get_logger("launch_ros").warning(f"{self.origin}: {message}")
 
         arguments = params.parameter_arguments(
             context,
@@ -433,6 +535,11 @@ def _not_installed(
         f" built): its executable {executable!r} exists once it is built and installed (colcon"
         f" build, then source install/setup.bash){hint}"
     )
+
+
+def _pairs(argv: list[str]) -> list[tuple[str, str]]:
+    """``[flag, value, flag, value, ...]`` as pairs."""
+    return list(zip(argv[::2], argv[1::2], strict=True))
 
 
 def _items(values: Any, what: str) -> list[Subs]:

@@ -25,7 +25,12 @@ from mlaunch.launch.substitutions import (
     normalize,
     perform_substitutions,
 )
-from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.plan.errors import (
+    LaunchFileError,
+    LaunchFileTypeError,
+    SubstitutionFailure,
+    SubstitutionValueError,
+)
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -92,6 +97,15 @@ def _valid_plain(value: Any) -> bool:
     return isinstance(value, SCALAR_TYPES)
 
 
+def _valid_loaded(value: Any) -> bool:
+    """A YAML result a parameter may hold: a scalar, or a list of one type (text too, but not
+    mixed with other types, unlike a plain list; launch's check with ``can_be_str=False``)."""
+    if isinstance(value, list):
+        first = next((type(v) for v in value if type(v) is not str), str)
+        return first in SCALAR_TYPES and all(isinstance(v, first) for v in value)
+    return isinstance(value, SCALAR_TYPES)
+
+
 def normalize_typed(value: Any, value_type: Any) -> Any:
     """A plain value checked against ``value_type``, or substitutions kept for later.
 
@@ -103,18 +117,18 @@ def normalize_typed(value: Any, value_type: Any) -> Any:
         value = str(value)
     if isinstance(value, SCALAR_TYPES):
         if not _is_instance(value, scalar, is_list):
-            raise LaunchFileError(f"value {value!r} is not of type {type_name(value_type)}")
+            raise LaunchFileTypeError(f"value {value!r} is not of type {type_name(value_type)}")
         return value
     if is_substitution(value):
         return normalize(value)
     if not isinstance(value, Iterable) or isinstance(value, (bytes, dict)):
-        raise LaunchFileError(
+        raise LaunchFileTypeError(
             f"a parameter value must be a scalar, a substitution or a list of them, got"
             f" {type(value).__name__}: {value!r}"
         )
     items = list(value)
     if value_type is not None and not is_list:
-        raise LaunchFileError(
+        raise LaunchFileTypeError(
             f"value {items!r} is a list, but value_type {type_name(value_type)} is not"
         )
     kinds: set[type] = set()
@@ -127,7 +141,7 @@ def normalize_typed(value: Any, value_type: Any) -> Any:
             kinds.add(Substitution)
             out.append(normalize(item))
         else:
-            raise LaunchFileError(
+            raise LaunchFileTypeError(
                 f"list parameter item {item!r} is not a scalar or a substitution (in {items!r})"
             )
     _check_list_kinds(kinds, scalar, items)
@@ -147,7 +161,7 @@ def _check_list_kinds(kinds: set[type], scalar: type | None, items: list[Any]) -
             break
     names = ", ".join(sorted(k.__name__ for k in plain))
     want = f"List[{scalar.__name__}]" if scalar else "one type"
-    raise LaunchFileError(f"list parameter {items!r} holds {names}; expected {want}")
+    raise LaunchFileTypeError(f"list parameter {items!r} holds {names}; expected {want}")
 
 
 def perform_typed(context: LaunchContext, value: Any, value_type: Any) -> Any:
@@ -171,8 +185,8 @@ def coerce(text: str, value_type: Any) -> Any:
         if not text:
             return text  # launch forwards empty text as is: YAML would read it as null
         loaded = _yaml(text, "a parameter value")
-        if not _valid_plain(loaded) and loaded != []:
-            raise SubstitutionFailure(
+        if not _valid_loaded(loaded):
+            raise SubstitutionValueError(
                 f"value {text!r} read as YAML gives {type(loaded).__name__}, not a parameter"
                 " type (a scalar or a uniform list); to keep it as text use"
                 " ParameterValue(value, value_type=str)"
@@ -184,7 +198,7 @@ def coerce(text: str, value_type: Any) -> Any:
             # ints are floats here too (launch_ros refuses '[1, 2]' as List[float])
             loaded = [float(v) if type(v) is int else v for v in loaded]
         if not isinstance(loaded, list) or not all(_is_scalar(v, scalar) for v in loaded):
-            raise SubstitutionFailure(f"value {text!r} is not a List[{scalar.__name__}]")
+            raise SubstitutionValueError(f"value {text!r} is not a List[{scalar.__name__}]")
         return loaded
     if scalar is str:
         return text
@@ -192,10 +206,10 @@ def coerce(text: str, value_type: Any) -> Any:
         try:
             return scalar(text)
         except ValueError:
-            raise SubstitutionFailure(f"value {text!r} is not {scalar.__name__}")
+            raise SubstitutionValueError(f"value {text!r} is not {scalar.__name__}")
     loaded = _yaml(text, "a bool")
     if not isinstance(loaded, bool):
-        raise SubstitutionFailure(f"value {text!r} is not a bool (true/false)")
+        raise SubstitutionValueError(f"value {text!r} is not a bool (true/false)")
     return loaded
 
 
@@ -210,7 +224,16 @@ def _yaml(text: str, what: str) -> Any:
         return yaml.safe_load(text)
     except yaml.YAMLError as e:
         problem = str(e).splitlines()[0] if str(e) else type(e).__name__
-        raise SubstitutionFailure(f"value {text[:200]!r} cannot be read as {what}: {problem}")
+        raise SubstitutionValueError(f"value {text[:200]!r} cannot be read as {what}: {problem}")
+
+
+def as_given(value: Any) -> Any:
+    """A value from ``normalize_typed`` in launch's shapes: substitutions as lists."""
+    if isinstance(value, tuple):
+        return list(value)
+    if isinstance(value, list):
+        return [list(v) if isinstance(v, tuple) else v for v in value]
+    return value
 
 
 def describe_value(value: Any) -> str:
@@ -234,7 +257,8 @@ class ParameterValue:
 
     @property
     def value(self) -> Any:
-        return self._evaluated if self._evaluated is not None else self._value
+        """The value once evaluated; before, as given (substitutions as lists, as in launch)."""
+        return self._evaluated if self._evaluated is not None else as_given(self._value)
 
     def evaluate(self, context: LaunchContext) -> Any:
         self._evaluated = perform_typed(context, self._value, self.value_type)
@@ -319,6 +343,17 @@ class ParameterFile:
             path = Path(substituted_copy(context, path, temp_dir))
         self._evaluated = path
         return path
+
+    def cleanup(self) -> None:
+        """Remove the substituted copy ``evaluate`` wrote, if any; ``param_file`` is then the
+        file as given again. A file of a run is removed with its node's process instead."""
+        if self.created and self._evaluated is not None:
+            try:
+                os.unlink(self._evaluated)
+            except FileNotFoundError:
+                pass
+            self._evaluated = None
+            self.created = False
 
     def __str__(self) -> str:
         return (

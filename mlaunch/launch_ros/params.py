@@ -126,7 +126,7 @@ def normalize_dict(params: Mapping[Any, Any], prefix: Subs | None = None) -> Nor
     """Names become substitution tuples (nested dicts joined with '.'), values normalized."""
     out: NormalizedDict = {}
     for raw_name, value in params.items():
-        name = normalize(raw_name)
+        name = parameter_name(raw_name)
         if prefix:
             name = (*prefix, TextSubstitution(text="."), *name)
         if isinstance(value, Mapping):
@@ -134,6 +134,18 @@ def normalize_dict(params: Mapping[Any, Any], prefix: Subs | None = None) -> Nor
         else:
             out[name] = normalize_value(value, name)
     return out
+
+
+def parameter_name(name: Any) -> Subs:
+    """A parameter name as substitutions: text, a substitution, or a sequence of them."""
+    if isinstance(name, (str, Substitution)) or (
+        isinstance(name, (list, tuple)) and all(isinstance(n, (str, Substitution)) for n in name)
+    ):
+        return normalize(name)
+    raise LaunchFileTypeError(
+        f"a parameter name must be text, a substitution or a list of them, got"
+        f" {type(name).__name__}: {name!r:.80}"
+    )
 
 
 def normalize_value(value: Any, name: Subs = ()) -> NormalizedValue:
@@ -164,7 +176,9 @@ def _normalize_list(value: Sequence[Any], name: Subs) -> NormalizedValue:
     if kinds == {bool}:
         return Plain(tuple(bool(v) for v in value))
     # Each item on its own (text, numbers, lists of substitutions): read each with YAML later.
-    return Items(tuple(normalize(v) if _kind(v, name) is tuple else v for v in value))
+    return Items(
+        tuple(v if isinstance(v, (str, bool, int, float)) else normalize(v) for v in value)
+    )
 
 
 def _kind(item: Any, name: Subs) -> type:

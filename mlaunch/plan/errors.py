@@ -135,6 +135,11 @@ class SubstitutionFailure(MlaunchError):
     """A substitution cannot be performed (unset configuration, failing command, ...)."""
 
 
+class SubstitutionValueError(SubstitutionFailure, ValueError):
+    """A performed value cannot be read as the type it must have (a ValueError too, as launch's
+    type coercion raises)."""
+
+
 class InvalidConditionExpressionError(SubstitutionFailure, ValueError):
     """An if/unless expression is not one of true, false, 1, 0 (a ValueError, as launch's)."""
 

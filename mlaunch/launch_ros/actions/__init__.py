@@ -19,7 +19,13 @@ from mlaunch.launch.substitutions import (
 )
 from mlaunch.launch_ros import params
 from mlaunch.launch_ros import xacro as _xacro
-from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
+from mlaunch.launch_ros.node import (
+    LifecycleNode,
+    Node,
+    NodeCommand,
+    NodeNames,
+    note_params_file_origin,
+)
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
 from mlaunch.launch_ros.scope import (
     add_global_params,
@@ -29,7 +35,7 @@ from mlaunch.launch_ros.scope import (
     node_name_problem,
     prefix_namespace,
 )
-from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
+from mlaunch.plan.errors import SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -89,6 +95,24 @@ class SetParameter(Action):
     def __init__(self, name: SomeSubstitutionsType, value: Any, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.param_dict = params.normalize_dict({normalize(name): value})
+        self._given = (name, value)
+
+    @property
+    def name(self) -> Any:
+        """launch_ros's: the parameter's name, normalized (a tuple of substitutions)."""
+        return next(iter(self._public_dict()))
+
+    @property
+    def value(self) -> Any:
+        """launch_ros's: the value in launch_ros's normalized shape (see
+        launch_ros.utilities.normalize_parameters)."""
+        return next(iter(self._public_dict().values()))
+
+    def _public_dict(self) -> dict[Any, Any]:
+        from mlaunch.launch_ros.utilities.normalize_parameters import normalize_parameter_dict
+
+        name, value = self._given
+        return normalize_parameter_dict({normalize(name): value})
 
     def execute(self, context: LaunchContext) -> None:
         entries = tuple(params.evaluate_dict(context, self.param_dict).items())
@@ -107,11 +131,11 @@ class SetParametersFromFile(Action):
         self.filename = normalize(filename)
 
     def execute(self, context: LaunchContext) -> None:
-        path = os.path.abspath(perform_substitutions(context, self.filename))
-        if not os.path.isfile(path):
-            # launch_ros asserts when a node uses it; failing here names the right line.
-            raise LaunchFileError(f"parameters file {path!r} does not exist", where=self.origin)
-        add_global_params(context, self, (path,))
+        # As given, as launch_ros keeps it: a node after it looks the file up (relative to the
+        # working directory) and, when it is missing, names this line.
+        filename = perform_substitutions(context, self.filename)
+        note_params_file_origin(context, filename, self.origin)
+        add_global_params(context, self, (filename,))
 
     def describe_short(self) -> str:
         return f"SetParametersFromFile({describe(self.filename)})"
