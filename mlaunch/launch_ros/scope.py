@@ -133,6 +133,30 @@ def _extend_shared(
         configs[key] = [*(current or ()), *entries]
 
 
+# The context globals' table of where each SetParametersFromFile file was given.
+PARAMS_FILE_ORIGINS_KEY = "mlaunch_params_file_origins"
+
+
+def note_params_file_origin(context: Any, filename: str, origin: str | None) -> None:
+    """Remember where a SetParametersFromFile gave ``filename``: a node that cannot find the
+    file names that line (the file is looked for when a node uses it, as in launch_ros)."""
+    if not origin or not hasattr(context, "extend_globals"):
+        return  # a stand-in context of a unit test
+    origins: dict[str, str] | None = context.locals.get(PARAMS_FILE_ORIGINS_KEY)
+    if origins is None:
+        origins = {}
+        context.extend_globals({PARAMS_FILE_ORIGINS_KEY: origins})
+    origins.setdefault(filename, origin)
+
+
+def params_file_origin(context: Any, filename: str) -> str:
+    """`` (given by SetParametersFromFile at FILE:LINE)``, or nothing when unknown."""
+    locals_ = getattr(context, "locals", None)
+    origins = None if locals_ is None else locals_.get(PARAMS_FILE_ORIGINS_KEY)
+    origin = None if origins is None else origins.get(filename)
+    return f" (given by SetParametersFromFile at {origin})" if origin else ""
+
+
 def ros_remaps(context: LaunchContext) -> tuple[tuple[str, str], ...]:
     return tuple(context.launch_configurations.get("ros_remaps") or ())
 
@@ -144,6 +168,8 @@ __all__ = [
     "make_namespace_absolute",
     "namespace_problem",
     "node_name_problem",
+    "note_params_file_origin",
+    "params_file_origin",
     "prefix_namespace",
     "ros_remaps",
 ]

@@ -19,13 +19,7 @@ from mlaunch.launch.substitutions import (
 )
 from mlaunch.launch_ros import params
 from mlaunch.launch_ros import xacro as _xacro
-from mlaunch.launch_ros.node import (
-    LifecycleNode,
-    Node,
-    NodeCommand,
-    NodeNames,
-    note_params_file_origin,
-)
+from mlaunch.launch_ros.node import LifecycleNode, Node, NodeCommand, NodeNames
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
 from mlaunch.launch_ros.scope import (
     add_global_params,
@@ -33,6 +27,7 @@ from mlaunch.launch_ros.scope import (
     make_namespace_absolute,
     namespace_problem,
     node_name_problem,
+    note_params_file_origin,
     prefix_namespace,
 )
 from mlaunch.plan.errors import SubstitutionFailure
