@@ -9,8 +9,8 @@ A Node resolves to the command line launch_ros gives it, in launch_ros's order::
         (-r <from>:=<to>)...                                SetRemap globals, then remappings
 
 Resolving builds a NodeCommand and hands what the process needs to ExecuteProcess.process_spec;
-nothing of a resolution is kept on the action except the names launch_ros exposes
-(``node_name``).
+nothing of a resolution is kept on the action except what launch_ros exposes of the last one
+(``node_name``, ``expanded_remapping_rules``, ``cmd``), which resolving never reads back.
 """
 
 from __future__ import annotations
