@@ -399,7 +399,7 @@ def test_robot_description_text_stays_a_string(prefix: Path, temp_dir: str) -> N
         ([], {}, r"parameter 'bad' is the list \[\] of nothing"),
         (LaunchConfiguration("m"), {"m": "{a: 1}"}, r"YAML reads as dict.*value_type=str"),
         (LaunchConfiguration("m"), {"m": "[1, a]"}, r"parameter 'bad' is the list \[1, 'a'\]"),
-        (LaunchConfiguration("m"), {"m": "a: b: c"}, r"cannot read 'a: b: c' as YAML"),
+        (LaunchConfiguration("m"), {"m": "a: b: c"}, r"Unable to parse 'a: b: c' as YAML"),
         (LaunchConfiguration("m"), {"m": "null"}, r"YAML reads as NoneType"),
     ],
 )

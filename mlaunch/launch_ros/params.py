@@ -41,7 +41,7 @@ from mlaunch.launch_ros.parameter_descriptions import (
     ParameterValue,
     is_substitution,
 )
-from mlaunch.plan.errors import LaunchFileTypeError, SubstitutionFailure
+from mlaunch.plan.errors import LaunchFileTypeError, SubstitutionFailure, SubstitutionTypeError
 from mlaunch.plan.record import Record
 from mlaunch.ros.files import write_temp
 
@@ -99,8 +99,11 @@ if TYPE_CHECKING:
     NormalizedEntry: TypeAlias = NormalizedDict | ParameterFile | Parameter
 
 
-def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
-    """``Node(parameters=...)`` checked and normalized when the Node is built."""
+def normalize_parameters(
+    parameters: Any, dict_normalizer: Callable[[Mapping[Any, Any]], Any] | None = None
+) -> tuple[NormalizedEntry, ...]:
+    """``Node(parameters=...)`` checked and normalized when the Node is built; dicts by
+    ``dict_normalizer`` if given (launch_ros.utilities gives launch_ros's shapes)."""
     if isinstance(parameters, (str, Mapping)) or not isinstance(parameters, Sequence):
         raise LaunchFileTypeError(
             f"parameters must be a list of dicts, params-file paths and Parameter entries,"
@@ -109,7 +112,7 @@ def normalize_parameters(parameters: Any) -> tuple[NormalizedEntry, ...]:
     out: list[NormalizedEntry] = []
     for entry in parameters:
         if isinstance(entry, Mapping):
-            out.append(normalize_dict(entry))
+            out.append((dict_normalizer or normalize_dict)(entry))
         elif isinstance(entry, (Parameter, ParameterFile)):
             out.append(entry)
         elif isinstance(entry, (str, Path, Substitution)) or is_substitution(entry):
@@ -248,49 +251,51 @@ def evaluate_value(context: LaunchContext, value: NormalizedValue, name: str) ->
     if isinstance(value, ParameterValue):
         return value.evaluate(context)
     if isinstance(value, Text):
-        return _typed_text(perform_substitutions(context, value.subs), name)
+        return typed_text(perform_substitutions(context, value.subs), name)
     items = [
-        _yaml(perform_substitutions(context, v), name) if isinstance(v, tuple) else v
+        read_yaml(perform_substitutions(context, v), name) if isinstance(v, tuple) else v
         for v in value.items
     ]
-    return _uniform(items, name)
+    return uniform(items, name)
 
 
-def _typed_text(text: str, name: str) -> Any:
+def typed_text(text: str, name: str) -> Any:
     """launch_ros's rule for a performed value: YAML, and only a scalar or a uniform list."""
-    loaded = _yaml(text if text else "''", name)
+    loaded = read_yaml(text if text else "''", name)
     if type(loaded) in (bool, int, float, str, bytes):
         return loaded
     if isinstance(loaded, list):
-        return _uniform(loaded, name)
-    raise SubstitutionFailure(
-        f"parameter {name!r} is {text[:120]!r}, which YAML reads as"
-        f" {type(loaded).__name__}: allowed are bool, int, float, str and uniform lists{_HINT}"
+        return uniform(loaded, name)
+    raise SubstitutionTypeError(
+        f"parameter {name!r} is {text[:120]!r}, which YAML reads as {type(loaded).__name__}:"
+        " Allowed value types are bool, int, float, str, bytes and non-empty lists of one of"
+        f" bool, int, float, str{_HINT}"
     )
 
 
-def _yaml(text: str, name: str) -> Any:
+def read_yaml(text: str, name: str) -> Any:
+    """Performed text read with YAML, as launch_ros reads a parameter's substitutions."""
     import yaml
 
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as e:
         first = str(e).splitlines()[0] if str(e) else type(e).__name__
-        raise SubstitutionFailure(
-            f"parameter {name!r}: cannot read {text[:120]!r} as YAML ({first}){_HINT}"
+        raise SubstitutionTypeError(
+            f"parameter {name!r}: Unable to parse {text[:120]!r} as YAML ({first}){_HINT}"
         )
 
 
-def _uniform(items: Sequence[Any], name: str) -> tuple[Any, ...]:
+def uniform(items: Sequence[Any], name: str) -> tuple[Any, ...]:
     """A non-empty list of one type among bool, int, float, str (launch_ros's check)."""
     if items and type(items[0]) in (bool, int, float, str):
         first = type(items[0])
         if all(isinstance(i, first) for i in items):
             return tuple(items)
     kinds = ", ".join(sorted({type(i).__name__ for i in items})) or "nothing"
-    raise SubstitutionFailure(
-        f"parameter {name!r} is the list {list(items)!r:.160} of {kinds}: a list parameter must"
-        " be non-empty and of one type (bool, int, float or str)"
+    raise SubstitutionTypeError(
+        f"parameter {name!r} is the list {list(items)!r:.160} of {kinds}: Expected a non-empty"
+        " sequence of one type (bool, int, float or str)"
     )
 
 

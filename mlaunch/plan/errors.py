@@ -135,6 +135,11 @@ class SubstitutionFailure(MlaunchError):
     """A substitution cannot be performed (unset configuration, failing command, ...)."""
 
 
+class SubstitutionTypeError(SubstitutionFailure, TypeError):
+    """A performed parameter value is of no type a parameter may have (a TypeError too, as
+    launch_ros raises)."""
+
+
 class SubstitutionValueError(SubstitutionFailure, ValueError):
     """A performed value cannot be read as the type it must have (a ValueError too, as launch's
     type coercion raises)."""

@@ -11,7 +11,7 @@ parameters itself (``evaluate_parameters`` takes what it returns). A dict become
 - a tuple of substitution tuples, one per item of a list that mixes kinds (plain items dumped
   as YAML): each performed and read with YAML, and the results must be of one type.
 
-Nested dicts are flattened (``{'a': {'b': 1}}`` -> ``a.b``). Other entries become a
+Nested dicts are flattened (``{'a': {'b': 1}}`` -> ``a.b``). Paths and substitutions become a
 ``ParameterFile``. A bad argument is a TypeError.
 
 A Node does not use these shapes: mlaunch.launch_ros.params normalizes its parameters with the
@@ -25,28 +25,17 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from mlaunch.launch.substitution import Substitution, TextSubstitution, describe, normalize
-from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
+from mlaunch.launch_ros import params
+from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 from mlaunch.launch_ros.params import parameter_name
 
 Subs = tuple[Substitution, ...]
 
 
 def normalize_parameters(parameters: Any) -> tuple[Any, ...]:
-    """Dicts normalized, Parameter and ParameterFile kept, anything else a ParameterFile."""
-    if isinstance(parameters, str) or not isinstance(parameters, Sequence):
-        raise TypeError(
-            f"parameters must be a list of dicts, params files and Parameter entries, got"
-            f" {type(parameters).__name__}: {parameters!r:.120}"
-        )
-    out: list[Any] = []
-    for entry in parameters:
-        if isinstance(entry, Mapping):
-            out.append(normalize_parameter_dict(entry))
-        elif isinstance(entry, (Parameter, ParameterFile)):
-            out.append(entry)
-        else:
-            out.append(ParameterFile(entry))
-    return tuple(out)
+    """Dicts normalized, Parameter and ParameterFile kept, paths and substitutions made a
+    ParameterFile; anything else is a TypeError."""
+    return params.normalize_parameters(parameters, normalize_parameter_dict)
 
 
 def normalize_parameter_dict(parameters: Any, *, _prefix: Subs | None = None) -> dict[Subs, Any]:
