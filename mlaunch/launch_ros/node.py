@@ -193,13 +193,13 @@ class Node(ExecuteProcess):
         # code that reads them after the node was visited; resolving itself never reads them).
         self.resolved_names: NodeNames | None = None
         # ``cmd`` as launch_ros holds it: before a resolution, up to the node's name argument.
-        self.cmd += self.arguments
+        self._cmd += self.arguments
         if self.ros_arguments is not None:
-            self.cmd += [normalize("--ros-args"), *self.ros_arguments]
-        self.cmd.append(normalize("--ros-args"))
+            self._cmd += [normalize("--ros-args"), *self.ros_arguments]
+        self._cmd.append(normalize("--ros-args"))
         if self._node_name is not None:
-            self.cmd += [normalize("-r"), (LocalSubstitution(_NAME_ARGUMENT),)]
-        self._given_cmd = list(self.cmd)
+            self._cmd += [normalize("-r"), (LocalSubstitution(_NAME_ARGUMENT),)]
+        self._given_cmd = list(self._cmd)
         # launch_ros's record of the last resolution's params arguments ((value, is a file)) and
         # remapping rules (None: none); its unit tests read the first by its private name.
         self.__expanded_parameter_arguments: list[tuple[str, bool]] | None = None
@@ -267,7 +267,7 @@ class Node(ExecuteProcess):
         if names.namespace is not None:
             cmd += [normalize("-r"), (LocalSubstitution(_NAMESPACE_ARGUMENT),)]
         cmd += [(TextSubstitution(text=item),) for item in part.argv]
-        self.cmd = cmd
+        self._cmd = cmd
 
     # --- resolving ------------------------------------------------------------------------------
 
