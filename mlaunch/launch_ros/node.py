@@ -193,12 +193,12 @@ class Node(ExecuteProcess):
         # code that reads them after the node was visited; resolving itself never reads them).
         self.resolved_names: NodeNames | None = None
         # ``cmd`` as launch_ros holds it: before a resolution, up to the node's name argument.
-        self._cmd += self.arguments
+        self._cmd += [list(a) for a in self.arguments]
         if self.ros_arguments is not None:
-            self._cmd += [normalize("--ros-args"), *self.ros_arguments]
-        self._cmd.append(normalize("--ros-args"))
+            self._cmd += [_text("--ros-args"), *(list(a) for a in self.ros_arguments)]
+        self._cmd.append(_text("--ros-args"))
         if self._node_name is not None:
-            self._cmd += [normalize("-r"), (LocalSubstitution(_NAME_ARGUMENT),)]
+            self._cmd += [_text("-r"), [LocalSubstitution(_NAME_ARGUMENT)]]
         self._given_cmd = list(self._cmd)
         # launch_ros's record of the last resolution's params arguments ((value, is a file)) and
         # remapping rules (None: none); its unit tests read the first by its private name.
@@ -265,8 +265,8 @@ class Node(ExecuteProcess):
         self.__expanded_remappings = list(part.remaps) if part.remaps else None
         cmd = list(self._given_cmd)
         if names.namespace is not None:
-            cmd += [normalize("-r"), (LocalSubstitution(_NAMESPACE_ARGUMENT),)]
-        cmd += [(TextSubstitution(text=item),) for item in part.argv]
+            cmd += [_text("-r"), [LocalSubstitution(_NAMESPACE_ARGUMENT)]]
+        cmd += [_text(item) for item in part.argv]
         self._cmd = cmd
 
     # --- resolving ------------------------------------------------------------------------------
@@ -514,6 +514,11 @@ def _not_installed(
         f" built): its executable {executable!r} exists once it is built and installed (colcon"
         f" build, then source install/setup.bash){hint}"
     )
+
+
+def _text(item: str) -> list[Substitution]:
+    """One item of launch_ros's ``cmd``: its text as a substitution list."""
+    return [TextSubstitution(text=item)]
 
 
 def _pairs(argv: list[str]) -> list[tuple[str, str]]:
