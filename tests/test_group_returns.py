@@ -243,3 +243,52 @@ def test_a_default_outside_the_choices_is_refused_when_declared() -> None:
         DeclareLaunchArgument("a", default_value="c", choices=["a", "b"])
     with pytest.raises(RuntimeError, match="Required launch argument 'a'"):
         DeclareLaunchArgument("a", choices=["a", "b"]).visit(LaunchContext())
+
+
+def test_each_pop_restores_its_own_half() -> None:
+    """As launch's two stacks: the configurations' pair leaves the environment alone, and the
+    environment's pair the configurations."""
+    context = LaunchContext(environment={"BASE": "b"})
+    action: Action
+    for action in (
+        PushLaunchConfigurations(),
+        SetLaunchConfiguration("inside", "i"),
+        SetEnvironmentVariable("KEPT", "k"),
+        PopLaunchConfigurations(),
+    ):
+        action.visit(context)
+    assert context.launch_configurations == {}
+    assert context.environment == {"BASE": "b", "KEPT": "k"}
+    for action in (
+        PushEnvironment(),
+        SetLaunchConfiguration("kept", "k"),
+        SetEnvironmentVariable("INSIDE", "i"),
+        PopEnvironment(),
+    ):
+        action.visit(context)
+    assert context.launch_configurations == {"kept": "k"}
+    assert context.environment == {"BASE": "b", "KEPT": "k"}
+
+
+def test_a_scoped_include_keeps_both_inside() -> None:
+    inner = LaunchDescription(
+        [SetLaunchConfiguration("inside", "i"), SetEnvironmentVariable("INSIDE", "i")]
+    )
+    context = LaunchContext(environment={"BASE": "b"})
+    include = IncludeLaunchDescription(
+        LaunchDescriptionSource(inner), launch_arguments=[("given", "g")], scoped=True
+    )
+    returned = visit(include, context)
+    assert kinds(returned) == [
+        "PushLaunchConfigurations",
+        "PushEnvironment",
+        "SetLaunchConfiguration",
+        "LaunchDescription",
+        "PopEnvironment",
+        "PopLaunchConfigurations",
+    ]
+    for entity in returned:
+        for inside in entity.visit(context) or ():  # the description gives its entities
+            inside.visit(context)
+    assert context.launch_configurations == {}
+    assert context.environment == {"BASE": "b"}

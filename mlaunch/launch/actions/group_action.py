@@ -71,22 +71,24 @@ class GroupAction(Action):
         configs = self.launch_configurations
         sets: list[Action] = [SetLaunchConfiguration(k, v) for k, v in configs.items()]
         if not scoped:
-            return [*self._placed(sets), *self.actions]
+            return [*placed(sets, self.origin), *self.actions]
         if not forwarding:  # the kept values are performed before the configurations are reset
             sets = [ResetEnvironment(), ResetLaunchConfigurations(configs)]
         opening = [PushLaunchConfigurations(), PushEnvironment(), *sets]
         closing = [PopEnvironment(), PopLaunchConfigurations()]
-        return [*self._placed(opening), *self.actions, *self._placed(closing)]
+        return [*placed(opening, self.origin), *self.actions, *placed(closing, self.origin)]
 
-    def _placed(self, actions: list[Action]) -> list[Action]:
-        """``actions`` located where the group was written (what an error in one names)."""
-        for action in actions:
-            action.origin = self.origin
-        return actions
+
+def placed(actions: list[Action], origin: str) -> list[Action]:
+    """``actions`` (made by a group or an include to scope what it holds) located where that
+    was written: what an error in one of them names."""
+    for action in actions:
+        action.origin = origin
+    return actions
 
 
 def _flag(context: LaunchContext, value: Any, what: str) -> bool:
     return value if isinstance(value, bool) else to_bool(perform(context, value), what)
 
 
-__all__ = ["GroupAction"]
+__all__ = ["GroupAction", "placed"]

@@ -12,7 +12,10 @@ from __future__ import annotations
 
 import os
 
+from mlaunch.launch.actions.group_action import placed
+from mlaunch.launch.actions.pop_environment import PopEnvironment
 from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
+from mlaunch.launch.actions.push_environment import PushEnvironment
 from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
 from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
 from mlaunch.launch.launch_description import Action
@@ -74,15 +77,11 @@ class IncludeLaunchDescription(Action):
             {"current_launch_file_path": absolute, "current_launch_file_directory": directory}
         )
         sets: list[Action] = [SetLaunchConfiguration(name, value) for name, value in args]
-        if self.scoped:
-            sets.insert(0, PushLaunchConfigurations())
-        for action in sets:
-            action.origin = self.origin
         if not self.scoped:
-            return [*sets, description]
-        closing = PopLaunchConfigurations()
-        closing.origin = self.origin
-        return [*sets, description, closing]
+            return [*placed(sets, self.origin), description]
+        opening = [PushLaunchConfigurations(), PushEnvironment(), *sets]
+        closing = [PopEnvironment(), PopLaunchConfigurations()]
+        return [*placed(opening, self.origin), description, *placed(closing, self.origin)]
 
     def _check_required(self, description: Any, given: list[str]) -> None:
         """Each argument the description declares without a default (not under a condition)

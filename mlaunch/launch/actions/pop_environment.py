@@ -10,10 +10,13 @@ if TYPE_CHECKING:
 
 
 class PopEnvironment(Action):
-    """Restore the environment the matching PushEnvironment kept."""
+    """Restore the environment the matching PushEnvironment kept; the launch configurations
+    stay as they are (see mlaunch.launch.actions.push_launch_configurations)."""
 
     def execute(self, context: LaunchContext) -> None:
+        configurations = context.launch_configurations
         context.pop_scope()
+        context.launch_configurations = configurations
 
 
 __all__ = ["PopEnvironment"]

@@ -1,4 +1,4 @@
-"""``launch.actions.pop_launch_configurations``: close the scope the matching Push opened."""
+"""``launch.actions.pop_launch_configurations``: the configurations the matching Push kept."""
 
 from __future__ import annotations
 
@@ -10,10 +10,13 @@ if TYPE_CHECKING:
 
 
 class PopLaunchConfigurations(Action):
-    """Restore the launch configurations the matching PushLaunchConfigurations kept."""
+    """Restore the launch configurations the matching PushLaunchConfigurations kept; the
+    environment stays as it is (see mlaunch.launch.actions.push_launch_configurations)."""
 
     def execute(self, context: LaunchContext) -> None:
+        environment = context.environment
         context.pop_scope()
+        context.environment = environment
 
 
 __all__ = ["PopLaunchConfigurations"]

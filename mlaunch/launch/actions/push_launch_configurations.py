@@ -1,9 +1,12 @@
-"""``launch.actions.push_launch_configurations``: open a scope (what GroupAction returns first).
+"""``launch.actions.push_launch_configurations``: keep the configurations for the matching Pop.
 
-mlaunch's context keeps one stack of scopes for the configurations and the environment together
-(``LaunchContext.push_scope``): PushLaunchConfigurations and PushEnvironment each push one, and
-their Pop counterparts each restore one, so a pair opened and closed in order (a group, a
-scoped include) leaves both as they were.
+mlaunch's context keeps one stack of scopes, each the configurations and the environment
+together (``LaunchContext.push_scope``). PushLaunchConfigurations and PushEnvironment each push
+one; PopLaunchConfigurations takes the top one back for the configurations only and
+PopEnvironment for the environment only, so each pair restores just its own half, as
+upstream's two stacks do when pairs nest (a group returns them nested). Pairs that cross
+(pushing one kind, then the other, and popping the first first) restore what the other push
+kept.
 """
 
 from __future__ import annotations
