@@ -174,7 +174,11 @@ class Supervisor:
             signals=self.signals,
             start=self.start,
             resolve=lambda body, event: resolve_deferred(
-                body, labels=self.labels, options=self.options, event=event
+                body,
+                labels=self.labels,
+                options=self.options,
+                event=event,
+                shutting_down=self.shutting_down,
             ),
             exit_status=self.exit_status,
         )

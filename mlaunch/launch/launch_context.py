@@ -17,6 +17,10 @@ if TYPE_CHECKING:
     from mlaunch.plan.planner import Planner
 
 
+# The run's state key that says it is shutting down (resolve sets it as the engine says).
+SHUT_DOWN = "is_shutdown"
+
+
 class Locals:
     """Attribute access to the context locals (``context.locals.event``), as ROS 2 offers.
 
@@ -75,7 +79,6 @@ class LaunchContext:
         # Handlers registered through this context (upstream's list: newest first).
         self._event_handlers: list[Any] = []
         self._asyncio_loop: Any = None
-        self._is_shutdown = False
         # One run's globals: shared (not copied) by every snapshot, so what a deferred action
         # adds (launch_ros's count of node names) is seen by the whole run.
         self._globals: dict[str, Any] = {}
@@ -159,7 +162,11 @@ class LaunchContext:
 
     @property
     def is_shutdown(self) -> bool:
-        return self._is_shutdown
+        """Whether the run is shutting down (said by every context of the run, snapshots too)."""
+        return bool(self.run_state.get(SHUT_DOWN))
+
+    def _set_is_shutdown(self, state: bool) -> None:
+        self.run_state[SHUT_DOWN] = state
 
     def register_event_handler(self, event_handler: Any, append: bool = False) -> None:
         """Listen with ``event_handler`` from now on (first in line unless ``append``)."""

@@ -373,12 +373,19 @@ def resolve_deferred(
     labels: LabelCounter,
     options: ResolveOptions,
     event: Any = None,
+    shutting_down: bool = False,
 ) -> Plan:
-    """Resolve a timer's or handler's entities now, in the context captured when registered."""
+    """Resolve a timer's or handler's entities now, in the context captured when registered.
+
+    ``shutting_down``: the run is shutting down, which the contexts of the run say from now on
+    (``is_shutdown``, as launch's: a fixture's exit during shutdown is no failure).
+    """
     plan = Plan(temp_dir=options.temp_dir)
     live = deferred.context
     if not isinstance(live, LaunchContext):
         raise TypeError(f"a deferred step's context is {type(live).__name__}, not a LaunchContext")
+    if shutting_down:
+        live._set_is_shutdown(True)
     if deferred.captured is None:
         context = live.snapshot()
     else:
