@@ -52,7 +52,7 @@ class Executor:
         shutdown: Shutdown,
         signals: SignalWatch,
         start: Callable[[ProcessSpec], object],
-        resolve: Callable[[Deferred, object], Plan],
+        resolve: Callable[[Deferred, object, bool | None], Plan],
         exit_status: Callable[[int], None],
     ) -> None:
         self.events = events
@@ -148,10 +148,10 @@ class Executor:
             self._awaited.discard(id(spec))
             self.events.emit(Completed(spec.action))
 
-    def fire(self, body: Deferred, event: object) -> None:
+    def fire(self, body: Deferred, event: object, shutting_down: bool | None = None) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
         try:
-            plan = self.resolve(body, event)
+            plan = self.resolve(body, event, shutting_down)
         except MlaunchError as e:
             self.handler_failed(str(e))
             return

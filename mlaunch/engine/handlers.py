@@ -159,9 +159,10 @@ class LaunchHandlers:
 
     def _exited(self, process: ProcessView, code: int) -> None:
         event = ev.ProcessExited(**_details(process), returncode=code)
+        shutting_down = self.supervisor.shutting_down
         self.dispatch("process_exit", process, event)
         if process.spec.on_exit is not None:
-            self.supervisor.fire(process.spec.on_exit, event)
+            self.supervisor.fire(process.spec.on_exit, event, shutting_down)
 
     def _transition(self, record: Transition) -> None:
         """OnStateTransition handlers: their own matcher on the event, else on the node's spec."""
@@ -181,7 +182,12 @@ class LaunchHandlers:
         self.general(record.event)
 
     def dispatch(self, kind: str, process: ProcessView | None, event: Any) -> None:
-        """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec."""
+        """Fire every handler of ``kind`` whose matcher accepts ``process``'s spec.
+
+        Each sees the run as it was when the event came (``is_shutdown``), as in launch, where
+        a Shutdown one handler returns is an event handled after them all.
+        """
+        shutting_down = self.supervisor.shutting_down
         for handler in list(self.handlers):
             if handler.kind != kind:
                 continue
@@ -194,7 +200,7 @@ class LaunchHandlers:
             if handler.once:
                 self.handlers.remove(handler)
             if handler.body is not None:
-                self.supervisor.fire(handler.body, event)
+                self.supervisor.fire(handler.body, event, shutting_down)
         self.general(event)
 
     def output(self, process: ProcessView, stream: str, data: bytes) -> None:

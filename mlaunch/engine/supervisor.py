@@ -173,12 +173,12 @@ class Supervisor:
             shutdown=self.shutdown,
             signals=self.signals,
             start=self.start,
-            resolve=lambda body, event: resolve_deferred(
+            resolve=lambda body, event, shutting_down: resolve_deferred(
                 body,
                 labels=self.labels,
                 options=self.options,
                 event=event,
-                shutting_down=self.shutting_down,
+                shutting_down=self.shutting_down if shutting_down is None else shutting_down,
             ),
             exit_status=self.exit_status,
         )
@@ -366,9 +366,10 @@ class Supervisor:
         """Carry out a visited description's steps (``Executor.execute``)."""
         self.executor.execute(steps, warnings)
 
-    def fire(self, body: Deferred, event: object) -> None:
-        """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
-        self.executor.fire(body, event)
+    def fire(self, body: Deferred, event: object, shutting_down: bool | None = None) -> None:
+        """Resolve deferred entities now (timer, handler, on_exit) and run what they give;
+        ``shutting_down``: what the handlers of ``event`` see (None: whether the run is now)."""
+        self.executor.fire(body, event, shutting_down)
 
     def handler_failed(self, message: str) -> None:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
