@@ -34,7 +34,7 @@ from mlaunch.launch.substitutions import (
     ThisLaunchFileDir,
     perform_substitutions,
 )
-from mlaunch.plan.errors import LaunchArgumentError
+from mlaunch.plan.errors import LaunchArgumentError, LaunchFileError
 from mlaunch.plan.steps import Log
 from mlaunch.resolve.resolver import ResolveOptions, resolve
 
@@ -292,3 +292,10 @@ def test_a_scoped_include_keeps_both_inside() -> None:
             inside.visit(context)
     assert context.launch_configurations == {}
     assert context.environment == {"BASE": "b"}
+
+
+def test_what_is_no_launch_entity_is_said_by_the_resolver_not_the_include_check() -> None:
+    included = LaunchDescription([DeclareLaunchArgument("a", default_value="1"), object()])
+    parent = LaunchDescription([IncludeLaunchDescription(LaunchDescriptionSource(included))])
+    with pytest.raises(LaunchFileError, match="is not a launch action"):
+        resolve(parent, path=None, arguments={}, environ=ENV)

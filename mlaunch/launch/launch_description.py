@@ -209,6 +209,8 @@ def _collect_arguments(
             included = [] if described is None else [described]
             _collect_arguments(included, inner, found, [*(via or ()), entity], files)
             continue
+        if not isinstance(entity, LaunchDescriptionEntity):
+            continue  # not a launch entity: visiting it says so, where it was written
         _collect_arguments(entity.describe_sub_entities(), inner, found, via, files)
         for _why, more in entity.describe_conditional_sub_entities():
             _collect_arguments(more, True, found, via, files)
