@@ -284,7 +284,7 @@ class LaunchService:
     # --- running --------------------------------------------------------------------------------
 
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
-        from mlaunch.app.parts import components_part
+        from mlaunch.app.parts import components_part, ros_clock_part
         from mlaunch.engine.guard import Guard, new_run_id
         from mlaunch.engine.logfiles import make_run_log_dir
         from mlaunch.engine.output import Printer, stdout_is_color_terminal
@@ -332,9 +332,11 @@ class LaunchService:
                 self._supervisor = supervisor
             if self._calls:
                 self._wake()
-            # Composable nodes are loaded by the same part as in ``mlaunch FILE``.
+            # Composable nodes are loaded, and ROSTimers on simulated time counted, by the same
+            # parts as in ``mlaunch FILE``.
             attach = lambda: components_part(plan, supervisor)  # noqa: E731
             supervisor.reactor.attach("the LoadNode driver", attach)
+            supervisor.reactor.attach("the ROS clock", lambda: ros_clock_part(supervisor))
             try:
                 code = supervisor.run()
             finally:

@@ -1,8 +1,9 @@
 """What attaches to a run of the pipeline (mlaunch.app.pipeline): the Run a part is made from,
 ``PartMaker`` (a part's name, how it is made, whether the run can go on without it) and
 ``standard_parts``, what every run gets: lifecycle driving (when the plan needs it, as resolve
-noted), the LoadNode driver, the control socket, the ``--status`` view (when asked for) and the
-exit summary. Each part is imported only when it is attached.
+noted), the LoadNode driver, the ROS clock (ROSTimers on simulated time), the control socket,
+the ``--status`` view (when asked for) and the exit summary. Each part is imported only when it
+is attached.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from collections.abc import Callable
 
 from mlaunch.app.options import Options
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Said, Started
+from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Said, SimTimeWait, Started
 from mlaunch.plan.steps import Need, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from mlaunch.parts.control import Control
     from mlaunch.parts.control_socket import ControlSocket
     from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.parts.ros_clock import RosClock
 
 
 class Run:
@@ -82,14 +84,15 @@ class PartMaker:
 
 
 def standard_parts(opts: Options) -> list[PartMaker]:
-    """Lifecycle driving, composable node loading, the control socket, the ``--status`` view if
-    asked for, then the exit summary.
+    """Lifecycle driving, composable node loading, the ROS clock, the control socket, the
+    ``--status`` view if asked for, then the exit summary.
 
     Closed in this order at the end: the status view leaves the screen before the summary.
     """
     parts = [
         PartMaker("lifecycle driving", lifecycle),
         PartMaker("the LoadNode driver", components),
+        PartMaker("the ROS clock", ros_clock),
         PartMaker("the control socket", control_socket),
     ]
     if opts.status:
@@ -166,32 +169,63 @@ def components_part(plan: Plan, supervisor: Supervisor) -> Part:
     (or a description a LaunchService includes later) can still make one, so without that need
     a watch attaches the driver at the first LoadComponents the supervisor hands over.
     """
-    if Need.COMPONENTS in plan.needs:
+
+    def driver() -> ComponentDriver:
         from mlaunch.parts.components import ComponentDriver
 
         return ComponentDriver(supervisor)
-    return _ComponentsWatch(supervisor)
+
+    if Need.COMPONENTS in plan.needs:
+        return driver()
+
+    def wants(event: Event) -> bool:
+        return isinstance(event, HandedOff) and Need.COMPONENTS in event.step.needs
+
+    return _AttachOnDemand(supervisor, wants, driver)
 
 
-class _ComponentsWatch(Part):
-    """Attaches the LoadNode driver at the first LoadComponents step handed over.
+def ros_clock(run: Run) -> Part:
+    """Simulated ROS time for ROSTimers (``ros_clock_part``)."""
+    return ros_clock_part(run.supervisor)
+
+
+def ros_clock_part(supervisor: Supervisor) -> Part:
+    """The ROS clock (mlaunch.parts.ros_clock), attached at the first ROSTimer on simulated
+    time the supervisor hands over (``SimTimeWait``): only whether SetUseSimTime ran when the
+    timer starts tells, and a launch without one never imports it."""
+
+    def clock() -> RosClock:
+        from mlaunch.parts.ros_clock import RosClock
+
+        return RosClock(supervisor)
+
+    return _AttachOnDemand(supervisor, lambda event: isinstance(event, SimTimeWait), clock)
+
+
+class _AttachOnDemand(Part):
+    """Makes a part at the first record it ``wants`` (a step handed over that needs it).
 
     Until then it only looks at each record's class; the record that triggered it is handed to
-    the new driver, which sees every later record itself.
+    the new part, which sees every later record itself.
     """
 
-    def __init__(self, supervisor: Supervisor) -> None:
+    def __init__(
+        self,
+        supervisor: Supervisor,
+        wants: Callable[[Event], bool],
+        make: Callable[[], ComponentDriver | RosClock],
+    ) -> None:
         self.supervisor = supervisor
-        self.driver: ComponentDriver | None = None
+        self.wants = wants
+        self.make = make
+        self.driver: ComponentDriver | RosClock | None = None
         supervisor.events.subscribe(self._on_event)
 
     def _on_event(self, event: Event) -> None:
-        if not isinstance(event, HandedOff) or Need.COMPONENTS not in event.step.needs:
+        if not self.wants(event):
             return
-        from mlaunch.parts.components import ComponentDriver
-
         self.supervisor.events.unsubscribe(self._on_event)
-        driver = self.driver = ComponentDriver(self.supervisor)
+        driver = self.driver = self.make()
         driver.on_event(event)
 
     def close(self) -> None:

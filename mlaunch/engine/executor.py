@@ -11,7 +11,15 @@ from __future__ import annotations
 
 from mlaunch.engine.stopping import handle_stop_signals
 from mlaunch.plan.errors import EXIT_USAGE, MlaunchError
-from mlaunch.plan.events import Completed, HandedOff, LaunchEvent, Said, StartsSkipped, Unclaimed
+from mlaunch.plan.events import (
+    Completed,
+    HandedOff,
+    LaunchEvent,
+    Said,
+    SimTimeWait,
+    StartsSkipped,
+    Unclaimed,
+)
 from mlaunch.plan.steps import (
     AddHandler,
     EmitEvent,
@@ -139,8 +147,32 @@ class Executor:
             if awaited:
                 self.events.emit(Completed(action))
 
+        if step.on_sim_time:
+            self._wait_sim_time(step, expire)
+        else:
+            self._wall_timer(step, expire)
+
+    def _wall_timer(self, step: StartTimer, expire: Callable[[], None]) -> None:
         timer = self.timers.add(step.period, expire, cancel_on_shutdown=step.cancel_on_shutdown)
         timer.holds_shutdown = not step.cancel_on_shutdown
+
+    def _wait_sim_time(self, step: StartTimer, expire: Callable[[], None]) -> None:
+        """Hand a ROSTimer on simulated time to the ROS clock part; if none took it (looked at
+        once the stream has handed it to every subscriber), say so and count wall-clock time."""
+        handed = SimTimeWait(step.origin, step.period, expire, step.cancel_on_shutdown)
+        self.events.emit(handed)
+
+        def unless_taken() -> None:
+            if handed.taken:
+                return
+            text = (
+                f"{step.origin}: ROSTimer counts its period in wall-clock time: launch's ROS"
+                " clock uses simulated time (SetUseSimTime) but nothing in this run reads /clock"
+            )
+            self.events.emit(Said("WARNING", "launch", text))
+            self._wall_timer(step, expire)
+
+        self.timers.add(0.0, unless_taken, cancel_on_shutdown=step.cancel_on_shutdown)
 
     def ended_for_good(self, spec: ProcessSpec) -> None:
         """``spec``'s process exited and will not restart: ExecutionComplete, if awaited."""

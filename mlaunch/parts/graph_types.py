@@ -137,6 +137,10 @@ class TopicWatch:
             self._cond.wait_for(lambda: self.count >= n or self._closed, timeout)
             return self.count >= n
 
+    def listen(self, callback: Callable[[], None]) -> None:
+        """Call ``callback`` (on the graph's thread) after each message; it must be quick."""
+        self._listeners.append(callback)
+
     def last_message(self) -> Any:
         """The newest message received, or None."""
         with self._cond:

@@ -255,6 +255,26 @@ class HandedOff(Event):
         self.taken = False
 
 
+class SimTimeWait(Event):
+    """A ROSTimer's ``period`` counted on simulated time: the engine hands it to the ROS clock
+    part (mlaunch.parts.ros_clock), which sets ``taken`` and calls ``expire`` from the loop
+    once /clock has advanced ``period`` seconds past the time it had when the wait began (0
+    before any message, as rclpy's clock under use_sim_time). ``cancel_on_shutdown``: dropped
+    when the launch shuts down. Not taken, the engine counts the period on the wall clock.
+    """
+
+    __slots__ = ("cancel_on_shutdown", "expire", "origin", "period", "taken")
+
+    def __init__(
+        self, origin: str, period: float, expire: Callable[[], None], cancel_on_shutdown: bool
+    ) -> None:
+        self.origin = origin
+        self.period = period
+        self.expire = expire
+        self.cancel_on_shutdown = cancel_on_shutdown
+        self.taken = False
+
+
 class Unclaimed(Event):
     """Follows a LaunchEvent or a HandedOff once every subscriber has seen it; said if nobody
     took it."""

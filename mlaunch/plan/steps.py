@@ -261,7 +261,13 @@ class Log(Step):
 
 
 class StartTimer(Step):
-    __slots__ = ("action", "body", "cancel_on_shutdown", "period")
+    """Run ``body`` after ``period`` seconds of wall-clock time, or of ROS time for a ROSTimer:
+    its ``ros_time`` is the run's state (``LaunchContext.run_state``), where SetUseSimTime
+    records whether launch's own ROS clock follows /clock; the engine looks when it starts the
+    timer, so a SetUseSimTime after the timer in the same description counts, as in launch_ros.
+    """
+
+    __slots__ = ("action", "body", "cancel_on_shutdown", "period", "ros_time")
     _fields = (*Step._fields, "period", "body", "cancel_on_shutdown", "action")
 
     def __init__(
@@ -271,12 +277,19 @@ class StartTimer(Step):
         body: Deferred | None = None,
         cancel_on_shutdown: bool = True,
         action: Any = None,
+        ros_time: dict[str, Any] | None = None,
     ) -> None:
         self.origin = origin
         self.period = period
         self.body = body
         self.cancel_on_shutdown = cancel_on_shutdown
         self.action = action  # the TimerAction (OnExecutionComplete targets it)
+        self.ros_time = ros_time
+
+    @property
+    def on_sim_time(self) -> bool:
+        """A ROSTimer whose clock is simulated time (/clock) at this moment."""
+        return self.ros_time is not None and bool(self.ros_time.get(SIM_TIME_STATE))
 
 
 class AddHandler(Step):
@@ -377,6 +390,10 @@ class Need(enum.Enum):
 NO_NEEDS: frozenset[Need] = frozenset()
 LIFECYCLE: frozenset[Need] = frozenset({Need.LIFECYCLE})
 COMPONENTS: frozenset[Need] = frozenset({Need.COMPONENTS})
+# The key of ``LaunchContext.run_state`` where SetUseSimTime records launch's own use_sim_time.
+SIM_TIME_STATE = "ros_use_sim_time"
+
+
 # The YAML/XML form of a LifecycleSequence: a launch argument listing the nodes.
 SEQUENCE_ARGUMENT = "mlaunch_lifecycle_sequence"
 

@@ -189,8 +189,14 @@ class TimerAction(Action):
                 body=planner.defer(self.actions, self.origin),
                 cancel_on_shutdown=cancel,
                 action=self,
+                ros_time=self._ros_time(context),
             )
         )
+
+    def _ros_time(self, context: LaunchContext) -> dict[str, Any] | None:
+        """Where the run records whether the period is simulated ROS time (StartTimer's
+        ``ros_time``); None: wall-clock time, as launch's TimerAction counts it."""
+        return None
 
     def describe_short(self) -> str:
         return f"TimerAction(period={self.period!r})"

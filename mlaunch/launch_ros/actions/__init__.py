@@ -31,6 +31,7 @@ from mlaunch.launch_ros.scope import (
     prefix_namespace,
 )
 from mlaunch.plan.errors import SubstitutionFailure
+from mlaunch.plan.steps import SIM_TIME_STATE
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -171,6 +172,8 @@ class SetUseSimTime(Action):
         planner = context.planner
         value = bool(perform_typed(context, self.value, bool))
         context.launch_configurations["ros_use_sim_time"] = value
+        # launch's own ROS node is one per launch: not scoped (a ROSTimer reads it, run time).
+        context.run_state[SIM_TIME_STATE] = value
         planner.warn(
             f"{self.origin}: SetUseSimTime({value}) sets use_sim_time only for launch's own ROS"
             " clock, not for the nodes (as in ROS 2 Jazzy); use SetParameter('use_sim_time',"
