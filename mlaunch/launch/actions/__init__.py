@@ -12,17 +12,21 @@ from __future__ import annotations
 import os
 
 from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
-from mlaunch.launch.actions.group_action import GroupAction
-from mlaunch.launch.actions.include_launch_description import IncludeLaunchDescription
-from mlaunch.launch.actions.pop_environment import PopEnvironment
-from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
-from mlaunch.launch.actions.push_environment import PushEnvironment
-from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
-from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
-from mlaunch.launch.actions.reset_environment import ResetEnvironment
-from mlaunch.launch.actions.reset_launch_configurations import ResetLaunchConfigurations
-from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
-from mlaunch.launch.actions.unregister_event_handler import UnregisterEventHandler
+from mlaunch.launch.actions.register_event_handler import (
+    RegisterEventHandler,
+    UnregisterEventHandler,
+)
+from mlaunch.launch.actions.scoping import (
+    GroupAction,
+    IncludeLaunchDescription,
+    PopEnvironment,
+    PopLaunchConfigurations,
+    PushEnvironment,
+    PushLaunchConfigurations,
+    ResetEnvironment,
+    ResetLaunchConfigurations,
+    SetLaunchConfiguration,
+)
 from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
 from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
 from mlaunch.launch.substitutions import (

@@ -1,4 +1,5 @@
-"""``launch.actions.register_event_handler``: listen with an event handler from here on.
+"""``launch.actions.register_event_handler``: listen with an event handler from here on, and
+UnregisterEventHandler (``launch.actions.unregister_event_handler`` re-exports it): stop.
 
 Any handler registers: one of the kinds the engine dispatches itself (process start, exit,
 output, shutdown, completion, a transition) or any other, whose ``matches(event)`` then decides
@@ -10,6 +11,7 @@ from __future__ import annotations
 from mlaunch.launch.event_handlers import register_step
 from mlaunch.launch.launch_description import Action
 from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.steps import RemoveHandler
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -52,4 +54,35 @@ class RegisterEventHandler(Action):
         return [(text, list(entities))] if entities else []
 
 
-__all__ = ["REGISTERED", "RegisterEventHandler"]
+class HandlerNotRegistered(LaunchFileError, ValueError):
+    """Unregistering a handler that is not registered (a ValueError, as launch raises)."""
+
+
+class UnregisterEventHandler(Action):
+    """Unregister ``event_handler``; an error when it is not registered (as launch's)."""
+
+    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
+        super().__init__(**kwargs)
+        self.event_handler = event_handler
+
+    def execute(self, context: LaunchContext) -> None:
+        handler = self.event_handler
+        here = handler in context._event_handlers
+        run = context.run_state.get(REGISTERED, [])
+        # A handler of the run counts even where this context is a copy made before it was
+        # registered (a timer's body that takes its values where written).
+        in_run = any(h is handler for h in run)
+        if not here and not in_run:
+            raise HandlerNotRegistered(
+                f"UnregisterEventHandler: {type(handler).__name__} is not registered"
+                " (never registered, or unregistered already)",
+                where=self.origin,
+            )
+        if here:
+            context._event_handlers.remove(handler)
+        if in_run:
+            run[:] = [h for h in run if h is not handler]
+        context.planner.add(RemoveHandler(origin=self.origin, handler=handler))
+
+
+__all__ = ["REGISTERED", "HandlerNotRegistered", "RegisterEventHandler", "UnregisterEventHandler"]

@@ -1,29 +1,5 @@
-"""``launch.actions.reset_launch_configurations``: forget the configurations, keep some."""
+"""``launch.actions.reset_launch_configurations``, where upstream defines it."""
 
-from __future__ import annotations
-
-from mlaunch.launch.launch_description import Action
-from mlaunch.launch.substitutions import perform
-
-TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
-if TYPE_CHECKING:
-    from typing import Any
-
-    from mlaunch.launch.launch_context import LaunchContext
-
-
-class ResetLaunchConfigurations(Action):
-    """Forget every configuration, then set the given ones (performed before forgetting)."""
-
-    def __init__(self, launch_configurations: dict[Any, Any] | None = None, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.launch_configurations = launch_configurations or {}
-
-    def execute(self, context: LaunchContext) -> None:
-        keep = {
-            perform(context, k): perform(context, v) for k, v in self.launch_configurations.items()
-        }
-        context.launch_configurations = keep
-
+from mlaunch.launch.actions.scoping import ResetLaunchConfigurations
 
 __all__ = ["ResetLaunchConfigurations"]
