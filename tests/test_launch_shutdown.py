@@ -3,7 +3,8 @@
 A launch file's Shutdown(due_to_sigint=True): interactive, the terminal is taken to have sent
 SIGINT already, so the processes get SIGTERM after sigterm_timeout; noninteractive (-n), they get
 SIGINT. A child that reads its stdin waits meanwhile, as under launch (its stdin is a pipe nobody
-writes to, not /dev/null). Handlers that run once the shutdown began see ``is_shutdown``.
+writes to, not /dev/null). Handlers that run once the shutdown began see ``is_shutdown``; a
+Shutdown while the launch already stops reaches the OnShutdown handlers too.
 """
 
 from __future__ import annotations
@@ -19,8 +20,10 @@ from mlaunch.launch.actions import (
     ExecuteProcess,
     LaunchDescription,
     RegisterEventHandler,
+    TimerAction,
 )
-from mlaunch.launch.event_handlers import OnProcessExit, OnProcessStart
+from mlaunch.launch.actions import Shutdown as ShutdownAction
+from mlaunch.launch.event_handlers import OnProcessExit, OnProcessStart, OnShutdown
 from mlaunch.launch.events import Shutdown
 
 
@@ -96,3 +99,26 @@ def test_a_legacy_fixture_stopped_by_the_shutdown_is_no_failure() -> None:
     service = LaunchService(screen=lambda data: None)
     service.include_launch_description(description)
     assert tests.run(service) == 0  # the fixture ends by SIGINT, as the shutdown stops it
+
+
+def test_a_shutdown_while_shutting_down_reaches_the_on_shutdown_handlers() -> None:
+    reasons: list[str] = []
+    printed: list[bytes] = []
+    service = LaunchService(screen=printed.append)
+    service.include_launch_description(
+        LaunchDescription(
+            [
+                ExecuteProcess(cmd=SLEEPER),
+                RegisterEventHandler(
+                    OnShutdown(on_shutdown=lambda event, context: reasons.append(event.reason))
+                ),
+                TimerAction(period=0.1, actions=[ShutdownAction(reason="fast")]),
+                TimerAction(
+                    period=0.5, actions=[ShutdownAction(reason="slow")], cancel_on_shutdown=False
+                ),
+            ]
+        )
+    )
+    assert service.run() == 0
+    assert reasons == ["fast", "slow"]
+    assert b"".join(printed).count(b"shutting down") == 1  # the launch stops once

@@ -116,7 +116,7 @@ class Executor:
         elif isinstance(step, RemoveHandler):
             self.handlers.remove(step.handler)
         elif isinstance(step, RequestShutdown):
-            self.shutdown.begin(
+            self.shutdown.request(
                 step.reason,
                 due_to_signal=2 if step.due_to_sigint else None,  # SIGINT, as the event said
                 send_sigint=step.send_sigint,

@@ -24,6 +24,7 @@ from mlaunch.plan.events import (
     LaunchEvent,
     Output,
     ShutdownBegun,
+    ShutdownRepeated,
     Started,
     Transition,
     Unclaimed,
@@ -60,7 +61,7 @@ class LaunchHandlers:
             self._started(event.process)
         elif isinstance(event, Exited):
             self._exited(event.process, event.code)
-        elif isinstance(event, ShutdownBegun):
+        elif isinstance(event, (ShutdownBegun, ShutdownRepeated)):
             sigint = event.due_to_signal == 2  # SIGINT, without importing signal for it
             self.dispatch("shutdown", None, ev.Shutdown(reason=event.reason, due_to_sigint=sigint))
         elif isinstance(event, Transition):

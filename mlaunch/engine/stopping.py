@@ -13,7 +13,7 @@ import signal
 from mlaunch.engine.process import signal_name
 from mlaunch.engine.records import RESTARTING
 from mlaunch.plan.errors import exit_for_signal
-from mlaunch.plan.events import Interrupted, ShutdownBegun, StoppingAll
+from mlaunch.plan.events import Interrupted, ShutdownBegun, ShutdownRepeated, StoppingAll
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -80,6 +80,16 @@ class Shutdown:
                 record.not_restarting()
         self.events.emit(ShutdownBegun(reason, due_to_signal))
         self.events.emit(StoppingAll())
+
+    def request(
+        self, reason: str, *, due_to_signal: int | None = None, send_sigint: bool = True
+    ) -> None:
+        """A Shutdown of the launch file (action or event): it begins the shutdown or, while
+        one is under way, goes to the OnShutdown handlers alone (ShutdownRepeated)."""
+        if self.active:
+            self.events.emit(ShutdownRepeated(reason, due_to_signal))
+        else:
+            self.begin(reason, due_to_signal=due_to_signal, send_sigint=send_sigint)
 
     def stop_all(self) -> None:
         """The stop ladder for every process not held, and for groups left by their leader."""

@@ -222,6 +222,17 @@ class ShutdownBegun(Event):
         self.due_to_signal = due_to_signal
 
 
+class ShutdownRepeated(Event):
+    """Another Shutdown of the launch file while the launch already stops: its OnShutdown
+    handlers see it, as launch hands them every Shutdown event; nothing else changes."""
+
+    __slots__ = ("due_to_signal", "reason")
+
+    def __init__(self, reason: str, due_to_signal: int | None = None) -> None:
+        self.reason = reason
+        self.due_to_signal = due_to_signal
+
+
 class StoppingAll(Event):
     """The second shutdown phase: every process not held gets its stop ladder.
 
