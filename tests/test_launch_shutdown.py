@@ -122,3 +122,36 @@ def test_a_shutdown_while_shutting_down_reaches_the_on_shutdown_handlers() -> No
     assert service.run() == 0
     assert reasons == ["fast", "slow"]
     assert b"".join(printed).count(b"shutting down") == 1  # the launch stops once
+
+
+def test_a_launch_files_process_matcher_is_given_the_action() -> None:
+    from mlaunch.launch.events import SignalProcess
+
+    codes: list[tuple[str, int]] = []
+
+    def sleeper(name: str) -> ExecuteProcess:
+        return ExecuteProcess(
+            cmd=SLEEPER, on_exit=lambda event, context: codes.append((name, event.returncode))
+        )
+
+    target, other = sleeper("target"), sleeper("other")
+    signal_target = SignalProcess(
+        signal_number=signal.SIGTERM, process_matcher=lambda action: action is target
+    )
+    service = LaunchService(screen=lambda data: None)
+    service.include_launch_description(
+        LaunchDescription(
+            [
+                target,
+                other,
+                RegisterEventHandler(
+                    OnProcessExit(target_action=target, on_exit=[ShutdownAction()])
+                ),
+                RegisterEventHandler(
+                    OnProcessStart(target_action=other, on_start=[EmitEvent(event=signal_target)])
+                ),
+            ]
+        )
+    )
+    assert service.run() == 0
+    assert codes == [("target", -signal.SIGTERM), ("other", -signal.SIGINT)]

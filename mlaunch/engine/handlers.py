@@ -153,7 +153,7 @@ class LaunchHandlers:
 
     def _running(self, matcher: Callable[[Any], bool] | None) -> list[Process]:
         processes = self.supervisor.processes
-        return [p for p in processes if p.running and (matcher is None or matcher(p))]
+        return [p for p in processes if p.running and (matcher is None or _selects(matcher, p))]
 
     def _started(self, process: ProcessView) -> None:
         self.dispatch("process_start", process, ev.ProcessStarted(**_details(process)))
@@ -235,6 +235,13 @@ class LaunchHandlers:
                 self.supervisor.fire(deferred, event)
         if any(h.kind == MATCHER_KIND for h in self.handlers):
             self.general(_io_event(event_type, process, stream, data))
+
+
+def _selects(matcher: Callable[[Any], bool], process: Process) -> bool:
+    """Whether a ShutdownProcess's or SignalProcess's matcher selects ``process``: launch's
+    matchers are given the process's action, mlaunch's own (matches_pid ...) the process."""
+    sees_process = getattr(matcher, ev.SEES_PROCESS, False)
+    return bool(matcher(process if sees_process else process.spec.action))
 
 
 def _io_event(event_type: type, process: ProcessView, stream: str, data: bytes) -> Any:

@@ -198,16 +198,27 @@ class SignalProcess(ProcessTargetedEvent):
         self.signal_number = signal_number
 
 
+# A process matcher written in a launch file is given a running process's action, as launch's
+# (``lambda action: action is talker``). The matchers below are given the running process
+# itself (its action, pid, label and argv: an action may run more than one process here).
+SEES_PROCESS = "sees_process"
+
+
+def _sees_process(match: ProcessMatcher) -> ProcessMatcher:
+    setattr(match, SEES_PROCESS, True)
+    return match
+
+
 def matches_action(target_action: Any) -> ProcessMatcher:
-    return lambda process: getattr(process, "action", None) is target_action
+    return _sees_process(lambda process: getattr(process, "action", None) is target_action)
 
 
 def matches_pid(target_pid: int) -> ProcessMatcher:
-    return lambda process: getattr(process, "pid", None) == target_pid
+    return _sees_process(lambda process: getattr(process, "pid", None) == target_pid)
 
 
 def matches_name(target_name: str) -> ProcessMatcher:
-    return lambda process: getattr(process, "label", None) == target_name
+    return _sees_process(lambda process: getattr(process, "label", None) == target_name)
 
 
 def matches_executable(executable_name: str) -> ProcessMatcher:
@@ -215,7 +226,7 @@ def matches_executable(executable_name: str) -> ProcessMatcher:
         argv: tuple[str, ...] = tuple(getattr(process, "argv", ()))
         return bool(argv) and argv[0].endswith(executable_name)
 
-    return match
+    return _sees_process(match)
 
 
 # launch keeps the process events in the subpackage launch.events.process (also served
