@@ -8,6 +8,7 @@ from __future__ import annotations
 import asyncio
 import gc
 import os
+import signal
 import subprocess
 import sys
 import textwrap
@@ -273,4 +274,34 @@ def test_two_threaded_runs_and_the_hosts_own_child_keep_their_exits() -> None:
     assert [thread.is_alive() for thread in threads] == [False, False]
     assert [service.return_code for service in services] == [0, 0]
     assert own.wait(DEADLINE) == 7
+    assert_nothing_left(before)
+
+
+class HostDeadline(BaseException):
+    """What a test runner raises from its own SIGALRM handler (pytest-timeout's Failed is a
+    BaseException too: no ``except Exception`` on the way may swallow it)."""
+
+
+def test_an_exception_raised_into_run_stops_its_processes_through_the_ladder() -> None:
+    """A host's own signal handler may raise into run() (pytest-timeout's signal method does):
+    the processes get the stop ladder (SIGINT first) before the exception goes on up."""
+    before = descendants()
+    service, screen = polite_service()
+
+    def deadline(signum: int, frame: object) -> None:
+        raise HostDeadline("the host's deadline")
+
+    def raise_when_up() -> None:
+        started(screen)
+        os.kill(os.getpid(), signal.SIGALRM)
+
+    old = signal.signal(signal.SIGALRM, deadline)
+    try:
+        threading.Thread(target=raise_when_up, daemon=True).start()
+        with pytest.raises(HostDeadline, match="the host's deadline"):
+            service.run()
+    finally:
+        signal.signal(signal.SIGALRM, old)
+    assert b"shutting down: the run was interrupted (HostDeadline)" in screen.data
+    assert b"polite bye" in screen.data
     assert_nothing_left(before)

@@ -319,6 +319,8 @@ class LaunchService:
                 run_id=run_id,
                 # A script may have children of its own: the run's are found by their marker.
                 adopt=False,
+                # Its host may raise into the loop (a test runner's timeout): stop gently.
+                gentle_on_error=True,
             )
             said = Said("INFO", "launch", f"All log files can be found below {log_dir}")
             supervisor.events.emit(said)

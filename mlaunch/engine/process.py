@@ -382,3 +382,20 @@ class Process:
         except PermissionError:
             pass
         return self.group_alive
+
+
+def wait_child(pids: Mapping[int, object] | None) -> tuple[int, int, object]:
+    """An exited child not yet reaped (any child, or one of ``pids``); pid 0 when none."""
+    if pids is None:
+        try:
+            return os.wait4(-1, os.WNOHANG)
+        except ChildProcessError:
+            return 0, 0, None
+    for pid in list(pids):
+        try:
+            found = os.wait4(pid, os.WNOHANG)
+        except ChildProcessError:
+            continue  # not ours to wait for (any more)
+        if found[0]:
+            return found
+    return 0, 0, None

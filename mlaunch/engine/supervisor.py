@@ -28,7 +28,6 @@ plan's steps are carried out by its ``Executor`` (mlaunch.engine.executor).
 from __future__ import annotations
 
 import itertools
-import os
 import selectors
 import signal
 import time
@@ -42,7 +41,7 @@ from mlaunch.engine.handlers import LaunchHandlers
 from mlaunch.engine.ladder import StopLadder
 from mlaunch.engine.output import Printer
 from mlaunch.engine.pipes import Pipes
-from mlaunch.engine.process import Process, describe_status
+from mlaunch.engine.process import Process, describe_status, wait_child
 from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
 from mlaunch.engine.records import RESTARTING, RUNNING, STOPPED, ProcessRecord
 from mlaunch.engine.respawn import Respawns
@@ -90,6 +89,9 @@ class Supervisor:
     children of its own passes False (the run's processes are still found by their marker).
     ``stray_grace``: seconds between SIGTERM and SIGKILL for a stray descendant.
     ``spawner(spec, index, restarts)``: makes the Process for a spec (``Process`` by default).
+    ``gentle_on_error``: an exception out of the loop (an embedder's host raising from a signal
+    handler of its own: a test runner's timeout) first stops everything through the stop ladder,
+    the loop turning on; SIGKILL only for what that leaves or when the loop fails again.
     """
 
     def __init__(
@@ -107,8 +109,10 @@ class Supervisor:
         stray_grace: float = STRAY_GRACE,
         spawner: Callable[[ProcessSpec, int, int], Process] = Process,
         cgroup: RunCgroup | None = None,
+        gentle_on_error: bool = False,
     ) -> None:
         self.plan = plan
+        self.gentle_on_error = gentle_on_error
         # Subscribed below, and the terminal whose flow control the loop drives; parts are
         # handed the printer by the run (mlaunch.app.parts.Run), never through here.
         self._printer = printer
@@ -219,6 +223,16 @@ class Supervisor:
         """The run's exit status is at least ``code`` (a failure, an interruption)."""
         self.exit_code = max(self.exit_code, code)
 
+    def _stop_after(self, error: BaseException) -> None:
+        """Stop everything through the ladder, the loop turning as before, until the run is
+        over; if the loop fails again meanwhile, ``_emergency_stop`` kills what is left."""
+        try:
+            self.begin_shutdown(f"the run was interrupted ({type(error).__name__})")
+            while not self._finished():
+                self._loop_once()
+        except BaseException:
+            pass  # the first error is the one worth reporting
+
     def _emergency_stop(self) -> None:
         """The loop itself failed: kill everything we know of before the error propagates."""
         try:
@@ -257,7 +271,9 @@ class Supervisor:
             if self.guard is not None:
                 # Everything of the run has ended: the guard may leave while we tidy up.
                 self.guard.dismiss()
-        except BaseException:
+        except BaseException as error:
+            if self.gentle_on_error:
+                self._stop_after(error)
             self._emergency_stop()
             raise
         finally:
@@ -428,7 +444,7 @@ class Supervisor:
         # (two LaunchServices on threads hung, each waiting for a child the other had reaped).
         mine = None if self.strays.adopt else self.by_pid
         while True:
-            pid, status, rusage = _wait_child(mine)
+            pid, status, rusage = wait_child(mine)
             if pid == 0:
                 return
             process = self.by_pid.pop(pid, None)
@@ -481,20 +497,3 @@ class Supervisor:
     def _forget(self, old: Process) -> None:
         if not old.streams and old not in self.lingering and old in self.processes:
             self.processes.remove(old)  # a crash loop must not grow the list forever
-
-
-def _wait_child(pids: Mapping[int, object] | None) -> tuple[int, int, object]:
-    """An exited child not yet reaped (any child, or one of ``pids``); pid 0 when none."""
-    if pids is None:
-        try:
-            return os.wait4(-1, os.WNOHANG)
-        except ChildProcessError:
-            return 0, 0, None
-    for pid in list(pids):
-        try:
-            found = os.wait4(pid, os.WNOHANG)
-        except ChildProcessError:
-            continue  # not ours to wait for (any more)
-        if found[0]:
-            return found
-    return 0, 0, None
