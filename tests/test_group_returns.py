@@ -213,7 +213,9 @@ def test_a_configuration_of_the_includer_does_not_satisfy_the_included_file() ->
         resolve(parent, path=None, arguments={"needed": "1"}, environ=ENV)
 
 
-def test_the_resolver_gives_the_includer_its_locals_back(tmp_path: Path) -> None:
+def _includer_and_child(tmp_path: Path) -> tuple[LaunchDescription, Path]:
+    """A description (of ``parent.launch.py``) that includes sub/child.launch.py, giving it
+    ThisLaunchFileDir as an argument, then logs ThisLaunchFileDir."""
     (tmp_path / "sub").mkdir()
     child = tmp_path / "sub" / "child.launch.py"
     child.write_text(
@@ -224,18 +226,54 @@ def test_the_resolver_gives_the_includer_its_locals_back(tmp_path: Path) -> None
         "    return LaunchDescription([LogInfo(msg=[LaunchConfiguration('x'), ' ',"
         " ThisLaunchFileDir()])])\n"
     )
-    parent = tmp_path / "parent.launch.py"
-    description = LaunchDescription(
-        [
-            IncludeLaunchDescription(str(child), launch_arguments={"x": ThisLaunchFileDir()}),
-            LogInfo(msg=["after ", ThisLaunchFileDir(), " ", EnvironmentVariable("HOME")]),
-        ]
-    )
-    plan = resolve(
-        description, path=str(parent), arguments={}, environ=ENV, options=ResolveOptions()
-    )
+    include = IncludeLaunchDescription(str(child), launch_arguments={"x": ThisLaunchFileDir()})
+    include.origin = f"{tmp_path / 'parent.launch.py'}:7"
+    after = LogInfo(msg=["after ", ThisLaunchFileDir(), " ", EnvironmentVariable("HOME")])
+    after.origin = f"{tmp_path / 'parent.launch.py'}:8"
+    return LaunchDescription([include, after]), tmp_path / "parent.launch.py"
+
+
+def test_an_include_leaves_the_locals_at_the_included_file_as_jazzy(tmp_path: Path) -> None:
+    """ros2/launch#618 in Jazzy: the argument and the action after the include see the
+    included file's folder; mlaunch says so once at each place, naming the opt-in."""
+    description, parent = _includer_and_child(tmp_path)
+    plan = resolve(description, path=str(parent), arguments={}, environ=ENV)
+    messages = [s.message for s in plan.steps if isinstance(s, Log)]
+    sub = tmp_path / "sub"
+    assert messages == [f"{sub} {sub}", f"after {sub} /home/u"]
+    warned = [w for w in plan.warnings if "ThisLaunchFileDir" in w]
+    assert [w.split(": ")[0] for w in warned] == [f"{parent}:7", f"{parent}:8"]
+    assert all("--scoped-file-locals" in w and f"includer's {tmp_path}" in w for w in warned)
+
+
+def test_scoped_file_locals_give_the_includer_its_locals(tmp_path: Path) -> None:
+    """PR #862's rule, on request: the argument and what follows are the includer's."""
+    description, parent = _includer_and_child(tmp_path)
+    options = ResolveOptions(scoped_file_locals=True)
+    plan = resolve(description, path=str(parent), arguments={}, environ=ENV, options=options)
     messages = [s.message for s in plan.steps if isinstance(s, Log)]
     assert messages == [f"{tmp_path} {tmp_path / 'sub'}", f"after {tmp_path} /home/u"]
+    assert not [w for w in plan.warnings if "ThisLaunchFileDir" in w]
+
+
+def test_the_comment_in_the_includer_scopes_its_includes(tmp_path: Path) -> None:
+    description, parent = _includer_and_child(tmp_path)
+    parent.write_text("# mlaunch: scoped-file-locals\n")
+    plan = resolve(description, path=str(parent), arguments={}, environ=ENV)
+    messages = [s.message for s in plan.steps if isinstance(s, Log)]
+    assert messages == [f"{tmp_path} {tmp_path / 'sub'}", f"after {tmp_path} /home/u"]
+
+
+def test_no_warning_where_both_rules_agree(tmp_path: Path) -> None:
+    """ThisLaunchFileDir inside the included file is its own under either rule."""
+    description, parent = _includer_and_child(tmp_path)
+    del description.entities[1]
+    include = description.entities[0]
+    assert isinstance(include, IncludeLaunchDescription)
+    include.launch_arguments = [("x", "given")]
+    plan = resolve(description, path=str(parent), arguments={}, environ=ENV)
+    assert [s.message for s in plan.steps if isinstance(s, Log)] == [f"given {tmp_path / 'sub'}"]
+    assert not [w for w in plan.warnings if "ThisLaunchFileDir" in w]
 
 
 def test_a_default_outside_the_choices_is_refused_when_declared() -> None:

@@ -52,6 +52,7 @@ class Options:
         self.use_sim_time = use_sim_time
         self.capture = False  # --capture-at-definition (mlaunch.resolve.binding)
         self.scoped_parameters = False  # --scoped-parameters (mlaunch.launch_ros.scope)
+        self.scoped_file_locals = False  # --scoped-file-locals (mlaunch.launch.file_locals)
         self.ros: int | None = None  # --ros1 / --ros2: how a roslaunch file runs (None: by env)
         self.package_path: list[str] = [] if package_path is None else package_path
         self.standins = standins
@@ -196,6 +197,13 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         " 'mlaunch: scoped-parameters'",
     )
     parser.add_argument(
+        "--scoped-file-locals",
+        action="store_true",
+        help="keep an include's ThisLaunchFileDir/$(dirname) to the included file: its"
+        " arguments and the actions after it get the includer's (ros2 launch, as ros2/launch#618,"
+        " gives the included file's); per file: a comment 'mlaunch: scoped-file-locals'",
+    )
+    parser.add_argument(
         "--package-path",
         action="append",
         default=[],
@@ -327,6 +335,7 @@ def parse_options(argv: Sequence[str]) -> Options:
             f" arguments as {opts.format}"
         )
     opts.scoped_parameters = ns.scoped_parameters
+    opts.scoped_file_locals = ns.scoped_file_locals
     opts.ros = ns.ros
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):

@@ -123,6 +123,7 @@ def resolve_for_run(
         temp_dir=temp_dir,
         capture=opts.capture,
         scoped_parameters=opts.scoped_parameters,
+        scoped_file_locals=opts.scoped_file_locals,
         dry_run=opts.print_plan,
     )
     if opts.use_sim_time is not None:

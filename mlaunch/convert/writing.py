@@ -286,12 +286,16 @@ def eval_pieces(part: EvalRef) -> Value:
 
 
 # ROS 1 global parameters belong to their group; ROS 2's SetParameter in a scoped group also
-# reaches the nodes after it. The comment keeps ROS 1's meaning under mlaunch
-# (mlaunch.resolve.binding).
+# reaches the nodes after it. roslaunch's $(dirname) in an include's arg, and after the include,
+# is the includer's folder; ros2 launch (Jazzy) gives the included file's. The comments keep
+# ROS 1's meaning under mlaunch (mlaunch.launch_ros.scope, mlaunch.launch.file_locals).
 SCOPED_NOTE = (
     "{c} ROS 1 group parameters stay in their group under mlaunch (the comment below);\n"
     "{c} under ros2 launch a SetParameter in a group also reaches the nodes after it.\n"
     "{c} mlaunch: scoped-parameters\n"
+    "{c} $(dirname) in an include's argument, and after it, stays this file's folder under\n"
+    "{c} mlaunch (the comment below); under ros2 launch it is the included file's.\n"
+    "{c} mlaunch: scoped-file-locals\n"
 )
 
 

@@ -16,7 +16,7 @@ from mlaunch.plan.steps import Deferred, Plan, Spawn, step_needs
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
-    from typing import TypeVar
+    from typing import Any, TypeVar
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.plan.planner import Planner
@@ -34,6 +34,7 @@ class StandaloneOptions:
     temp_dir: str | None = None
     capture = False
     scoped_parameters = False
+    scoped_file_locals = False
 
 
 class StandalonePlanner:
@@ -44,6 +45,8 @@ class StandalonePlanner:
         self.plan = Plan()
         self.options = StandaloneOptions()
         self._labels = itertools.count(1)
+        self._scoped: dict[int, tuple[dict[str, str], dict[str, Any]]] = {}
+        self.visiting = ""  # the origin of the action being visited (what warnings name)
 
     def add(self, step: Step) -> None:
         self.plan.steps.append(step)
@@ -89,9 +92,19 @@ class StandalonePlanner:
             raise LaunchFileError(
                 f"{type(entity).__name__} ({entity!r:.60}) is not a launch action"
             )
-        more = visit(self.context)
-        if more:
-            self.visit_all(more)
+        scoped = self._scoped.pop(id(entity), None)
+        if scoped is not None:
+            self.context._locals.update(scoped[0])
+        outer = self.visiting
+        self.visiting = getattr(entity, "origin", None) or outer
+        try:
+            more = visit(self.context)
+            if more:
+                self.visit_all(more)
+        finally:
+            self.visiting = outer
+            if scoped is not None:
+                self.context._locals = scoped[1]
 
     def visit_all(self, entities: Iterable[object]) -> None:
         for entity in entities:
@@ -100,8 +113,18 @@ class StandalonePlanner:
     def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
         return function(*args, **kwargs)
 
-    def include(self, description: object, path: str | None, origin: str) -> None:
-        """Nothing to track: the include's locals stay the included file's, as upstream's."""
+    def include(
+        self,
+        description: object,
+        path: str | None,
+        origin: str,
+        file_locals: dict[str, str],
+        scoped: bool,
+    ) -> None:
+        """Launch's rule needs nothing here (the include already set the file's locals, and they
+        stay); a scoped include's file gets its own, and the includer's after it."""
+        if scoped:
+            self._scoped[id(description)] = (file_locals, dict(self.context._locals))
 
     def load_source(self, source: object, origin: str) -> object:
         built = getattr(source, "launch_description", None)

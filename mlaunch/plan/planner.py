@@ -38,6 +38,9 @@ class PlanningOptions(Protocol):
     def scoped_parameters(self) -> bool: ...  # SetParameter stays in its scoped group
 
     @property
+    def scoped_file_locals(self) -> bool: ...  # an include's file locals stay in the include
+
+    @property
     def dry_run(self) -> bool: ...  # --print: a program not built is a warning, not an error
 
 
@@ -46,6 +49,9 @@ class Planner(Protocol):
 
     @property
     def options(self) -> PlanningOptions: ...
+
+    @property
+    def visiting(self) -> str: ...  # the origin of the action being visited (what warnings name)
 
     def add(self, step: Step) -> None:
         """Append a step to the plan being built."""
@@ -83,10 +89,20 @@ class Planner(Protocol):
     def call_user(self, function: Callable[..., R], *args: object, **kwargs: object) -> R:
         """Call launch-file code, locating its exceptions in the user's file."""
 
-    def include(self, description: object, path: str | None, origin: str) -> None:
+    def include(
+        self,
+        description: object,
+        path: str | None,
+        origin: str,
+        file_locals: dict[str, str],
+        scoped: bool,
+    ) -> None:
         """``description`` (what an include returns to visit next) is the file at ``path``
         (None: a description given as such): visited as an include (a cycle is an error, not
-        recursion), the includer's locals back after it."""
+        recursion), with ``file_locals`` (ThisLaunchFile ...) inside. ``scoped``: the includer's
+        locals are back after it (ros2/launch PR #862); otherwise they stay the file's, as in
+        Jazzy (the include already set them), and only mlaunch's record of the includer's own
+        locals comes back (what the warning of ThisLaunchFileDir compares with)."""
 
     def load_source(self, source: object, origin: str) -> object:
         """The LaunchDescription an include's source names, built or loaded from its file."""

@@ -2,7 +2,9 @@
 
 ``# mlaunch: capture-at-definition`` (timers and handlers take the values where they are written,
 mlaunch.resolve.binding) and ``# mlaunch: scoped-parameters`` (SetParameter and SetRemap stay in
-their group, mlaunch.launch_ros.scope): comments, so the file runs unchanged under ros2 launch.
+their group, mlaunch.launch_ros.scope) and ``# mlaunch: scoped-file-locals`` (an include's
+arguments and the actions after it keep the includer's ThisLaunchFileDir, mlaunch.launch.
+file_locals): comments, so the file runs unchanged under ros2 launch.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import re
 
 PRAGMA = "mlaunch: capture-at-definition"
 SCOPED_PARAMETERS = "mlaunch: scoped-parameters"
+SCOPED_FILE_LOCALS = "mlaunch: scoped-file-locals"
 
 _FILES: dict[str, str] = {}
 _PRAGMAS: dict[tuple[str, str], bool] = {}

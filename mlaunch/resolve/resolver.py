@@ -64,7 +64,15 @@ class ResolveOptions(Record):
     None for the default search); ``temp_dir`` is where params files are written.
     """
 
-    _fields = ("standins", "packages", "temp_dir", "capture", "scoped_parameters", "dry_run")
+    _fields = (
+        "standins",
+        "packages",
+        "temp_dir",
+        "capture",
+        "scoped_parameters",
+        "scoped_file_locals",
+        "dry_run",
+    )
     __slots__ = _fields
 
     def __init__(
@@ -75,6 +83,7 @@ class ResolveOptions(Record):
         capture: bool = False,
         scoped_parameters: bool = False,
         dry_run: bool = False,
+        scoped_file_locals: bool = False,
     ) -> None:
         self.standins = standins
         self.packages = packages
@@ -83,6 +92,8 @@ class ResolveOptions(Record):
         self.capture = capture
         # SetParameter(s)FromFile stay inside scoped groups (mlaunch.launch_ros.actions).
         self.scoped_parameters = scoped_parameters
+        # An include's ThisLaunchFileDir ... stays in the include (mlaunch.launch.file_locals).
+        self.scoped_file_locals = scoped_file_locals
         # --print: a program that is not built or installed is a warning and the plan is shown
         # (a dry run on a laptop); a run refuses it before anything starts.
         self.dry_run = dry_run
@@ -104,8 +115,10 @@ class Resolver:
         self.labels = labels
         self.options = options
         self.includes = IncludeChain()  # include cycles are errors, not a RecursionError
-        # The descriptions includes returned, not visited yet -> (file or None, include's origin)
-        self.included: dict[int, tuple[str | None, str]] = {}
+        # The descriptions includes returned, not visited yet -> (file or None, include's
+        # origin, the file's locals, whether they are scoped to it, the includer's locals)
+        self.included: dict[int, tuple[str | None, str, dict[str, str], bool, dict[str, Any]]] = {}
+        self.visiting = ""  # the origin of the action being visited (what warnings name)
         self.depth = 0
         allow_deep_trees()
         context.planner = self  # the seam: actions plan through their context (plan.planner)
@@ -118,6 +131,8 @@ class Resolver:
             origin = getattr(entity, "origin", None)
             raise too_deep(origin, "launch actions (groups, includes)", includes=self.includes)
         self.depth += 1
+        outer = self.visiting
+        self.visiting = getattr(entity, "origin", None) or outer
         try:
             included = self.included.pop(id(entity), None)
             if included is None:
@@ -126,10 +141,22 @@ class Resolver:
                 self._visit_included(entity, *included)
         finally:
             self.depth -= 1
+            self.visiting = outer
 
-    def _visit_included(self, description: object, path: str | None, origin: str) -> None:
+    def _visit_included(
+        self,
+        description: object,
+        path: str | None,
+        origin: str,
+        file_locals: dict[str, str],
+        scoped: bool,
+        before: dict[str, Any],
+    ) -> None:
         """An included description: in the chain of includes when it is a file's, with the
-        includer's locals back after it (the include pointed them at the file)."""
+        file's locals, and after it the includer's or launch's (mlaunch.launch.file_locals)."""
+        from mlaunch.launch.file_locals import enter, leave
+
+        enter(self.context, file_locals)
         try:
             if path is None:
                 self._visit(description)
@@ -137,7 +164,7 @@ class Resolver:
                 with self.includes.enter(path, origin, self.context):
                     self._visit(description)
         finally:
-            self.context._pop_locals()
+            leave(self.context, before, scoped)
 
     def _visit(self, entity: object) -> None:
         visit = getattr(entity, "visit", None)
@@ -223,9 +250,17 @@ class Resolver:
     def declare_argument(self, info: ArgumentInfo) -> ArgumentInfo:
         return self.plan.arguments.setdefault(info.name, info)
 
-    def include(self, description: object, path: str | None, origin: str) -> None:
-        self.context._push_locals()  # the includer's, before the include points them at the file
-        self.included[id(description)] = (path, origin)
+    def include(
+        self,
+        description: object,
+        path: str | None,
+        origin: str,
+        file_locals: dict[str, str],
+        scoped: bool,
+    ) -> None:
+        # the includer's locals, before the include points them at the file
+        before = dict(self.context._locals)
+        self.included[id(description)] = (path, origin, file_locals, scoped, before)
 
     def new_label(self, base: str) -> str:
         return self.labels.next(base)

@@ -138,7 +138,9 @@ def _action(item: Item) -> Any:
     if isinstance(item, Include):
         source = RoslaunchSource(subs(item.path))
         arguments = [(name, subs(value)) for name, value in item.arguments]
-        return core.IncludeLaunchDescription(source, launch_arguments=arguments)
+        include = core.IncludeLaunchDescription(source, launch_arguments=arguments)
+        include.keep_file_locals = True  # roslaunch's $(dirname) in an arg is the includer's
+        return include
     if isinstance(item, MachineItem):
         from mlaunch.machines.actions import Machine
 

@@ -15,9 +15,10 @@ SetLaunchConfigurations and its actions.
 An include (``IncludeLaunchDescription``) returns a SetLaunchConfiguration for each argument
 given, then the included description. Before returning, it checks that each argument the
 description requires is given, and points the locals (ThisLaunchFile, ThisLaunchFileDir ...) at
-the included file. The planner is told which description is the included file's
-(``Planner.include``): the resolver visits it in the chain of includes (a cycle is an error)
-and gives the includer its own locals back after it.
+the included file, as Jazzy's does, for the arguments and what follows too (mlaunch.launch.
+file_locals; opt-in: the includer's). The planner is told which description is the included
+file's (``Planner.include``): the resolver visits it in the chain of includes (a cycle is an
+error) with the file's locals.
 
 The stack of scopes: mlaunch's context keeps one stack, each entry the configurations and the
 environment together (``LaunchContext.push_scope``). PushLaunchConfigurations and
@@ -29,8 +30,6 @@ push kept.
 """
 
 from __future__ import annotations
-
-import os
 
 from mlaunch.launch.launch_description import Action
 from mlaunch.launch.substitutions import normalize, perform, perform_substitutions, to_bool
@@ -184,6 +183,10 @@ class IncludeLaunchDescription(Action):
     the included file's configurations and environment changes from leaking out.
     """
 
+    # mlaunch's: True keeps the file locals to the include (its arguments and the actions after
+    # it get the includer's) even without --scoped-file-locals: ROS 1 files' includes.
+    keep_file_locals = False
+
     def __init__(
         self,
         launch_description_source: Any,
@@ -209,21 +212,21 @@ class IncludeLaunchDescription(Action):
         return [] if found is None else [found]
 
     def execute(self, context: LaunchContext) -> list[Any]:
+        from mlaunch.launch import file_locals
+
         planner = context.planner
         source = self.launch_description_source
         path = source.get_launch_file_location(context)
-        # The arguments are the includer's: performed here, before the locals are the file's.
-        args = [(perform(context, k), perform(context, v)) for k, v in self.launch_arguments]
         description = planner.load_source(source, origin=self.origin)
-        self._check_required(description, [name for name, _ in args])
-        planner.include(description, path, self.origin)
-        location = source.expand_location(context)
-        absolute = os.path.abspath(location)
-        directory = os.path.dirname(absolute) if os.path.exists(absolute) else location
-        context.extend_locals(
-            {"current_launch_file_path": absolute, "current_launch_file_directory": directory}
+        included = file_locals.of_location(source.expand_location(context))
+        scoped = file_locals.is_scoped(context, self)
+        planner.include(description, path, self.origin, included, scoped)
+        if not scoped:  # Jazzy: the arguments, and what follows the include, see the file's
+            file_locals.point_at(context, included)
+        self._check_required(
+            description, [perform(context, name) for name, _ in self.launch_arguments]
         )
-        sets: list[Action] = [SetLaunchConfiguration(name, value) for name, value in args]
+        sets: list[Action] = [SetLaunchConfiguration(k, v) for k, v in self.launch_arguments]
         if not self.scoped:
             return [*placed(sets, self.origin), description]
         opening = [PushLaunchConfigurations(), PushEnvironment(), *sets]

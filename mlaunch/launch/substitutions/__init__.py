@@ -130,7 +130,7 @@ class ThisLaunchFile(Substitution):
         path = context.current_launch_file_path
         if path is None:
             raise SubstitutionFailure("ThisLaunchFile used outside of a launch file")
-        return path
+        return _checked(context, "current_launch_file_path", path, "ThisLaunchFile")
 
     def describe(self) -> str:
         return "ThisLaunchFile()"
@@ -143,7 +143,9 @@ class ThisLaunchFileDir(Substitution):
         # The local launch sets with the file (a script may set it itself, as launch's tests do).
         directory = context.locals.get("current_launch_file_directory")
         if directory is not None:
-            return str(directory)
+            return _checked(
+                context, "current_launch_file_directory", str(directory), "ThisLaunchFileDir"
+            )
         path = context.current_launch_file_path
         if path is None:
             raise SubstitutionFailure("ThisLaunchFileDir used outside of a launch file")
@@ -151,6 +153,16 @@ class ThisLaunchFileDir(Substitution):
 
     def describe(self) -> str:
         return "ThisLaunchFileDir()"
+
+
+def _checked(context: LaunchContext, key: str, value: str, what: str) -> str:
+    """``value``, with mlaunch.launch.file_locals's warning when it is an included file's that
+    PR #862's rule would not give (only then is that module loaded)."""
+    if "mlaunch_own_file_locals" not in getattr(context, "_locals", ()):
+        return value
+    from mlaunch.launch.file_locals import checked
+
+    return checked(context, key, value, what)
 
 
 class LaunchLogDir(Substitution):
