@@ -24,7 +24,7 @@ from mlaunch.plan.steps import OUTPUT_MODES, Deferred, ProcessSpec, RespawnPolic
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Iterable
+    from collections.abc import Iterable, Mapping
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
@@ -459,7 +459,7 @@ class ExecuteLocal(ExecuteProcess):
         self.process_description = process_description
 
 
-def which(name: str, env: dict[str, str]) -> str | None:
+def which(name: str, env: Mapping[str, str]) -> str | None:
     from mlaunch.launch.substitutions import which as which_on_path
 
     return which_on_path(name, env.get("PATH", os.defpath))

@@ -1,8 +1,10 @@
 """The launch context: what substitutions and conditions are evaluated against while resolving.
 
-Unlike ROS 2, ``environment`` is a copy owned by the context, never the launcher's own
-``os.environ``: SetEnvironmentVariable changes what later children get, and a scoped group or a
-deferred action restores or captures it without touching the launcher process.
+A run's context (resolve always gives one an environment) owns a copy: SetEnvironmentVariable
+changes what later children get, and a scoped group or a deferred action restores or captures it
+without touching the launcher process. A context made without one (``LaunchContext()`` in a
+script or a unit test of an extension) works on ``os.environ`` itself, as launch's does: what its
+actions set is in ``os.environ``, and PopEnvironment restores it in place.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ import os
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable, Mapping, Sequence
+    from collections.abc import Callable, Mapping, MutableMapping, Sequence
     from typing import Any
 
     from mlaunch.plan.planner import Planner
@@ -65,11 +67,11 @@ class LaunchContext:
         planner: Planner | None = None,
     ) -> None:
         self.launch_configurations: dict[str, Any] = {}
-        # A copy of the launcher's environment unless the caller gives one (resolve always does).
-        self.environment: dict[str, str] = dict(
-            environment if environment is not None else os.environ
+        # A copy of what the caller gives (resolve always does); else os.environ itself, as launch.
+        self._environment: MutableMapping[str, str] = (
+            dict(environment) if environment is not None else os.environ
         )
-        self.initial_environment: dict[str, str] = dict(self.environment)
+        self.initial_environment: dict[str, str] = dict(self._environment)
         self.argv: list[str] = list(argv or ())
         self.noninteractive = noninteractive
         self.log_dir = log_dir
@@ -89,6 +91,22 @@ class LaunchContext:
         self._warn = warn
         self._planner = planner
         self._events: Any = None  # the asyncio.Queue of _event_queue, made when first asked for
+
+    @property
+    def environment(self) -> MutableMapping[str, str]:
+        """The environment children get: a copy of the run's, or ``os.environ`` when not given."""
+        return self._environment
+
+    @environment.setter
+    def environment(self, value: Mapping[str, str]) -> None:
+        if self._environment is os.environ:
+            if value is not os.environ:
+                # In place, as launch restores os.environ: a copy first, value may be a view of it.
+                values = dict(value)
+                os.environ.clear()
+                os.environ.update(values)
+        else:
+            self._environment = dict(value)
 
     # --- the seam to planning (mlaunch.plan.planner) ----------------------------------------
 

@@ -77,7 +77,7 @@ class PopLaunchConfigurations(Action):
     environment stays as it is (see the module docstring)."""
 
     def execute(self, context: LaunchContext) -> None:
-        environment = context.environment
+        environment = dict(context.environment)  # a copy: a context on os.environ pops in place
         context.pop_scope()
         context.environment = environment
 
