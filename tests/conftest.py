@@ -1,13 +1,15 @@
-"""Shared fixtures: a private ROS domain per test, and the rclpy availability check."""
+"""Shared fixtures: a private ROS domain per test, the rclpy availability check, and the lock
+that lets a test marked ``serial`` run alone under pytest-xdist."""
 
 from __future__ import annotations
 
 import importlib.util
 import os
 import sys
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from pathlib import Path
 
+import alone
 import pytest
 from ros_domain import claim as claim_domain
 
@@ -36,6 +38,18 @@ HAVE_RCLPY = importlib.util.find_spec("rclpy") is not None
 requires_rclpy = pytest.mark.skipif(
     not HAVE_RCLPY, reason="rclpy is not installed: pip install -e '.[ros]' to run the ROS tests"
 )
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_protocol(
+    item: pytest.Item, nextitem: pytest.Item | None
+) -> Generator[None, object, object]:
+    """Under pytest-xdist, a test marked ``serial`` runs alone (tests/alone.py says why)."""
+    folder = alone.lock_folder(item.config)
+    if folder is None:
+        return (yield)
+    with alone.turn(folder, item.get_closest_marker(alone.MARKER) is not None):
+        return (yield)
 
 
 @pytest.fixture

@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from ports import free_port
 from procutil import wait_until
 
 SSHD = shutil.which("sshd") or ("/usr/sbin/sshd" if os.path.exists("/usr/sbin/sshd") else None)
@@ -57,12 +58,6 @@ def _keygen(path: Path) -> str:
     return path.with_suffix(".pub").read_text().strip()
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
-
-
 def _wait_listening(address: str, port: int, process: subprocess.Popen[bytes], log: Path) -> None:
     def listening() -> bool:
         if process.poll() is not None:
@@ -91,7 +86,7 @@ def start(
     host_pub = _keygen(root / "host_key")
     client_pub = _keygen(root / "client_key")
     (root / "authorized_keys").write_text(client_pub + "\n")
-    port = _free_port()
+    port = free_port()
     (root / "sshd_config").write_text(
         f"Port {port}\nListenAddress {address}\nHostKey {root / 'host_key'}\n"
         f"AuthorizedKeysFile {root / 'authorized_keys'}\nPidFile {root / 'sshd.pid'}\n"

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 from conftest import requires_rclpy
+from ports import free_port
 from procutil import Running, clean_env, demo_package, mlaunch, run_mlaunch
 
 from mlaunch import __version__
@@ -237,9 +238,7 @@ def test_quiet_launch_shows_the_viewer_address_on_the_chosen_port(
 ) -> None:
     path = tmp_path / "view.launch.py"
     path.write_text(VIEWER_LAUNCH)
-    with socket.socket() as free:
-        free.bind(("127.0.0.1", 0))
-        port = free.getsockname()[1]
+    port = free_port()
     env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
     env["ROS_LOG_DIR"] = str(tmp_path / "logs")
     run = Running(mlaunch(str(path), "-q", "--viewer-port", str(port)), env=env, cwd=str(tmp_path))

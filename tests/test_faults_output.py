@@ -14,6 +14,7 @@ import threading
 import time
 from pathlib import Path
 
+import pytest
 from test_output_flow import deadline_sleep, flood_code
 from test_supervision import Harness, make_spec
 
@@ -53,6 +54,7 @@ class PacedReader(threading.Thread):
             deadline_sleep(now + self.every)
 
 
+@pytest.mark.serial  # a quiet line's lag, in seconds
 def test_a_flooding_child_does_not_stall_a_quiet_ones_lines() -> None:
     # ~320 KB/s: the flood (~1.5 MB) takes seconds to pass; a whole 1 MiB backlog ahead of a
     # quiet line would hold it ~3 s. Per-process flow control keeps it near 32 KiB, ~0.1 s.

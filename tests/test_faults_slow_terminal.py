@@ -8,6 +8,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import pytest
 from test_faults import Mlaunch, proc, write_launch
 from test_faults_output import PacedReader
 
@@ -32,6 +33,7 @@ for i in range({SECONDS}):
 """
 
 
+@pytest.mark.serial  # a quiet line's lag, in seconds
 def test_a_quiet_line_is_never_a_second_behind_a_flood_on_a_30_kb_s_terminal(
     tmp_path: Path,
 ) -> None:

@@ -65,6 +65,7 @@ def check_tf_tree(env: dict[str, str]) -> None:
     assert parents["camera_depth_frame"] == "camera_link"
 
 
+@pytest.mark.serial  # how long Ctrl-C takes
 def test_jtbot_sim_end_to_end(ros_env: dict[str, str], tmp_path: Path) -> None:
     env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
     env["ROS_LOG_DIR"] = str(tmp_path / "log")

@@ -14,10 +14,10 @@ from typing import Any
 
 import pytest
 import sshd as sshd_server
+from ports import free_port
 from procutil import Running, wait_for
 from ros1tree import package_tree, requires_roslaunch
 from sshd import HOST_ALIAS, Server
-from test_ros1_native import free_port
 from test_ros1_smoke import NODES
 
 REPO = Path(__file__).resolve().parent.parent

@@ -8,13 +8,13 @@ import os
 import re
 import shutil
 import signal
-import socket
 import sys
 import xmlrpc.client
 from pathlib import Path
 from typing import Any
 
 import pytest
+from ports import free_port
 from procutil import Running, wait_for
 from ros1tree import SYSTEM_PYTHON, package_tree, requires_roslaunch
 
@@ -29,13 +29,6 @@ pytestmark = [
         reason="Debian's rosmaster, rosout and robot_state_publisher are not installed",
     ),
 ]
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port: int = s.getsockname()[1]
-        return port
 
 
 def master(port: int) -> Any:

@@ -13,8 +13,8 @@ import xmlrpc.client
 from pathlib import Path
 
 import pytest
+from ports import free_port
 from ros1tree import package_tree, requires_roslaunch
-from test_ros1_native import free_port
 
 REPO = Path(__file__).resolve().parent.parent
 NODES = (

@@ -406,6 +406,7 @@ def test_system_fails_precisely(
 
 
 @requires_rclpy
+@pytest.mark.serial  # a measured rate of 2-3 Hz
 def test_yaml_system_declares_its_expectations_and_sequence(ros_env: dict[str, str]) -> None:
     yaml_file = str(LAUNCHES / "smoke_system.launch.yaml")
     done = _smoke(ros_env, yaml_file, f"python:={sys.executable}")
