@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import signal
 import sys
 from collections.abc import Generator, Iterator
 from pathlib import Path
@@ -33,6 +34,14 @@ _kept = [
 ]
 if "AMENT_PREFIX_PATH" in os.environ:
     os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join(_kept)
+
+# A shell without job control starts `cmd &` with SIGINT ignored (POSIX), and an ignored signal
+# stays ignored in every child: a suite started so from a script would give the launchers its
+# tests stop with Ctrl-C's SIGINT (ros2 launch, roslaunch, the stand-ins) no way to hear it, and
+# each of those runs would wait out its stop deadline before the SIGKILL (14 reference recordings
+# took 44 s each instead of 8). The children must see a terminal's default.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 HAVE_RCLPY = importlib.util.find_spec("rclpy") is not None
 requires_rclpy = pytest.mark.skipif(
