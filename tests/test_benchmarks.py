@@ -148,7 +148,6 @@ def _left_behind(domain: str) -> list[str]:
     return found
 
 
-@pytest.mark.serial  # its rows are timings, checked against their targets
 def test_quick_run(tmp_path: Path, ros_env: dict[str, str]) -> None:
     """One quick run in the project venv (the plain venv takes a minute to create once)."""
     out = tmp_path / "bench.json"

@@ -131,6 +131,7 @@ def child_lines(data: bytes, label: str, tag: str) -> list[int]:
 # --- the screen -----------------------------------------------------------------------------------
 
 
+@pytest.mark.serial  # the reader keeps up only with a core to itself
 def test_a_reader_that_keeps_up_gets_every_line(tmp_path: Path) -> None:
     n = 250_000
     specs = [make_spec(f"f{i}", flood_code(n, "line")) for i in range(4)]
@@ -162,6 +163,7 @@ def test_a_slow_reader_slows_the_children_down_and_loses_nothing(tmp_path: Path)
     assert screen.peak <= screen.limit
 
 
+@pytest.mark.serial  # how long a child was held, in seconds
 def test_a_stalled_reader_costs_screen_lines_only_after_the_stall_time(tmp_path: Path) -> None:
     n = 300_000  # ~7 MB per child: far more than the 1 MiB backlog
     stamps = [tmp_path / f"stamp{i}" for i in range(2)]
@@ -359,6 +361,7 @@ def test_an_orphan_from_before_the_subreaper_is_found_by_its_marker(monkeypatch:
 # --- through the command line -----------------------------------------------------------------------
 
 
+@pytest.mark.serial  # the reader keeps up only with a core to itself
 def test_cli_flood_to_a_pipe_that_keeps_up_loses_nothing(tmp_path: Path) -> None:
     n = 250_000
     launch = tmp_path / "flood.launch.py"
