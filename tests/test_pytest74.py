@@ -10,6 +10,7 @@ reference. Skipped, saying why, when the package index cannot be reached.
 
 from __future__ import annotations
 
+import fcntl
 import os
 import shutil
 import subprocess
@@ -72,7 +73,15 @@ def old_pytest_env() -> dict[str, str]:
     folder = CACHE / f"pytest-{VERSION}"
     if not (folder / "pytest").is_dir():
         folder.parent.mkdir(parents=True, exist_ok=True)
-        _install(folder)
+        # One install at a time: the suite's xdist workers (or another run) that find the
+        # folder missing too wait for this one instead of downloading it again.
+        lock = os.open(folder.with_name(f"{folder.name}.lock"), os.O_CREAT | os.O_RDWR, 0o666)
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX)
+            if not (folder / "pytest").is_dir():
+                _install(folder)
+        finally:
+            os.close(lock)
     env = clean_env(PYTHONPATH=str(folder))
     shown = subprocess.run(
         [sys.executable, "-m", "pytest", "--version"],
