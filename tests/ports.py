@@ -9,9 +9,9 @@ this process ends, so no two tests of any run on this machine are given the same
 
 from __future__ import annotations
 
-import fcntl
-import os
 import socket
+
+from ros_domain import try_lock
 
 _held: list[int] = []  # the claims' descriptors: closing one would free its port for others
 TRIES = 50
@@ -23,11 +23,8 @@ def free_port() -> int:
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
             port = int(s.getsockname()[1])
-        fd = os.open(f"/tmp/mlaunch-port-{port}.lock", os.O_CREAT | os.O_RDWR, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
+        fd = try_lock(f"/tmp/mlaunch-port-{port}.lock")
+        if fd is None:
             continue
         _held.append(fd)
         return port

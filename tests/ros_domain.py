@@ -16,6 +16,18 @@ from contextlib import contextmanager
 FIRST, LAST = 101, 199  # inside ROS 2's valid range, away from the default 0
 
 
+def try_lock(path: str) -> int | None:
+    """A descriptor of ``path`` holding its exclusive lock, or None when another process holds
+    it; the lock lasts until the descriptor is closed (tests/ports.py claims ports so too)."""
+    fd = os.open(path, os.O_CREAT | os.O_RDWR, 0o666)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
 def claim(skip: Callable[[int], bool] | None = None) -> tuple[int, int]:
     """(domain, fd): a domain no other run holds; it stays held until ``fd`` is closed.
 
@@ -24,11 +36,8 @@ def claim(skip: Callable[[int], bool] | None = None) -> tuple[int, int]:
     ids = list(range(FIRST, LAST + 1))
     random.shuffle(ids)
     for domain in ids:
-        fd = os.open(f"/tmp/mlaunch-ros-domain-{domain}.lock", os.O_CREAT | os.O_RDWR, 0o666)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
+        fd = try_lock(f"/tmp/mlaunch-ros-domain-{domain}.lock")
+        if fd is None:
             continue
         if skip is not None and skip(domain):
             os.close(fd)

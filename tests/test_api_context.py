@@ -257,8 +257,10 @@ class _ContextLike:
 
 
 def test_descriptions_and_sources_work_with_a_context_that_has_no_planner(
-    tmp_path: Path, caplog: pytest.LogCaptureFixture
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    import logging
+
     from launch import LaunchDescription
     from launch.actions import LogInfo
     from launch.launch_description_sources import (
@@ -266,6 +268,10 @@ def test_descriptions_and_sources_work_with_a_context_that_has_no_planner(
         PythonLaunchDescriptionSource,
     )
 
+    # Once launch.logging is imported, a logger first asked for after it is a LaunchLogger, which
+    # does not propagate to caplog's handler: whether "launch" is one depends on which tests ran
+    # earlier in this process (under xdist, a different set), so the capture must not.
+    monkeypatch.setattr(logging.getLogger("launch"), "propagate", True)
     described = LaunchDescription([LogInfo(msg="x")], deprecated_reason="use other.launch.py")
     assert described.visit(_ContextLike()) == described.entities  # type: ignore[arg-type]
     assert "deprecated: use other.launch.py" in caplog.text

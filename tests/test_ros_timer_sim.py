@@ -11,13 +11,13 @@ from typing import Any
 
 import pytest
 from conftest import requires_rclpy
-from procutil import wait_until
 from test_launch_service import DEADLINE, Screen
 
 from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import LaunchDescription, OpaqueFunction
 from mlaunch.launch_ros.actions import SetUseSimTime
 from mlaunch.launch_ros.actions.ros_timer import ROSTimer
+from mlaunch.parts.ros_clock import RosClock
 
 pytestmark = requires_rclpy
 
@@ -101,13 +101,25 @@ def test_without_sim_time_a_ros_timer_counts_wall_time() -> None:
     assert time.monotonic() - started >= 0.2
 
 
-def test_a_waiting_sim_time_timer_is_cancelled_by_shutdown(ros_env: dict[str, str]) -> None:
+def test_a_waiting_sim_time_timer_is_cancelled_by_shutdown(
+    ros_env: dict[str, str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Nothing publishes /clock: the timer waits, keeps the launch running, and shutdown()
     ends it without running its actions."""
+    # The part's thread ends once its graph is up: ~20 ms when an earlier test of this process
+    # imported rclpy (under xdist, a polling check missed it). Its start is noted instead.
+    graph_started = threading.Event()
+    start_graph = RosClock._start_graph
+
+    def noted(part: RosClock) -> None:
+        graph_started.set()
+        start_graph(part)
+
+    monkeypatch.setattr(RosClock, "_start_graph", noted)
     service, fired = timed_launch(True, 5.0)
     thread = service.run_in_thread()
     # The wait was handed to the ROS clock part, and keeps the otherwise idle launch running.
-    assert wait_until(lambda: "mlaunch-ros-clock" in [t.name for t in threading.enumerate()])
+    assert graph_started.wait(DEADLINE)
     assert thread.is_alive()
     service.shutdown()
     thread.join(DEADLINE)
