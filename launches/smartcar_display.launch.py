@@ -8,6 +8,9 @@ file with mlaunch resolves to the same plan as this file.
 # ROS 1 group parameters stay in their group under mlaunch (the comment below);
 # under ros2 launch a SetParameter in a group also reaches the nodes after it.
 # mlaunch: scoped-parameters
+# $(dirname) in an include's argument, and after it, stays this file's folder under
+# mlaunch (the comment below); under ros2 launch it is the included file's.
+# mlaunch: scoped-file-locals
 
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess, GroupAction
