@@ -619,6 +619,21 @@ def test_duplicate_full_names_warn_with_location(prefix: Path, temp_dir: str) ->
     assert second.origin.startswith(THIS + ":")
 
 
+def test_nodes_without_a_namespace_are_not_counted(prefix: Path, temp_dir: str) -> None:
+    """launch_ros counts a node's name only when its namespace is given or pushed."""
+    bare = [Node(package="demo", executable="talker", name="t") for _ in range(2)]
+    pushed = [
+        PushRosNamespace("p"),
+        *(Node(package="demo", executable="talker", name="t") for _ in "ab"),
+    ]
+    plan = run([*bare, GroupAction(pushed)], prefix, temp_dir)
+    dup = [w for w in plan.warnings if "nodes with the name" in w]
+    assert dup == [
+        f"{pushed[2].origin}: there are now at least 2 nodes with the name /p/t created within"
+        " this launch context"
+    ]
+
+
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [

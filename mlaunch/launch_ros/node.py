@@ -431,12 +431,12 @@ class Node(ExecuteProcess):
     def _track_name(self, ctx: LaunchContext, names: NodeNames) -> None:
         """Warn when a second node gets the same full name (launch_ros's per-launch count).
 
-        The count lives in the run's context globals, as launch_ros keeps it. Counted for every
-        named node (namespace '/' when none is given); launch_ros only counts nodes whose
-        namespace is given too.
+        The count lives in the run's context globals, as launch_ros keeps it. As there, only a
+        node whose name and namespace are both given (or pushed) is counted: launch_ros leaves
+        a node without either out of the count, and so out of the warning.
         """
         fqn = names.fully_qualified
-        if fqn is None:
+        if fqn is None or names.namespace is None:
             return
         counts = node_name_counts(ctx)
         counts[fqn] = counts.get(fqn, 0) + 1
