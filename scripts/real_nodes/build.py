@@ -71,6 +71,7 @@ PACKAGES: tuple[tuple[str, str, str], ...] = (
     ("demos", "demo_nodes_cpp", "demo_nodes_cpp"),
     ("demos", "composition", "composition"),
 )
+NOT_BUILT = ("install", "python_packages.py")
 JOBS = 2  # the machines this runs on share 2 cores between several builds and test runs
 SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages/"
 # Debian's libpython (package libpython3.X): see _cmake_arguments.
@@ -128,17 +129,21 @@ def _tool_versions() -> bytes:
 
 
 def build_key(sources: Path, interfaces: Path) -> str:
-    """The cache key: the archives, every file here, the pins, the interface wheels, the tools."""
+    """The cache key: the archives built from, every file here, the pins, the interface wheels,
+    the tools. Other archives of the folder (a pure Python package's: python_packages.py) are
+    not in it, so adding one rebuilds nothing here."""
     parts = [ib._interpreter(), _tool_versions(), str(LIBPYTHON).encode()]
-    for stem in sorted(read_manifest(sources)):
+    read_manifest(sources)  # names the archives that are missing
+    for stem in sorted({stem for stem, _, _ in PACKAGES if stem != "vendor"}):
         parts += [stem.encode(), (sources / f"{stem}.tar.gz").read_bytes()]
     shared = [
         ROOT / "interfaces" / "toolchain.txt",
         ROOT / "interfaces" / "drop_missing_includes.cmake",
     ]
     for path in [*sorted(HERE.rglob("*")), *shared]:
-        # `install` (setup's side: Debian packages, pip) does not change what is built.
-        if path.is_file() and "__pycache__" not in path.parts and path.name != "install":
+        # `install` (setup's side: Debian packages, pip) does not change what is built, nor does
+        # python_packages.py (the pure Python packages: a wheel with its own key).
+        if path.is_file() and "__pycache__" not in path.parts and path.name not in NOT_BUILT:
             parts += [path.relative_to(ROOT).as_posix().encode(), path.read_bytes()]
     parts.append(interfaces.resolve().name.encode())  # wheels-KEY: the interfaces' own key
     return ib._digest(parts)
@@ -264,13 +269,21 @@ def build_package(source: Path, name: str, venv: Path, prefix: Path, work: Path)
     (build / ".mlaunch-installed").write_text("")
 
 
-def pack_wheel(prefix: Path, out: Path, manifest: dict[str, tuple[str, str]]) -> Path:
+def pack_wheel(
+    prefix: Path,
+    out: Path,
+    manifest: dict[str, tuple[str, str]],
+    *,
+    dist: str = DIST,
+    names: str = ", ".join(name for _, _, name in PACKAGES),
+) -> Path:
     """Packs the install prefix as one wheel: site-packages at the root, the rest as data.
 
     Each entry keeps its file's mode bits: without them pip installs the programs as 0644
-    and running one is "Permission denied".
+    and running one is "Permission denied". ``dist`` and ``names`` (the ROS packages in it)
+    name the wheel; ``manifest`` gives the repositories and commits it was built from.
     """
-    info_dir, data_dir = f"{DIST}-{VERSION}.dist-info/", f"{DIST}-{VERSION}.data/data/"
+    info_dir, data_dir = f"{dist}-{VERSION}.dist-info/", f"{dist}-{VERSION}.data/data/"
     entries: list[tuple[str, bytes, int]] = []
     for path in sorted(prefix.rglob("*")):
         rel = path.relative_to(prefix).as_posix()
@@ -281,10 +294,9 @@ def pack_wheel(prefix: Path, out: Path, manifest: dict[str, tuple[str, str]]) ->
     sources = "".join(
         f"Source: {repo} {commit}\n" for repo, commit in sorted(set(manifest.values()))
     )
-    names = ", ".join(name for _, _, name in PACKAGES)
     metadata = (
-        f"Metadata-Version: 2.1\nName: {DIST.replace('_', '-')}\nVersion: {VERSION}\n"
-        f"Summary: ROS 2 Jazzy C++ packages built by mlaunch's setup: {names}\n"
+        f"Metadata-Version: 2.1\nName: {dist.replace('_', '-')}\nVersion: {VERSION}\n"
+        f"Summary: ROS 2 Jazzy packages built by mlaunch's setup: {names}\n"
         "Requires-Dist: ros-jazzy-rclpy\nRequires-Dist: ros-jazzy-rcl-action\n"
         f"Requires-Dist: ros-jazzy-rcl-lifecycle\n{sources}"
     )
@@ -302,7 +314,7 @@ def pack_wheel(prefix: Path, out: Path, manifest: dict[str, tuple[str, str]]) ->
         writer.writerow(ib._record_line(arcname, data))
     writer.writerow([info_dir + "RECORD", "", ""])
     entries.append((info_dir + "RECORD", record.getvalue().encode(), 0o644))
-    target = out / f"{DIST}-{VERSION}-{ib.wheel_tag()}.whl"
+    target = out / f"{dist}-{VERSION}-{ib.wheel_tag()}.whl"
     with zipfile.ZipFile(target, "w", zipfile.ZIP_DEFLATED) as archive:
         for arcname, data, mode in entries:
             info = zipfile.ZipInfo(arcname, date_time=(2024, 1, 1, 0, 0, 0))
@@ -339,14 +351,20 @@ def build_all(sources: Path, interfaces: Path, root: Path, keep: Path | None = N
                 raise BuildError(str(error).replace(str(work / f"{name}.log"), str(kept)))
             print(f"real-nodes: built {name}", file=sys.stderr, flush=True)
         pack_wheel(prefix, wheels, manifest)
-        (wheels / ".complete").write_text("")
-        shutil.rmtree(done, ignore_errors=True)
-        shutil.move(str(wheels), done)
+        return publish(wheels, done)
+
+
+def publish(wheels: Path, done: Path) -> Path:
+    """Marks a folder of packed wheels complete and moves it to its place in the cache."""
+    (wheels / ".complete").write_text("")
+    shutil.rmtree(done, ignore_errors=True)
+    done.parent.mkdir(parents=True, exist_ok=True)
+    shutil.move(str(wheels), done)
     return done
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def add_sources_argument(parser: argparse.ArgumentParser) -> None:
+    """The folder of source archives, as each script here takes it."""
     parser.add_argument(
         "sources",
         nargs="?",
@@ -354,6 +372,11 @@ def main(argv: list[str] | None = None) -> int:
         default=DEFAULT_SOURCES,
         help="the folder of source archives with MANIFEST.tsv",
     )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_sources_argument(parser)
     parser.add_argument(
         "--interfaces",
         type=Path,
