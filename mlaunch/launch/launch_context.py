@@ -258,13 +258,6 @@ class LaunchContext:
         """Whether ``value`` (a list in the configurations) is also an enclosing scope's."""
         return any(value is v for configs, _ in self._scopes for v in configs.values())
 
-    def scope(self, *, forwarding: bool = True, configs: Mapping[str, Any] | None = None) -> _Scope:
-        """A scope whose configuration and environment changes are undone at exit.
-
-        Not forwarding: the scope starts with only ``configs`` and the initial environment.
-        """
-        return _Scope(self, forwarding, configs)
-
     def file_locals(self, path: str) -> _FileLocals:
         """Locals of an included file: ThisLaunchFile and friends point at it inside."""
         return _FileLocals(self, path)
@@ -293,36 +286,7 @@ class LaunchContext:
         return copy
 
 
-# Context managers as small classes: contextlib costs ~0.7 ms to import at start-up.
-
-
-class _Scope:
-    """``with context.scope(...)``: push a scope on entry, pop it on exit."""
-
-    __slots__ = ("configs", "context", "forwarding")
-
-    def __init__(
-        self, context: LaunchContext, forwarding: bool, configs: Mapping[str, Any] | None
-    ) -> None:
-        self.context = context
-        self.forwarding = forwarding
-        self.configs = configs
-
-    def __enter__(self) -> None:
-        ctx = self.context
-        ctx.push_scope()
-        try:
-            if not self.forwarding:
-                ctx.launch_configurations = {}
-                ctx.environment = dict(ctx.initial_environment)
-            if self.configs:
-                ctx.launch_configurations.update(self.configs)
-        except BaseException:
-            ctx.pop_scope()
-            raise
-
-    def __exit__(self, *exc_info: object) -> None:
-        self.context.pop_scope()
+# A context manager as a small class: contextlib costs ~0.7 ms to import at start-up.
 
 
 class _FileLocals:
