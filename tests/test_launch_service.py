@@ -75,6 +75,31 @@ def test_shutdown_and_include_from_another_thread() -> None:
     assert b"process stopped by SIGINT" in screen.data
 
 
+def test_the_context_says_is_shutdown_once_asked_and_after_the_run() -> None:
+    screen = Screen()
+    service = LaunchService(screen=screen)
+    service.shutdown()  # not running: nothing to shut down, as launch's
+    assert not service.context.is_shutdown
+    service.include_launch_description(LaunchDescription([python(SLEEPER, name="sleeper")]))
+    seen: list[bool] = []
+
+    def drive() -> None:
+        assert screen.wait_for("up")
+        seen.append(service.context.is_shutdown)
+        service.shutdown()
+        seen.append(service.context.is_shutdown)  # at once, in the caller's thread
+
+    thread = in_thread(drive)
+    assert service.run() == 0
+    thread.join(DEADLINE)
+    assert seen == [False, True]
+
+    idle = LaunchService(screen=Screen())
+    idle.include_launch_description(LaunchDescription([python("print('done')")]))
+    assert idle.run() == 0
+    assert idle.context.is_shutdown  # a launch that ended when idle has shut down too
+
+
 def test_keeps_running_when_idle_until_shutdown() -> None:
     screen = Screen()
     service = LaunchService(screen=screen)

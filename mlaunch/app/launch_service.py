@@ -343,6 +343,8 @@ class LaunchService:
                 code = supervisor.run()
             finally:
                 supervisor.reactor.close_all()
+                # However it ended, the launch has shut down (launch sets it on its Shutdown).
+                self._context._set_is_shutdown(True)
             if self._error and code == 0:
                 code = 1
             return code
@@ -441,7 +443,14 @@ class LaunchService:
         supervisor.execute(plan.steps)
 
     def _request_shutdown(self, reason: str) -> None:
-        """Queue the shutdown of a running launch, ``reason`` its log line; thread-safe."""
+        """Queue the shutdown of a running launch, ``reason`` its log line; thread-safe.
+
+        The context says ``is_shutdown`` from now on, as launch's does when asked to shut down.
+        """
+        with self._lock:
+            running = self._running
+        if running:
+            self._context._set_is_shutdown(True)
         self._call_if_running(lambda: self._shutdown_now(reason))
 
     def _call_if_running(self, call: Callable[[], None]) -> None:
