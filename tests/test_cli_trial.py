@@ -278,6 +278,26 @@ def test_readme_exit_status_table_is_the_codes() -> None:
         assert re.search(rf"\b{code}\b", epilog), (code, epilog)
 
 
+def test_readme_leads_with_what_mlaunch_is_and_the_two_commands() -> None:
+    """A new user reads what mlaunch is, the two commands, then how to use it: build details and
+    measurements live in docs/ (usage began at line 73, after CI timings and the real-node build).
+    """
+    from conftest import REPO
+
+    readme = (REPO / "README.md").read_text()
+    lines = readme.splitlines()
+    assert lines[2].startswith("mlaunch is "), lines[:4]
+    block = readme.split("```sh\n", 1)[1].split("```", 1)[0]
+    assert "./scripts/setup && .venv/bin/mlaunch launches/jtbot_sim.launch.py" in block
+    assert "./scripts/check" in block
+    assert lines.index("## Using it") < 40, lines.index("## Using it")
+    assert not re.search(r"\b\d+ min \d+ s\b|\bload \d+ to \d+\b", readme), "measurements: docs/"
+    linked = re.findall(r"\]\((docs/[\w.-]+\.md)\)", readme)
+    assert "docs/setup.md" in linked
+    for doc in linked:
+        assert (REPO / doc).is_file(), doc
+
+
 def test_viewer_on_a_busy_port_says_what_to_change() -> None:
     """MLAUNCH_VIEWER_PORT is read by the viewer itself: a busy port is its one-line error."""
     from mlaunch.standins.viewer import DisplayConfig, ViewerError, ViewerState, serve
