@@ -194,3 +194,30 @@ def test_a_reader_that_leaves_during_a_run_costs_the_screen_only(tmp_path: Path)
         if popen.poll() is None:
             popen.kill()
             popen.wait()
+
+
+def test_a_process_name_with_a_slash_or_dots_keeps_its_log_inside_the_log_folder(
+    tmp_path: Path,
+) -> None:
+    # Issue 38, item 15: the name is the launch file's; `../../x` put x-1.log two folders up.
+    from test_faults import Mlaunch, proc, write_launch
+
+    names = ["../../escaped", "sub/dir", "..", "a%2Fb"]
+    entries = [proc(f"print({n!r})", n).replace("'screen'", "'log'") for n in names]
+    m = Mlaunch(tmp_path, write_launch(tmp_path, entries))
+    try:
+        assert m.wait() == 0, m.text + m.stderr()
+    finally:
+        m.close()
+    (folder,) = [p for p in (tmp_path / "log").iterdir() if not p.is_symlink()]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["faults.launch.py", "log", "tmp"]
+    assert sorted(p.name for p in (tmp_path / "log").iterdir()) == sorted(["latest", folder.name])
+    files = {
+        "..%2F..%2Fescaped-1.log": "../../escaped",
+        "sub%2Fdir-2.log": "sub/dir",
+        "..-3.log": "..",
+        "a%252Fb-4.log": "a%2Fb",  # not the file of a process named a/b
+    }
+    assert sorted(p.name for p in folder.iterdir()) == sorted([*files, "launch.log"])
+    for file, name in files.items():
+        assert (folder / file).read_text() == name + "\n"

@@ -24,6 +24,16 @@ ALL = -1  # keep: every rotated part stays
 LOG_BUFFER = 64 * 1024
 
 
+def log_file_name(label: str) -> str:
+    """The file a process's lines go to in the log folder: ``<label>.log``, always inside it.
+
+    A label is the launch file's ``name``, which may hold ``/`` or ``..``: ``%`` and ``/`` are
+    written as ``%25`` and ``%2F`` (so two labels never share a file), and a name that starts
+    with a dot keeps it (``..`` gives ``...log``, a file of the folder, not its parent).
+    """
+    return label.replace("%", "%25").replace("/", "%2F").replace("\0", "%00") + ".log"
+
+
 class LogFile:
     """An append-only log file that rotates at a size limit (name -> name.1 -> name.2 ...).
 

@@ -16,7 +16,13 @@ import sys
 import time
 from collections.abc import Callable, Mapping
 
-from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP, LogFile, tail_lines
+from mlaunch.engine.logfiles import (
+    DEFAULT_ROTATE_BYTES,
+    DEFAULT_ROTATE_KEEP,
+    LogFile,
+    log_file_name,
+    tail_lines,
+)
 from mlaunch.engine.sayings import VIEWER_ADDRESS, Sayings
 from mlaunch.engine.screen import Screen
 from mlaunch.plan.events import Event, Output, Summary
@@ -217,7 +223,7 @@ class Printer:
         else:
             self._prefix[label] = plain
         if self.log_dir:
-            self._own[label] = self._open(f"{label}.log")
+            self._own[label] = self._open(log_file_name(label))
 
     def output(self, label: str, stream: str, mode: str, data: bytes) -> None:
         """Complete lines from a process (bytes ending in newline)."""
@@ -267,7 +273,7 @@ class Printer:
         if own is None:
             if not self.log_dir:
                 return None
-            return tail_lines(os.path.join(self.log_dir, f"{label}.log"), count)
+            return tail_lines(os.path.join(self.log_dir, log_file_name(label)), count)
         own.flush()
         return tail_lines(own.path, count)
 

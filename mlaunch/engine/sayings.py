@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 
+from mlaunch.engine.logfiles import log_file_name
 from mlaunch.engine.process import describe_status, signal_name
 from mlaunch.plan.events import (
     Controlled,
@@ -215,7 +216,7 @@ class Sayings:
         via = _VIA.get(event.by, "")
         label, action = event.label, event.action
         if action == "mute":
-            text = f"output muted by the user{via}; still written to {label}.log"
+            text = f"output muted by the user{via}; still written to {log_file_name(label)}"
         elif action == "unmute":
             text = f"output unmuted by the user{via}"
         else:
