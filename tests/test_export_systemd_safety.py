@@ -9,7 +9,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from procutil import REPO, clean_env, run_mlaunch
+from procutil import REPO, clean_env, mlaunch, run_mlaunch
 
 PREFIX = REPO / "launches" / "examples" / "prefix"
 LAUNCH = """
@@ -32,6 +32,7 @@ KEYS = {
     "Description", "PartOf", "After", "Requires", "StartLimitIntervalSec", "Type",
     "RemainAfterExit", "User", "ExecStart", "WorkingDirectory", "EnvironmentFile", "Environment",
     "UnsetEnvironment", "Restart", "RestartSec", "KillMode", "KillSignal", "TimeoutStopSec",
+    "TimeoutStartSec",
     "SyslogIdentifier", "Wants", "BindsTo", "WantedBy",
 }  # fmt: skip
 verify_needed = pytest.mark.skipif(
@@ -168,3 +169,75 @@ def test_without_env_the_file_is_empty_and_the_nodes_are_warned_about(tmp_path: 
     lines = (out / "demo.env").read_text().splitlines()
     assert [line for line in lines if not line.startswith("#")] == []
     assert "demo.env is empty: the nodes get systemd's environment" in done.stderr
+
+
+# --- issue 38, item 16: what systemd reads differently from what was meant -------------------
+
+TIMES = """
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess, TimerAction
+
+def generate_launch_description():
+    return LaunchDescription([
+        ExecuteProcess(cmd=["sleep", "1000"], name="long", sigterm_timeout="1000000",
+                       sigkill_timeout="5", respawn=True, respawn_delay=2000000.0),
+        ExecuteProcess(cmd=["sleep", "1000"], name="short", sigterm_timeout="-7",
+                       sigkill_timeout="-1", respawn=True, respawn_delay=0.0),
+        ExecuteProcess(cmd=["sleep", "1000"], name="endless", sigterm_timeout="1e300"),
+        TimerAction(period=1e6, actions=[ExecuteProcess(cmd=["sleep", "1000"], name="late")]),
+    ])
+"""
+
+
+@verify_needed
+def test_huge_and_negative_times_are_written_as_systemd_reads_them(tmp_path: Path) -> None:
+    launch = tmp_path / "times.launch.py"
+    launch.write_text(TIMES)
+    out = tmp_path / "units"
+    done = run_mlaunch("export", str(launch), "--to", "systemd", str(out), env=clean_env())
+    assert done.returncode == 0, done.stderr
+    long, short, endless, late = (
+        (out / f"times-{name}.service").read_text().splitlines()
+        for name in ("long-1", "short-2", "endless-3", "late-4")
+    )
+    # before: 1e+06 and -8, which systemd ignores (its defaults apply: 90 s, 100 ms)
+    assert "TimeoutStopSec=1000005" in long and "RestartSec=2000000" in long
+    assert "TimeoutStopSec=0.000001" in short and "RestartSec=0" in short  # 0 would be "never"
+    assert "TimeoutStopSec=infinity" in endless
+    assert "ExecStartPre=/bin/sleep 1000000" in late and "TimeoutStartSec=1000090" in late
+    check = verify(out)
+    assert check.returncode == 0, check.stderr
+    assert check.stderr.strip() == "", check.stderr
+
+
+@pytest.mark.parametrize("first", ["-", "@", "+", "!", ":"])
+def test_a_program_found_through_a_relative_path_entry_is_written_absolute(
+    tmp_path: Path, first: str
+) -> None:
+    # `ExecStart=-x` runs `x` with its failure ignored; `@x` runs x named otherwise, `+x` with
+    # full privileges: a program whose name starts so must never be written relative.
+    work = tmp_path / "work"
+    work.mkdir()
+    program = work / f"{first}prog"
+    program.write_text("#!/bin/sh\nexit 0\n")
+    program.chmod(0o755)
+    launch = tmp_path / "rel.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        f"    return LaunchDescription([ExecuteProcess(cmd=[{program.name!r}], name='p')])\n"
+    )
+    out = tmp_path / "units"
+    env = clean_env(PATH=":" + clean_env()["PATH"])  # an empty entry: the current folder
+    done = subprocess.run(
+        mlaunch("export", str(launch), "--to", "systemd", str(out)),
+        capture_output=True, text=True, env=env, cwd=work, timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    (start,) = [
+        line
+        for line in (out / "rel-p-1.service").read_text().splitlines()
+        if line.startswith("ExecStart=")
+    ]
+    assert start == f"ExecStart={program}", start

@@ -240,25 +240,53 @@ def chosen_environment(patterns: list[str], environ: Mapping[str, str]) -> dict[
     return chosen
 
 
-def exec_start(spec: ProcessSpec, path: str) -> list[str]:
-    """The argv a service runs: the shell's for shell=True, argv[0] made absolute."""
+def exec_start(spec: ProcessSpec, path: str, cwd: str) -> list[str]:
+    """The argv a service runs: the shell's for shell=True, argv[0] made absolute.
+
+    Absolute always, even when a relative PATH entry (``.``, an empty one) finds the program:
+    systemd reads a leading ``-``, ``@``, ``+``, ``!`` or ``:`` of ExecStart as a prefix, so a
+    program named ``-x`` found as ``-x`` would run ``x`` with its failure ignored.
+    """
     if spec.shell:
         return ["/bin/sh", "-c", " ".join(spec.argv)]
     argv = list(spec.argv)
     if not os.path.isabs(argv[0]):
-        found = shutil.which(argv[0], path=path)
+        # A relative PATH entry or program is relative to the folder the process starts in,
+        # as the launch would have run it.
+        base = spec.cwd or cwd
+        search = os.pathsep.join(os.path.join(base, d) for d in path.split(os.pathsep))
+        program = os.path.join(base, argv[0]) if os.sep in argv[0] else argv[0]
+        found = shutil.which(program, path=search)
         if found is None:
             raise MlaunchError(
                 f"{spec.label}: program {argv[0]!r} is not on the PATH the units get ({path})"
             )
-        argv[0] = found
+        argv[0] = os.path.normpath(found)
     return argv
+
+
+# systemd's time spans are microseconds in 64 bits; more is its "infinity"
+LONGEST_SPAN = (2**64 - 2) / 1e6
+
+
+def timespan(seconds: float, *, least: float = 0.0) -> str:
+    """``seconds`` as a time span systemd reads (``RestartSec=``, ``TimeoutStopSec=``, sleep).
+
+    ``:g`` wrote a million seconds as ``1e+06``, which systemd ignores with a warning (so the
+    default applies), and a negative time as itself, refused as well. A time below ``least``
+    (a negative one: launch acts at once) is ``least``; past what systemd counts, ``infinity``.
+    """
+    if seconds != seconds or seconds >= LONGEST_SPAN:  # NaN or too long
+        return "infinity"
+    seconds = max(seconds, least)
+    text = f"{seconds:.6f}".rstrip("0").rstrip(".")
+    return text or "0"
 
 
 def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str | None) -> str:
     """The ``.service`` file of one process; a value systemd would misread is an UnsafeValue."""
     spec = unit.spec
-    argv = exec_start(spec, spec.env.get("PATH", os.defpath))
+    argv = exec_start(spec, spec.env.get("PATH", os.defpath), cwd)
     source = os.path.basename(spec.origin.split(":")[0]) or "launch"
     lines = [
         "[Unit]",
@@ -276,7 +304,9 @@ def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str 
     if user:
         lines.append("User=" + user_setting(user))
     if unit.delay > 0:
-        lines.append(f"ExecStartPre=/bin/sleep {unit.delay:g}")
+        lines.append(f"ExecStartPre=/bin/sleep {timespan(unit.delay)}")
+        # the start timeout (90 s by default) covers ExecStartPre: the wait must fit in it
+        lines.append(f"TimeoutStartSec={timespan(unit.delay + 90)}")
     lines.append("ExecStart=" + " ".join(quote_exec(w) for w in argv))
     lines.append("WorkingDirectory=" + setting("working directory", spec.cwd or cwd))
     lines.append("EnvironmentFile=" + setting("environment file path", env_file))
@@ -292,7 +322,8 @@ def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str 
     lines += [
         "KillMode=control-group",
         "KillSignal=SIGINT",
-        f"TimeoutStopSec={spec.sigterm_timeout + spec.sigkill_timeout:g}",
+        # 0 would turn the timeout off: a negative ladder (launch kills at once) is 1 µs
+        "TimeoutStopSec=" + timespan(spec.sigterm_timeout + spec.sigkill_timeout, least=1e-6),
         "SyslogIdentifier=" + setting("process name", spec.label),
     ]
     return "\n".join(lines) + "\n"
@@ -313,7 +344,7 @@ def restart_lines(spec: ProcessSpec) -> list[str]:
     if mode == "never":
         return ["Restart=no"]
     restart = "always" if mode == "always" else "on-failure"
-    return [f"Restart={restart}", f"RestartSec={spec.respawn.delay:g}"]
+    return [f"Restart={restart}", f"RestartSec={timespan(spec.respawn.delay)}"]
 
 
 def target_text(units: list[Unit], description: str) -> str:
