@@ -66,6 +66,8 @@ def command(args: Sequence[str]) -> int:
         from mlaunch.app.parts import standard_parts
 
         return pipeline.launch(opts, standard_parts(opts))
+    if settings.junit:
+        junit.check_target(settings.junit)  # found now, not after the whole test ran
     return run(opts, settings)
 
 

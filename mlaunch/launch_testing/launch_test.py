@@ -19,6 +19,7 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from collections.abc import Sequence
     from types import ModuleType
+    from xml.etree.ElementTree import ElementTree
 
     from mlaunch.launch_testing.test_runner import LaunchTestRunner
 
@@ -121,13 +122,27 @@ def run(
             launch_description=runs[0].get_launch_description(), path=path
         )
         return EXIT_PASS
+    if args.xmlpath:
+        from mlaunch.smoke import junit
+
+        junit.check_target(args.xmlpath)  # found now, not after the tests ran
     results = runner.run()
     if args.xmlpath:
         from mlaunch.launch_testing.junitxml import unittestResultsToXml
+        from mlaunch.smoke import junit
 
         report = unittestResultsToXml(test_results=results, name=f"{package}.{basename}")
-        report.write(args.xmlpath, encoding="utf-8", xml_declaration=True)
+        junit.write_report(args.xmlpath, _xml_bytes(report))
     return EXIT_PASS if all(r.wasSuccessful() for r in results.values()) else EXIT_FAIL
+
+
+def _xml_bytes(report: ElementTree) -> bytes:
+    """The report as ElementTree writes it to a file (declaration, UTF-8)."""
+    import io
+
+    out = io.BytesIO()
+    report.write(out, encoding="utf-8", xml_declaration=True)
+    return out.getvalue()
 
 
 def main(argv: Sequence[str] | None = None, prog: str = "launch_test") -> int:

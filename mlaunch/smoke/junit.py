@@ -7,13 +7,18 @@ The dialect is the common subset GitLab, Jenkins, GitHub reporters and Buildkite
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import os
 import re
 import socket
+import stat
 import time
 import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
+
+from mlaunch.plan.errors import OutputError, UsageError
 
 # XML 1.0 cannot carry these at all (not even escaped); ANSI colour codes are noise in a report.
 _INVALID_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
@@ -81,11 +86,94 @@ def render(
 
 
 def write(path: str, suite: str, cases: Sequence[Case], *, duration: float) -> None:
-    """Write the report atomically (a CI step reading it never sees half a file)."""
-    text = render(suite, cases, duration=duration)
-    folder = os.path.dirname(os.path.abspath(path))
+    """Write the report to ``path`` (raises OutputError when it cannot: exit status 74)."""
+    try:
+        write_report(path, render(suite, cases, duration=duration).encode("utf-8"))
+    except OSError as e:
+        raise OutputError(f"cannot write the JUnit report {path}: {e.strerror or e}") from None
+
+
+def write_report(path: str, data: bytes) -> None:
+    """Write ``data`` into what ``path`` is: a regular file (or a new one) atomically, so a CI
+    step reading it never sees half a file; a device or a FIFO (``/dev/null``, ``/dev/stdout``,
+    a pipe) by writing into it, never by renaming a file over it."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        st = None
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        _write_into(path, data, st)
+        return
+    real = os.path.realpath(path)  # a symlink to the report: the report is replaced, not it
+    folder, name = os.path.split(real)
     os.makedirs(folder, exist_ok=True)
-    tmp = f"{path}.{os.getpid()}.tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write(text)
-    os.replace(tmp, path)
+    # O_EXCL: never a planted name followed. A new report gets open()'s mode, a replaced one keeps.
+    tmp = os.path.join(folder, f".{name}.{os.getpid()}.{os.urandom(4).hex()}.tmp")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
+    try:
+        if st is not None:
+            os.fchmod(fd, stat.S_IMODE(st.st_mode))
+        with open(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, real)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def check_target(path: str) -> None:
+    """Raise UsageError now, before the run, if the report could not be written at ``path``."""
+    try:
+        _check(path)
+    except OSError as e:
+        raise UsageError(
+            f"--junit {path}: the report could not be written there: {e.strerror or e}"
+        ) from None
+
+
+def _check(path: str) -> None:
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        st = None
+    if st is not None and stat.S_ISDIR(st.st_mode):
+        raise UsageError(f"--junit {path}: that is a folder; name a file in it")
+    if st is not None and stat.S_ISSOCK(st.st_mode):
+        raise UsageError(f"--junit {path}: that is a socket; name a file, a FIFO or a device")
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        if not os.access(path, os.W_OK):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES))
+        return
+    folder = os.path.dirname(os.path.realpath(path))
+    os.makedirs(folder, exist_ok=True)
+    probe = os.path.join(folder, f".junit-probe.{os.getpid()}.{os.urandom(4).hex()}")
+    os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600))
+    os.unlink(probe)
+
+
+# A FIFO's reader may open it a moment after mlaunch (a CI step reading it): waited for this long.
+FIFO_READER_WAIT = 10.0
+
+
+def _write_into(path: str, data: bytes, st: os.stat_result) -> None:
+    """Write into a device or a FIFO as it is (O_NONBLOCK at open: a FIFO nobody reads yet is
+    waited on for FIFO_READER_WAIT, not forever)."""
+    deadline = time.monotonic() + FIFO_READER_WAIT
+    while True:
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | os.O_NOCTTY | os.O_CLOEXEC)
+            break
+        except OSError as e:
+            if e.errno != errno.ENXIO or not stat.S_ISFIFO(st.st_mode):
+                raise
+            if time.monotonic() > deadline:
+                raise OSError(errno.ENXIO, "nobody opened the FIFO to read it") from None
+            time.sleep(0.05)
+    try:
+        os.set_blocking(fd, True)
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view) :]
+    finally:
+        os.close(fd)
