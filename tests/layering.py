@@ -37,6 +37,7 @@ LAYERS: list[tuple[str, frozenset[str]]] = [
                 "launch_testing",
                 "launch_pytest",
                 "launch_testing_ros",
+                "testing",
                 "actions",
                 "compat",
                 "__main__",

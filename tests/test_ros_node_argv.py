@@ -800,7 +800,8 @@ def test_missing_executable_lists_what_the_package_has(prefix: Path, temp_dir: s
         run([Node(package="demo", executable="talkr")], prefix, temp_dir)
     libexec = prefix / "lib" / "demo"
     assert (
-        f"executable 'talkr' not found in package 'demo' (looked in '{libexec}'; it has:"
+        f"executable 'talkr' not found in package 'demo' (did you mean 'talker'?) (looked in"
+        f" '{libexec}'; it has:"
         " listener, talker)" in str(err.value)
     )
 

@@ -64,13 +64,15 @@ def run_cli(argv: Sequence[str]) -> int:
 
 
 def check_target(opts: Options) -> int:
-    """``--check``: the portability report of the launch file, without loading or running it."""
+    """``--check``: what a run would refuse and what Jazzy would read otherwise; nothing starts."""
     from mlaunch.app.pipeline import find_launch_file, package_search
-    from mlaunch.check.portability import report
+    from mlaunch.check import loading, portability
     from mlaunch.ros.search import searching
 
     with searching(package_search(opts, None)):
-        return report(find_launch_file(opts), sys.stdout)
+        path = find_launch_file(opts)
+        portable = portability.check(path)
+    return loading.report(opts, path, portable, sys.stdout)
 
 
 def program() -> None:

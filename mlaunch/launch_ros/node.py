@@ -41,7 +41,12 @@ from mlaunch.launch_ros.scope import (
     ros_remaps,
 )
 from mlaunch.launch_ros.substitutions import ExecutableInPackage
-from mlaunch.plan.errors import LaunchFileError, MlaunchError, SubstitutionFailure
+from mlaunch.plan.errors import (
+    LaunchFileError,
+    MlaunchError,
+    SubstitutionFailure,
+    did_you_mean,
+)
 from mlaunch.plan.record import Record
 from mlaunch.plan.steps import LIFECYCLE, NodeInfo, ProcessSpec
 from mlaunch.ros import packages
@@ -505,9 +510,19 @@ def _not_installed(
             hint = f" (mlaunch's stand-in for it needs {need}: ./scripts/setup builds it)"
     source = index.source(package)
     if source is None:
+        standin_executables = [e for p, e in standins.PACKAGE_EXECUTABLES if p == package]
+        if standin_executables and standins_on and not hint:
+            # The package is one mlaunch stands in for: the executable is what is wrong.
+            return PackageNotFoundError(
+                f"executable {executable!r} not found in package {package!r}"
+                f"{did_you_mean(executable, standin_executables)}: mlaunch's stand-in for the"
+                f" package runs {', '.join(map(repr, standin_executables))} (the package itself"
+                f" is not installed: {index.searched()})"
+            )
+        known = {*index.all_packages(), *(p for p, _ in standins.PACKAGE_EXECUTABLES)}
         return PackageNotFoundError(
-            f"package {package!r} not found, wanted for executable {executable!r}"
-            f" ({index.searched()}){hint}"
+            f"package {package!r} not found{did_you_mean(package, known)}, wanted for executable"
+            f" {executable!r} ({index.searched()}){hint}"
         )
     return PackageNotFoundError(
         f"package {package!r} is only a source package at {source.share_directory!r} (not"

@@ -44,6 +44,9 @@ if TYPE_CHECKING:
     from mlaunch.launch.launch_description import LaunchDescriptionEntity
     from mlaunch.ros.search import PackageSearch, searching
 
+# --check notes at most this many errors of one file (a loop over a broken include stops).
+COLLECT_LIMIT = 100
+
 
 class LabelCounter:
     """ROS 2's global ``name-N`` counter, shared by everything resolved in one run, with the
@@ -72,6 +75,7 @@ class ResolveOptions(Record):
         "scoped_parameters",
         "scoped_file_locals",
         "dry_run",
+        "collect",
     )
     __slots__ = _fields
 
@@ -84,6 +88,7 @@ class ResolveOptions(Record):
         scoped_parameters: bool = False,
         dry_run: bool = False,
         scoped_file_locals: bool = False,
+        collect: list[MlaunchError] | None = None,
     ) -> None:
         self.standins = standins
         self.packages = packages
@@ -97,6 +102,9 @@ class ResolveOptions(Record):
         # --print: a program that is not built or installed is a warning and the plan is shown
         # (a dry run on a laptop); a run refuses it before anything starts.
         self.dry_run = dry_run
+        # --check: an action that fails is noted here and the visit goes on with the next one,
+        # so one check names every error a run would stop at (None: the first error raises).
+        self.collect = collect
 
 
 class Resolver:
@@ -182,13 +190,27 @@ class Resolver:
             if e.what is None and not isinstance(e, LaunchFileError):
                 e.what = _short(entity)
             self._name_declaration(e)
-            raise
+            if not self._collected(e):
+                raise
+            return
         except Exception as e:
             if is_own_module(type(entity).__module__):
                 raise  # mlaunch's own action failing is mlaunch's bug
-            raise self._foreign_failure(entity, e) from e
+            failure = self._foreign_failure(entity, e)
+            if not self._collected(failure):
+                raise failure from e
+            return
         if more:
             self.visit_all(more)
+
+    def _collected(self, error: MlaunchError) -> bool:
+        """Whether ``error`` was noted for --check (the visit goes on) rather than raised."""
+        found = self.options.collect
+        if found is None or len(found) >= COLLECT_LIMIT:
+            return False
+        if not any(str(f) == str(error) for f in found):  # an include visited twice, a loop
+            found.append(error)
+        return True
 
     def _foreign_failure(self, entity: object, error: Exception) -> MlaunchError:
         """An action class of a launch file or a package (an exposed tag) that raised: where it

@@ -220,10 +220,12 @@ class PackageIndex:
             if os.path.isfile(os.path.join(libexec, e))
             and os.access(os.path.join(libexec, e), os.X_OK)
         )
+        from mlaunch.plan.errors import did_you_mean
+
         listing = f"; it has: {', '.join(have)}" if have else "; it has no executables"
         raise PackageNotFoundError(
-            f"executable {executable!r} not found in package {package!r} (looked in"
-            f" {libexec!r}{listing})"
+            f"executable {executable!r} not found in package {package!r}"
+            f"{did_you_mean(executable, have)} (looked in {libexec!r}{listing})"
         )
 
     def searched(self) -> str:
