@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 import textwrap
@@ -17,7 +18,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from procutil import Running, clean_env, mlaunch, run_mlaunch
+from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
 
 NOBODY = 65534
 as_root = pytest.mark.skipif(
@@ -82,7 +83,8 @@ def test_a_planted_socket_of_another_user_is_never_asked(shared: Path) -> None:
         assert os.stat(planted).st_uid == NOBODY
         named = run_mlaunch("ctl", RUN_NAME, "stop", "talker", env=env)
         assert named.returncode == 1, named.stdout + named.stderr
-        assert f"the control socket {planted} belongs to uid 65534 (nobody)" in named.stderr
+        folder = planted.parent.parent  # found before the socket: the run folder is not root's
+        assert f"the run folder {folder} belongs to uid 65534 (nobody)" in named.stderr
         assert "not a run of yours: nothing was sent to it" in named.stderr
         newest = run_mlaunch("ctl", "stop", "talker", env=env)
         assert newest.returncode == 1, newest.stdout + newest.stderr
@@ -161,3 +163,98 @@ def test_an_unexpected_answer_is_a_clear_error(tmp_path: Path, reply: str, said:
         assert "internal error" not in done.stderr
     finally:
         server.kill()
+
+
+def _as_nobody(*argv: str) -> None:
+    """Run ``argv`` as nobody (the other user of a shared machine)."""
+    done = subprocess.run(
+        ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", *argv],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert done.returncode == 0, done.stderr
+
+
+def _sleeper(tmp_path: Path, name: str) -> Path:
+    launch = tmp_path / f"{name}.launch.py"
+    launch.write_text(
+        "import sys\nfrom launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "def generate_launch_description():\n"
+        f"    return LaunchDescription([ExecuteProcess(name='{name}', output='screen',\n"
+        "        cmd=[sys.executable, '-c', 'import time; print(\"up\", flush=True);"
+        " time.sleep(600)'])])\n"
+    )
+    return launch
+
+
+def _run_folder(shared: Path, pid: int) -> Path:
+    found = [p for p in shared.iterdir() if p.name.endswith(f"-{pid}")]
+    assert len(found) == 1, list(shared.iterdir())
+    return found[0]
+
+
+@as_root
+def test_a_planted_where_file_never_leads_to_another_run(shared: Path, tmp_path: Path) -> None:
+    """nobody's run folder whose ``control/where`` names root's real run's socket: root's
+    ``ctl FOLDER stop talker`` stopped the talker of that other run, exit 0."""
+    env = clean_env(ROS_LOG_DIR=str(shared))
+    run = Running(mlaunch(str(_sleeper(tmp_path, "talker"))), env=env)
+    try:
+        run.wait_for(r"\[talker-1\] up")
+        real = _run_folder(shared, run.proc.pid) / "control" / "ctl.sock"
+        assert wait_until(real.exists, 30)
+        planted = shared / RUN_NAME
+        _as_nobody("mkdir", "-p", "-m", "700", str(planted / "control"))
+        _as_nobody("sh", "-c", f"echo {real} > {planted / 'control' / 'where'}")
+        for how in ([RUN_NAME], [str(planted)]):
+            done = run_mlaunch("ctl", *how, "stop", "talker", env=env)
+            assert done.returncode == 1, done.stdout + done.stderr
+            assert f"the run folder {planted} belongs to uid 65534 (nobody)" in done.stderr
+            assert "nothing was sent to it" in done.stderr
+        # root's own folder with nobody's where file in a control folder of root's: refused too.
+        own = shared / "2099-01-02-00-00-00-000000-host-4343" / "control"
+        own.mkdir(parents=True, mode=0o700)
+        (own / "where").write_text(f"{real}\n")
+        os.chown(own / "where", NOBODY, NOBODY)
+        done = run_mlaunch("ctl", own.parent.name, "stop", "talker", env=env)
+        assert done.returncode == 1, done.stdout + done.stderr
+        assert f"{own / 'where'} is a file of uid 65534 (nobody)" in done.stderr
+        newest = run_mlaunch("ctl", "list", env=env)  # the real run, past both
+        assert newest.returncode == 0, newest.stdout + newest.stderr
+        assert "talker-1  running" in newest.stdout
+        assert "stopped by the user" not in run.text
+    finally:
+        run.kill()
+
+
+@as_root
+def test_a_planted_latest_folder_is_not_followed(shared: Path, tmp_path: Path) -> None:
+    """nobody makes ``latest`` a folder before root's first run, then links its ``control`` to
+    the older of root's two runs: ``ctl stop talker`` (the newest run) and ``ctl latest ...``
+    reached the older run instead."""
+    env = clean_env(ROS_LOG_DIR=str(shared))
+    _as_nobody("mkdir", "-m", "755", str(shared / "latest"))
+    older = Running(mlaunch(str(_sleeper(tmp_path, "talker"))), env=env)
+    newer = None
+    try:
+        older.wait_for(r"\[talker-1\] up")
+        control = _run_folder(shared, older.proc.pid) / "control"
+        assert wait_until((control / "ctl.sock").exists, 30)
+        _as_nobody("ln", "-s", str(control), str(shared / "latest" / "control"))
+        newer = Running(mlaunch(str(_sleeper(tmp_path, "talker"))), env=env)
+        newer.wait_for(r"\[talker-1\] up")
+        newest = _run_folder(shared, newer.proc.pid) / "control" / "ctl.sock"
+        assert wait_until(newest.exists, 30)
+        done = run_mlaunch("ctl", "stop", "talker", env=env)
+        assert done.returncode == 0, done.stdout + done.stderr
+        newer.wait_for(r"\[talker-1\]: process stopped by the user")
+        named = run_mlaunch("ctl", "latest", "stop", "talker", env=env)
+        assert named.returncode == 1, named.stdout + named.stderr
+        assert f"{shared / 'latest'} is not the symlink a run makes but a folder" in named.stderr
+        assert "stopped by the user" not in older.text
+    finally:
+        older.kill()
+        if newer is not None:
+            newer.kill()

@@ -18,7 +18,7 @@ import sys
 
 from mlaunch.engine.logfiles import log_base_dir
 from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
-from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, Address, find_socket
+from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, Address
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
@@ -161,24 +161,33 @@ def command(args: Sequence[str]) -> int:
 class Target:
     """A run's control socket: ``folder`` is the run's log folder."""
 
-    __slots__ = ("folder", "path")
+    __slots__ = ("folder", "folder_known", "path")
 
-    def __init__(self, folder: str, path: str) -> None:
+    def __init__(self, folder: str, path: str, *, folder_known: bool = True) -> None:
         self.folder = folder
         self.path = path
+        # False when the user named the socket itself: its run's folder is a guess.
+        self.folder_known = folder_known
 
 
 def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
-    """The run RUN names (None: the newest still running) under the ROS log folder."""
+    """The run RUN names (None: the newest still running) under the ROS log folder; only
+    through folders, files and links of the caller's own (mlaunch.commands.ctl_trust)."""
+    from mlaunch.commands.ctl_trust import own_entry
+
     base = log_base_dir(environ)
     if run is None:
         return _newest_live(base)
     under_base = os.path.join(base, run)  # a folder's name, or "latest"
     if os.path.exists(run) or (os.sep not in run and os.path.isdir(under_base)):
-        path = os.path.realpath(run if os.path.exists(run) else under_base)
+        given = run if os.path.exists(run) else under_base
+        path = os.path.realpath(given)
         if os.path.isdir(path):
+            why = own_entry(given.rstrip(os.sep) or given)
+            if why:
+                raise CtlError(f"{why}; not a run of yours: nothing was sent to it")
             return _with_socket(path)
-        return Target(os.path.dirname(os.path.dirname(path)), path)
+        return Target(os.path.dirname(os.path.dirname(path)), path, folder_known=False)
     pid = run if run.isdigit() else None
     match = RUN_ID.fullmatch(run)
     if match:
@@ -193,15 +202,23 @@ def find_run(run: str | None, environ: Mapping[str, str]) -> Target:
     if not named:
         recent = ", ".join(folders[:5]) or "none"
         raise CtlError(f"no run {what} under {base} (newest runs: {recent})", EXIT_USAGE)
-    live = [f for f in named if find_socket(os.path.join(base, f))]
+    live = [f for f in named if _socket_of(os.path.join(base, f))[0]]
     if len(named) > 1 and len(live) != 1:
         shown = ", ".join(named[:10]) + (f" and {len(named) - 10} more" if len(named) > 10 else "")
         raise CtlError(f"{what} names {len(named)} runs: {shown}; give one folder", EXIT_USAGE)
     return _with_socket(os.path.join(base, (live or named)[0]))
 
 
+def _socket_of(folder: str) -> tuple[str | None, str]:
+    from mlaunch.commands.ctl_trust import locate
+
+    return locate(folder)
+
+
 def _with_socket(folder: str) -> Target:
-    path = find_socket(folder)
+    path, why = _socket_of(folder)
+    if why:
+        raise CtlError(f"{why}; not a run of yours: nothing was sent to it")
     if path is None:
         raise CtlError(
             f"the run in {folder} is not running (its control socket {FOLDER}/{NAME} is gone)"
@@ -221,21 +238,23 @@ def _run_folders(base: str) -> list[str]:
 def _newest_live(base: str) -> Target:
     """The newest run of the caller's that answers; stale sockets are skipped, and named if
     nothing answers; other users' sockets are skipped (never connected to), and named too."""
-    from mlaunch.commands.ctl_trust import untrusted
+    from mlaunch.commands.ctl_trust import own_entry, untrusted
 
     candidates = []
     latest = os.path.join(base, "latest")
-    if os.path.isdir(latest):
+    if os.path.lexists(latest) and not own_entry(latest):  # only a link of the caller's own
         candidates.append(os.path.realpath(latest))
     candidates += [os.path.join(base, name) for name in _run_folders(base)]
     stale: list[str] = []
     foreign: list[str] = []
     seen = set()
     for folder in candidates:
-        path = find_socket(folder) if folder not in seen else None
-        if path is None:
-            continue
+        path, why = _socket_of(folder) if folder not in seen else (None, "")
         seen.add(folder)
+        if path is None:
+            if why and os.path.lexists(os.path.join(folder, FOLDER)):
+                foreign.append(why)
+            continue
         why = untrusted(path)
         if why:
             foreign.append(why)
@@ -328,7 +347,17 @@ def ask(target: Target, request: dict[str, object]) -> dict[str, object]:
             f"the control socket {target.path} is served by pid {peer}, but its answer names"
             f" pid {about.get('pid')!r}: not an answer to trust"
         )
+    log_dir = about.get("log_dir") if isinstance(about, dict) else None
+    if target.folder_known and not _same_folder(log_dir, target.folder):
+        raise CtlError(
+            f"the control socket {target.path} answered for the run in {log_dir!r}, not for"
+            f" {target.folder}: not an answer to trust"
+        )
     return answer
+
+
+def _same_folder(log_dir: object, folder: str) -> bool:
+    return isinstance(log_dir, str) and os.path.realpath(log_dir) == os.path.realpath(folder)
 
 
 def _final_answer(sock: socket.socket, target: Target) -> dict[str, object]:

@@ -27,7 +27,6 @@ from __future__ import annotations
 import os
 import selectors
 import socket
-import stat
 from collections.abc import Callable, Mapping
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
@@ -87,32 +86,12 @@ class Address:
             self._fd = -1
 
 
-def find_socket(log_dir: str) -> str | None:
-    """The control socket of the run logging to ``log_dir`` (None when it has none)."""
-    path = socket_path(log_dir)
-    if _is_socket(path):
-        return path
-    try:
-        with open(os.path.join(log_dir, FOLDER, WHERE), encoding="utf-8") as f:
-            elsewhere = f.read().strip()
-    except (OSError, ValueError):
-        return None
-    return elsewhere if _is_socket(elsewhere) else None
-
-
 def runtime_socket_path(log_dir: str, environ: Mapping[str, str]) -> str | None:
     """Where the socket goes when the log folder takes none: ``$XDG_RUNTIME_DIR/mlaunch/``."""
     runtime = environ.get("XDG_RUNTIME_DIR")
     if not runtime or not os.path.isdir(runtime):
         return None
     return os.path.join(runtime, "mlaunch", os.path.basename(log_dir.rstrip("/")) + ".sock")
-
-
-def _is_socket(path: str) -> bool:
-    try:
-        return stat.S_ISSOCK(os.stat(path).st_mode)
-    except OSError:
-        return False
 
 
 def _listen(path: str) -> socket.socket:
@@ -155,7 +134,7 @@ class ControlSocket:
         # The run's Control, made when the first request needs it.
         self.control = control
         self.path = socket_path(log_dir)
-        self.log_dir = log_dir
+        self.log_dir = os.path.abspath(log_dir)  # what ctl checks its answers against
         self.environ = environ
         self.error = ""  # why it could not be opened
         self._listener: socket.socket | None = None
