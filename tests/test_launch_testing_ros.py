@@ -118,3 +118,90 @@ def test_data_republisher_and_message_pump(ros_env: dict[str, str]) -> None:
         pump.stop()
         node.destroy_node()
         context.try_shutdown()
+
+
+# A managed node that says each transition on stderr (as rclpy's logger does), and a launch_test
+# that drives it with ChangeState and waits for its lines by its LifecycleNode action.
+LIFECYCLE_TALKER = """\
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.lifecycle import Node, TransitionCallbackReturn
+
+
+class Talker(Node):
+    def on_configure(self, state):
+        self.get_logger().info('configured now')
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state):
+        self.get_logger().info('active now')
+        return super().on_activate(state)
+
+
+rclpy.init()
+node = Talker('lc_talker')
+try:
+    rclpy.spin(node)
+except (KeyboardInterrupt, ExternalShutdownException):
+    pass
+"""
+
+LIFECYCLE_TEST = """\
+import sys
+import unittest
+
+import launch
+import launch.actions
+import launch.events
+import launch.event_handlers
+import launch_ros.actions
+import launch_ros.event_handlers
+import launch_ros.events.lifecycle
+import launch_testing.actions
+import lifecycle_msgs.msg
+import pytest
+
+
+def change(node, transition):
+    return launch.actions.EmitEvent(event=launch_ros.events.lifecycle.ChangeState(
+        lifecycle_node_matcher=launch.events.matches_action(node), transition_id=transition))
+
+
+@pytest.mark.launch_test
+def generate_test_description():
+    talker = launch_ros.actions.LifecycleNode(
+        executable=sys.executable, arguments=[TALKER], name='lc_talker', namespace='',
+        output='screen')
+    T = lifecycle_msgs.msg.Transition
+    return launch.LaunchDescription([
+        talker,
+        launch.actions.RegisterEventHandler(launch.event_handlers.OnProcessStart(
+            target_action=talker, on_start=[change(talker, T.TRANSITION_CONFIGURE)])),
+        launch.actions.RegisterEventHandler(launch_ros.event_handlers.OnStateTransition(
+            target_lifecycle_node=talker, goal_state='inactive',
+            entities=[change(talker, T.TRANSITION_ACTIVATE)])),
+        launch_testing.actions.ReadyToTest(),
+    ]), {'talker': talker}
+
+
+class TestLifecycle(unittest.TestCase):
+    def test_each_transition_is_said(self, proc_output, talker):
+        proc_output.assertWaitFor('configured now', process=talker, timeout=20)
+        proc_output.assertWaitFor('active now', process=talker, timeout=20)
+"""
+
+
+@requires_rclpy
+def test_output_of_a_lifecycle_node_is_matched_by_its_action(
+    tmp_path: Path, ros_env: dict[str, str]
+) -> None:
+    # Issue 38, item 17 (ros2/demos' lifecycle_py test_lifecycle): the launch_test's runner did
+    # not drive lifecycle nodes ("event ChangeState has no handler"), so the node never
+    # configured, said nothing, and assertWaitFor(process=node) found no process: an ERROR.
+    talker = tmp_path / "lc_talker.py"
+    talker.write_text(LIFECYCLE_TALKER)
+    path = tmp_path / "test_lc_launch.py"
+    path.write_text(LIFECYCLE_TEST.replace("[TALKER]", f"[{str(talker)!r}]"))
+    found, output = run_pytest(path, tmp_path, clean_env(**ros_env))
+    assert found == [["test_lc_launch", "passed"]], output
+    assert "has no handler" not in output, output

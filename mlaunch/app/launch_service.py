@@ -284,7 +284,7 @@ class LaunchService:
     # --- running --------------------------------------------------------------------------------
 
     def _run(self, pending: list[Any], shutdown_when_idle: bool) -> int:
-        from mlaunch.app.parts import components_part, ros_clock_part
+        from mlaunch.app.parts import components_part, lifecycle_part, ros_clock_part
         from mlaunch.engine.guard import Guard, new_run_id
         from mlaunch.engine.logfiles import make_run_log_dir
         from mlaunch.engine.output import Printer, stdout_is_color_terminal
@@ -334,8 +334,11 @@ class LaunchService:
                 self._supervisor = supervisor
             if self._calls:
                 self._wake()
-            # Composable nodes are loaded, and ROSTimers on simulated time counted, by the same
-            # parts as in ``mlaunch FILE``.
+            # Lifecycle nodes are driven, composable nodes loaded, and ROSTimers on simulated
+            # time counted, by the same parts as in ``mlaunch FILE``.
+            arguments = dict(i.partition(":=")[::2] for i in self.argv if ":=" in i)
+            lifecycle = lambda: lifecycle_part(plan, supervisor, arguments)  # noqa: E731
+            supervisor.reactor.attach("lifecycle driving", lifecycle)
             attach = lambda: components_part(plan, supervisor)  # noqa: E731
             supervisor.reactor.attach("the LoadNode driver", attach)
             supervisor.reactor.attach("the ROS clock", lambda: ros_clock_part(supervisor))

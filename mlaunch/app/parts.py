@@ -8,7 +8,7 @@ is attached.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from mlaunch.app.options import Options
 from mlaunch.engine.part import Part
@@ -102,58 +102,52 @@ def standard_parts(opts: Options) -> list[PartMaker]:
 
 
 def lifecycle(run: Run) -> Part:
+    """Lifecycle (managed) node driving (``lifecycle_part``), kept on the Run once attached."""
+
+    def keep(manager: LifecycleManager) -> None:
+        run.lifecycle = manager
+
+    return lifecycle_part(run.plan, run.supervisor, run.opts.arguments, keep)
+
+
+def lifecycle_part(
+    plan: Plan,
+    supervisor: Supervisor,
+    arguments: Mapping[str, str],
+    keep: Callable[[LifecycleManager], None] | None = None,
+) -> Part:
     """Lifecycle (managed) node driving: at once when the plan needs it, else on demand.
 
     Resolve records in ``plan.needs`` whatever the description says about lifecycle nodes;
     a handler written as a function can still start one nobody could see before it ran, so
     without that need a watch (a few isinstance checks per record) attaches the manager the
-    moment a lifecycle node starts or a ChangeState is emitted.
+    moment a lifecycle node starts or a ChangeState is emitted. ``keep`` is told the manager
+    when it is made. ``mlaunch FILE``, ``mlaunch test`` and ``LaunchService`` share it.
     """
     from mlaunch.plan.steps import SEQUENCE_ARGUMENT
 
-    plan = run.plan
+    def make() -> LifecycleManager:
+        from mlaunch.parts.lifecycle import attach
+
+        manager = attach(arguments, supervisor)
+        if keep is not None:
+            keep(manager)
+        return manager
+
     if (
         Need.LIFECYCLE in plan.needs
         or SEQUENCE_ARGUMENT in plan.arguments
-        or SEQUENCE_ARGUMENT in run.opts.arguments
+        or SEQUENCE_ARGUMENT in arguments
     ):
-        from mlaunch.parts.lifecycle import attach
+        return make()
 
-        run.lifecycle = attach(run.opts.arguments, run.supervisor)
-        return run.lifecycle
-    return _LifecycleWatch(run)
-
-
-class _LifecycleWatch(Part):
-    """Attaches lifecycle driving the moment the run turns out to need it.
-
-    Until then it only looks at each record's class: a process of a lifecycle node starting,
-    or a launch event that needs lifecycle (ChangeState). The record that triggered it is
-    handed to the new manager, which sees every later record itself.
-    """
-
-    def __init__(self, run: Run) -> None:
-        self.run = run
-        run.supervisor.events.subscribe(self._on_event)
-
-    def _on_event(self, event: Event) -> None:
+    def wants(event: Event) -> bool:
         if isinstance(event, Started):
             node = event.process.spec.node
-            if node is None or not node.lifecycle:
-                return
-        elif not (isinstance(event, LaunchEvent) and getattr(event.event, "needs", None)):
-            return
-        from mlaunch.parts.lifecycle import attach
+            return node is not None and node.lifecycle
+        return isinstance(event, LaunchEvent) and bool(getattr(event.event, "needs", None))
 
-        run = self.run
-        run.supervisor.events.unsubscribe(self._on_event)
-        run.lifecycle = attach(run.opts.arguments, run.supervisor)
-        run.lifecycle.on_event(event)
-
-    def close(self) -> None:
-        self.run.supervisor.events.unsubscribe(self._on_event)
-        if self.run.lifecycle is not None:
-            self.run.lifecycle.close()
+    return _AttachOnDemand(supervisor, wants, make)
 
 
 def components(run: Run) -> Part:
@@ -213,12 +207,12 @@ class _AttachOnDemand(Part):
         self,
         supervisor: Supervisor,
         wants: Callable[[Event], bool],
-        make: Callable[[], ComponentDriver | RosClock],
+        make: Callable[[], ComponentDriver | RosClock | LifecycleManager],
     ) -> None:
         self.supervisor = supervisor
         self.wants = wants
         self.make = make
-        self.driver: ComponentDriver | RosClock | None = None
+        self.driver: ComponentDriver | RosClock | LifecycleManager | None = None
         supervisor.events.subscribe(self._on_event)
 
     def _on_event(self, event: Event) -> None:
