@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import signal
 import sys
+from typing import Any
 
 import pytest
 
@@ -23,7 +24,7 @@ from mlaunch.launch.actions import (
     TimerAction,
 )
 from mlaunch.launch.actions import Shutdown as ShutdownAction
-from mlaunch.launch.event_handlers import OnProcessExit, OnProcessStart, OnShutdown
+from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnShutdown
 from mlaunch.launch.events import Shutdown
 
 
@@ -31,14 +32,17 @@ def _exit_codes(*, noninteractive: bool, due_to_sigint: bool = True) -> tuple[li
     codes: list[int] = []
     printed: list[bytes] = []
     reader = ExecuteProcess(
-        cmd=[sys.executable, "-S", "-c", "input()"],
+        cmd=[sys.executable, "-S", "-c", "print('ready', flush=True); input()"],
         sigterm_timeout="0.5",
         on_exit=lambda event, context: codes.append(event.returncode),
     )
     shutdown = Shutdown(reason="as if Ctrl-C", due_to_sigint=due_to_sigint)
-    on_start = OnProcessStart(target_action=reader, on_start=[EmitEvent(event=shutdown)])
+    # Once the reader says it is up (a SIGINT in its interpreter's start-up would exit 1).
+    on_ready = OnProcessIO(
+        target_action=reader, on_stdout=lambda event: [EmitEvent(event=shutdown)]
+    )
     service = LaunchService(noninteractive=noninteractive, screen=printed.append)
-    service.include_launch_description(LaunchDescription([reader, RegisterEventHandler(on_start)]))
+    service.include_launch_description(LaunchDescription([reader, RegisterEventHandler(on_ready)]))
     assert service.run() == 0
     return codes, b"".join(printed)
 
@@ -60,6 +64,10 @@ def test_noninteractive_or_a_plain_shutdown_sends_sigint(
 
 
 SLEEPER = [sys.executable, "-c", "import time; time.sleep(30)"]
+# A sleeper that says when its interpreter is up: a signal sent before that can reach Python
+# while it starts (a KeyboardInterrupt in its start-up exits 1, not -2), so a test that
+# signals it waits for the line, not for the process to start (it raced on a loaded machine).
+READY_SLEEPER = [sys.executable, "-c", "import time; print('ready', flush=True); time.sleep(30)"]
 
 
 def test_handlers_see_is_shutdown_once_the_run_shuts_down() -> None:
@@ -131,13 +139,20 @@ def test_a_launch_files_process_matcher_is_given_the_action() -> None:
 
     def sleeper(name: str) -> ExecuteProcess:
         return ExecuteProcess(
-            cmd=SLEEPER, on_exit=lambda event, context: codes.append((name, event.returncode))
+            cmd=READY_SLEEPER,
+            on_exit=lambda event, context: codes.append((name, event.returncode)),
         )
 
     target, other = sleeper("target"), sleeper("other")
     signal_target = SignalProcess(
         signal_number=signal.SIGTERM, process_matcher=lambda action: action is target
     )
+    ready: list[object] = []
+
+    def both_ready(event: Any) -> list[EmitEvent]:
+        ready.append(event.action)
+        return [EmitEvent(event=signal_target)] if len(ready) == 2 else []
+
     service = LaunchService(screen=lambda data: None)
     service.include_launch_description(
         LaunchDescription(
@@ -147,9 +162,7 @@ def test_a_launch_files_process_matcher_is_given_the_action() -> None:
                 RegisterEventHandler(
                     OnProcessExit(target_action=target, on_exit=[ShutdownAction()])
                 ),
-                RegisterEventHandler(
-                    OnProcessStart(target_action=other, on_start=[EmitEvent(event=signal_target)])
-                ),
+                RegisterEventHandler(OnProcessIO(on_stdout=both_ready)),
             ]
         )
     )
