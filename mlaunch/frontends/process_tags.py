@@ -25,7 +25,7 @@ RESPAWN_WORDS = ("always", "on-failure", "on_failure", "never")
 def _executable(e: Entity) -> Any:
     kwargs = _process_kwargs(e, label="name")
     cmd = split_command(e, "cmd")
-    if not cmd:
+    if not cmd or cmd == [""]:  # blank: ros2 launch would try to run the program ''
         raise e.error("attribute 'cmd' is empty; it names the program to run", e.attrs["cmd"])
     return core.ExecuteProcess(cmd=cmd, **kwargs)
 

@@ -18,7 +18,7 @@ from typing import Any
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "nodes"))
 
-from _ros_main import main  # noqa: E402
+from _ros_main import main
 
 
 def build(argv: list[str]) -> Any:

@@ -28,6 +28,11 @@ def split_parts(parts: Parts) -> list[Any]:
     whitespace outside quotes separates, a substitution joins the item it touches; each item is
     a str, a Substitution or a list of both. ValueError for an unclosed quote."""
     args: list[Any] = []
+    if parts and isinstance(parts[0], str) and not parts[0].strip():
+        # ros2 launch's split ends an argument at every blank-only text, even before the
+        # first one: a command line that is empty (``args=""``: Autoware's containers) or that
+        # starts with blanks before a substitution starts with an empty argument.
+        args.append("")
     current: list[Part] = []
     buf: list[str] = []
     in_token = False
