@@ -19,14 +19,23 @@ line), ``status`` (errors' exit-status table) and, for an unknown label, ``label
 Nothing a client sends stops or stalls the run: a request is bounded in size (MAX_REQUEST) and
 nesting (MAX_DEPTH), every malformed one is answered with an error, a ``logs`` answer is bounded
 (MAX_LOG_LINES, logfiles.TAIL_MAX_BYTES), and an error in carrying out a request is answered,
-never raised into the loop.
+never raised into the loop. Nor does a crowd of clients (any process of the user's can connect,
+the launch's own children too): at most MAX_CLIENTS are held, the one idle longest making room
+for a new one; a client that sends no whole request within REQUEST_TIMEOUT, or reads nothing of
+its answer within SEND_TIMEOUT, is closed; answers nobody reads hold at most MAX_QUEUED bytes in
+all (a ``logs`` answer past it is refused: try again); and when the descriptors run short
+(EMFILE, or a new connection's number within RESERVE_FDS of the limit) mlaunch stops accepting
+for a moment instead of spinning on the error, so the supervisor keeps descriptors to respawn.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import resource
 import selectors
 import socket
+import time
 from collections.abc import Callable, Mapping
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
@@ -35,6 +44,7 @@ from mlaunch.plan.events import Said
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.timers import Timer
     from mlaunch.parts.control import Control, ProcessInfo
 
 FOLDER = "control"
@@ -53,6 +63,19 @@ BACKLOG = 128
 MAX_LOG_LINES = 10_000
 # Beyond a stop ladder's own timeouts, what an answer to a stop or restart may take.
 WAIT_MARGIN = 5.0
+# Clients held at once (30 shells at once is a crowd); a new one past it closes the idlest.
+MAX_CLIENTS = 64
+# A client must send its whole request within this...
+REQUEST_TIMEOUT = 10.0
+# ... and read some of its answer within this, or it is closed.
+SEND_TIMEOUT = 30.0
+# Answers queued for clients that have not read them yet, all clients together.
+MAX_QUEUED = 32 * 1024 * 1024
+# Descriptors kept free for the supervisor (pipes and log files of a respawn): a connection whose
+# number comes this close to the soft limit is closed at once.
+RESERVE_FDS = 64
+# How long accepting pauses when the descriptors ran out (EMFILE): the loop must not spin on it.
+ACCEPT_PAUSE = 0.5
 # AF_UNIX paths longer than this (108 bytes on Linux, with the NUL) are reached through the folder.
 MAX_PATH = 100
 
@@ -139,6 +162,8 @@ class ControlSocket:
         self.error = ""  # why it could not be opened
         self._listener: socket.socket | None = None
         self._clients: list[_Client] = []
+        self._paused = False  # accepting stopped for a moment: the descriptors ran out
+        self._sweep: Timer | None = None
 
     def open(self) -> bool:
         """Bind and listen (False, with ``error``, when no folder takes the socket)."""
@@ -187,12 +212,70 @@ class ControlSocket:
             conn, _ = self._listener.accept()
         except (BlockingIOError, InterruptedError):
             return
-        except OSError:
-            return  # the client gave up before we took it
+        except OSError as e:
+            if e.errno in (errno.EMFILE, errno.ENFILE, errno.ENOBUFS, errno.ENOMEM):
+                self._make_room(force=True)  # the socket stays readable: never spin on it
+            return  # else the client gave up before we took it
         conn.setblocking(False)
+        if conn.fileno() >= self._fd_limit() - RESERVE_FDS:
+            self._refuse(conn, "mlaunch is short of file descriptors; try again")
+            self._make_room(force=True)  # the supervisor's descriptors come first
+            return
+        if len(self._clients) >= MAX_CLIENTS:
+            self._make_room(force=False)
+        if len(self._clients) >= MAX_CLIENTS:  # each one waits for a stop or restart
+            self._refuse(conn, f"{MAX_CLIENTS} requests are under way; try again")
+            return
         client = _Client(self, conn)
         self._clients.append(client)
         self.supervisor.selector.register(conn, selectors.EVENT_READ, client.on_ready)
+        if self._sweep is None:
+            self._sweep = self.supervisor.schedule(1.0, self._sweep_idle, keeps_alive=False)
+
+    def _refuse(self, conn: socket.socket, error: str) -> None:
+        import json
+
+        answer = {"ok": False, "error": error, "status": EXIT_FAILURE, "run": self.run_info()}
+        try:
+            conn.send(json.dumps(answer).encode() + b"\n")
+        except OSError:
+            pass
+        _drain(conn)
+        conn.close()
+
+    def _fd_limit(self) -> int:
+        soft, _hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+        return soft if soft != resource.RLIM_INFINITY else 1 << 20
+
+    def _make_room(self, *, force: bool) -> None:
+        """Close the client idle longest (one not waiting for a stop or restart); ``force``:
+        the descriptors ran out, so also stop accepting for ACCEPT_PAUSE."""
+        idle = [c for c in self._clients if c.evictable()]
+        if idle:
+            self.forget(min(idle, key=lambda c: c.since))
+        if force and self._listener is not None and not self._paused:
+            self._paused = True
+            _unregister(self.supervisor.selector, self._listener)
+            self.supervisor.schedule(ACCEPT_PAUSE, self._resume, keeps_alive=False)
+
+    def _resume(self) -> None:
+        self._paused = False
+        if self._listener is not None:
+            self.supervisor.selector.register(self._listener, selectors.EVENT_READ, self._accept)
+
+    def _sweep_idle(self) -> None:
+        """Close clients that sent no request, or read nothing, for too long (every second)."""
+        self._sweep = None
+        now = time.monotonic()
+        for client in list(self._clients):
+            if client.overdue(now):
+                self.forget(client)
+        if self._clients:
+            self._sweep = self.supervisor.schedule(1.0, self._sweep_idle, keeps_alive=False)
+
+    def queued(self) -> int:
+        """Bytes of answers waiting for their clients to read them, all clients together."""
+        return sum(len(c.out) for c in self._clients)
 
     def run_info(self) -> dict[str, object]:
         return {"pid": os.getpid(), "run_id": self.supervisor.run_id, "log_dir": self.log_dir}
@@ -208,6 +291,9 @@ class ControlSocket:
         """Answer who still waits (the launch ended), close, and remove the socket file."""
         for client in list(self._clients):
             client.ended()
+        if self._sweep is not None:
+            self._sweep.cancelled = True
+            self._sweep = None
         if self._listener is not None:
             _unregister(self.supervisor.selector, self._listener)
             self._listener.close()
@@ -286,6 +372,17 @@ class _Client:
         self.out = b""
         self.answered = False  # the final answer is queued: close once it is sent
         self.asked = False
+        # When it connected, or last read some of its answer (the idle clock).
+        self.since = time.monotonic()
+
+    def evictable(self) -> bool:
+        """Not waiting for a stop or restart under way: idle, or not reading its answer."""
+        return not self.asked or self.answered
+
+    def overdue(self, now: float) -> bool:
+        if not self.asked:
+            return now - self.since > REQUEST_TIMEOUT
+        return bool(self.out) and now - self.since > SEND_TIMEOUT
 
     # --- the loop's callbacks --------------------------------------------------------------
 
@@ -443,8 +540,25 @@ class _Client:
     def queue(self, message: dict[str, object]) -> None:
         import json
 
-        self.out += json.dumps(message).encode() + b"\n"
+        data = json.dumps(message).encode() + b"\n"
+        self.since = time.monotonic()  # the answer's clock starts now
+        waiting = self.server.queued()
+        if len(data) > 4096 and waiting + len(data) > MAX_QUEUED:
+            data = self._too_much(waiting)
+        self.out += data
         self._send()
+
+    def _too_much(self, waiting: int) -> bytes:
+        """The failure answered instead of a large answer past MAX_QUEUED."""
+        import json
+
+        readers = sum(1 for c in self.server._clients if c.out)
+        error = (
+            f"{waiting // (1024 * 1024)} MiB of answers wait for {readers} clients that do not"
+            f" read them (at most {MAX_QUEUED // (1024 * 1024)} MiB); try again"
+        )
+        failed = {"ok": False, "error": error, "status": EXIT_FAILURE}
+        return json.dumps({**failed, "run": self.server.run_info()}).encode() + b"\n"
 
     def _send(self) -> None:
         try:
@@ -454,6 +568,8 @@ class _Client:
         except OSError:
             self.server.forget(self)  # the client went away
             return
+        if sent:
+            self.since = time.monotonic()
         self.out = self.out[sent:]
         if self.out:
             self.server.supervisor.selector.modify(self.conn, selectors.EVENT_WRITE, self.on_ready)
