@@ -31,11 +31,12 @@ class Run:
     the printer.
 
     ``lifecycle`` is the LifecycleManager once lifecycle driving is attached (the smoke checks
-    share its ROS graph), else None. ``control`` is the run's runtime control, made on first
+    share its ROS graph), else None. ``readiness``: what ``ctl wait-ready`` asks, when a
+    readiness part is attached. ``control`` is the run's runtime control, made on first
     use (a run that is never controlled imports nothing for it).
     """
 
-    __slots__ = ("_control", "lifecycle", "opts", "plan", "printer", "supervisor")
+    __slots__ = ("_control", "lifecycle", "opts", "plan", "printer", "readiness", "supervisor")
 
     def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor, printer: Printer) -> None:
         self.opts = opts
@@ -44,6 +45,9 @@ class Run:
         self.printer = printer
         self.lifecycle: LifecycleManager | None = None
         self._control: Control | None = None
+        # The run's readiness as ``ctl wait-ready`` asks it (mlaunch.commands.readiness), when
+        # a part that can tell is attached.
+        self.readiness: Callable[[], dict[str, object]] | None = None
 
     def control(self) -> Control:
         """Stop, start, restart, mute, unmute a process by label, list them, read their last
@@ -251,7 +255,9 @@ class _ControlSocketPart(Part):
         from mlaunch.parts.control_socket import ControlSocket
 
         supervisor = self.run.supervisor
-        server = ControlSocket(supervisor, self.run.control, self.log_dir)
+        server = ControlSocket(
+            supervisor, self.run.control, self.log_dir, readiness=lambda: self.run.readiness
+        )
         if server.open():
             self.server = server
         else:

@@ -22,6 +22,9 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from mlaunch.app.parts import Run
+    from mlaunch.engine.part import Part
+
 
 def main(argv: Sequence[str] | None = None) -> int:
     """``mlaunch ...`` and its subcommands: the one place errors are caught and printed."""
@@ -55,12 +58,22 @@ def report_error(error: BaseException, debug: bool) -> int:
 def run_cli(argv: Sequence[str]) -> int:
     """``mlaunch FILE ...``: the pipeline with what every run attaches (or ``--check``)."""
     from mlaunch.app import pipeline
-    from mlaunch.app.parts import standard_parts
+    from mlaunch.app.parts import PartMaker, standard_parts
 
     opts = parse_options(argv)
     if opts.check:
         return check_target(opts)
-    return pipeline.launch(opts, standard_parts(opts))
+    parts = standard_parts(opts)
+    # Before the control socket opens: it answers wait-ready through it.
+    parts.insert(0, PartMaker("the readiness checks", _readiness))
+    return pipeline.launch(opts, parts)
+
+
+def _readiness(run: Run) -> Part:
+    """Readiness for systemd and ``ctl wait-ready`` (imported only when the run attaches it)."""
+    from mlaunch.commands.readiness import attach
+
+    return attach(run)
 
 
 def check_target(opts: Options) -> int:

@@ -9,7 +9,8 @@ ends; if mlaunch is killed, its guard removes it (mlaunch.engine.guard); a socke
 anyway is found stale by ``mlaunch ctl`` (nobody accepts), never waited on.
 
 The protocol is JSON lines. A request is one line: ``{"op": "stop", "label": "talker"}`` (op:
-one of mlaunch.parts.control.OPERATIONS; ``lines`` for logs). The answer is one line with ``ok``;
+one of mlaunch.parts.control.OPERATIONS, or ``ready`` with no label: the run's readiness
+checks; ``lines`` for logs). The answer is one line with ``ok``;
 a stop or restart first sends ``{"accepted": true, "wait": SECONDS}`` (how long its stop ladder
 may take), then the answer once the process has exited (or started again). Every answer carries
 ``run`` (pid, run id, log folder). A failed request answers ``ok: false`` with ``error`` (one
@@ -52,6 +53,8 @@ NAME = "ctl.sock"
 # In FOLDER when the socket is elsewhere (the log folder takes no socket): its path.
 WHERE = "where"
 PROTOCOL = 1
+# The request ``mlaunch ctl wait-ready`` sends (not a process operation: no label).
+READY = "ready"
 # A request line longer than this is refused (a request is a few dozen bytes)...
 MAX_REQUEST = 4096
 # ... and so is one nested deeper than this (a request is one flat object; json's parser
@@ -152,8 +155,12 @@ class ControlSocket:
         control: Callable[[], Control],
         log_dir: str,
         environ: Mapping[str, str] = os.environ,
+        *,
+        readiness: Callable[[], Callable[[], dict[str, object]] | None] = lambda: None,
     ) -> None:
         self.supervisor = supervisor
+        # The run's readiness (``ready`` requests), when a part that can tell is attached.
+        self.readiness = readiness
         # The run's Control, made when the first request needs it.
         self.control = control
         self.path = socket_path(log_dir)
@@ -470,8 +477,11 @@ class _Client:
     def carry_out(self, request: dict[str, object]) -> None:
         from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
 
-        control = self.server.control()
         op, label = request.get("op"), request.get("label")
+        if op == READY:
+            self.ready()
+            return
+        control = self.server.control()
         if op not in OPERATIONS:
             raise BadRequest(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
         if op == "list":
@@ -502,6 +512,14 @@ class _Client:
                 control.stop(label, by="ctl", done=self.done)
             else:
                 control.restart(label, by="ctl", done=self.done)
+
+    def ready(self) -> None:
+        """``ready``: the readiness checks and their states (``mlaunch ctl wait-ready``)."""
+        state = self.server.readiness()
+        if state is None:
+            self.fail("this run does not watch its readiness (mlaunch test's own checks do)")
+            return
+        self.answer(state())
 
     def accepted(self, control: Control, label: str) -> None:
         spec = control.record(label).spec  # raises before anything is said for a bad label
