@@ -7,16 +7,18 @@ ready by mlaunch test's rules (here: a node that joins the graph late), WATCHDOG
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import socket
+import subprocess
 import textwrap
 import threading
 import time
 from pathlib import Path
 
 import pytest
-from procutil import Running, clean_env, mlaunch, wait_for
+from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_for
 
 from mlaunch.parts.sd_notify import Notifier, watchdog_interval_usec
 
@@ -91,9 +93,9 @@ LATE_NODE = """\
 import sys, time
 time.sleep(float(sys.argv[1]))
 import rclpy
+open({marker!r}, "w").close()  # about to join the graph
 rclpy.init(args=sys.argv)
 node = rclpy.create_node("late")
-open({marker!r}, "w").close()
 try:
     rclpy.spin(node)
 except BaseException:
@@ -144,7 +146,7 @@ def test_ready_only_once_the_node_is_in_the_graph_and_watchdog_stops_on_a_death(
     run = Running(mlaunch(str(launch)), env=env)
     try:
         ready = wait_for(lambda: listener.first("READY=1"), 60, "READY=1")
-        # The node joined the graph after its marker was written: READY=1 was not early.
+        # The node joins the graph after its marker is written: READY=1 was not early.
         assert marker.exists(), listener.messages
         starting = [m for m in listener.with_prefix("STATUS=starting") if m[0] <= ready[0]]
         assert starting, listener.messages
@@ -165,3 +167,97 @@ def test_ready_only_once_the_node_is_in_the_graph_and_watchdog_stops_on_a_death(
         if run.proc.poll() is None:
             run.kill()
         listener.close()
+
+
+GHOST = """\
+import sys
+from launch import LaunchDescription
+from launch_ros.actions import Node
+
+def generate_launch_description():
+    return LaunchDescription([
+        Node(executable=sys.executable, arguments=[{late!r}, "1.0"], name="late",
+             exec_name="late"),
+        Node(executable=sys.executable, arguments=["-c", "import time; time.sleep(600)"],
+             name="ghost", exec_name="ghost"),
+    ])
+"""
+
+
+def wait_ready(env: dict[str, str], *args: str) -> subprocess.CompletedProcess[str]:
+    return run_mlaunch("ctl", "wait-ready", *args, env=env, timeout=120)
+
+
+def test_wait_ready_exit_status_and_what_is_missing(
+    tmp_path: Path, ros_env: dict[str, str]
+) -> None:
+    marker = tmp_path / "joined"
+    late = tmp_path / "late.py"
+    late.write_text(LATE_NODE.format(marker=str(marker)))
+    env = clean_env(**ros_env, ROS_LOG_DIR=str(tmp_path / "log"))
+    nobody = wait_ready(env, "4242424", "--timeout", "0.5")
+    assert nobody.returncode == 2, nobody.stderr
+    assert "no run pid 4242424" in nobody.stderr
+
+    launch = tmp_path / "ghost.launch.py"
+    launch.write_text(GHOST.format(late=str(late)))
+    run = Running(mlaunch(str(launch)), env=env)
+    try:
+        # Asked at once: the run is waited for, then its checks; /ghost never joins the graph.
+        done = wait_ready(env, str(run.proc.pid), "--timeout", "6", "--json")
+        assert done.returncode == 1, done.stdout + done.stderr
+        answer = json.loads(done.stdout)
+        assert answer["ok"] is False and answer["status"] == 1 and answer["ready"] is False
+        states = {(c["check"], c["target"]): c["state"] for c in answer["checks"]}
+        assert states[("node", "/ghost")] == "pending", answer
+        processes = [c for c in answer["checks"] if c["check"] == "process"]
+        assert [c["state"] for c in processes] == ["met", "met"], answer
+        text = wait_ready(env, str(run.proc.pid), "--timeout", "0.5")
+        assert text.returncode == 1
+        assert "pending: node /ghost is in the ROS graph" in text.stderr, text.stderr
+    finally:
+        run.signal(signal.SIGINT)
+        run.finish(30)
+
+
+LATE_ONLY = GHOST.split('        Node(executable=sys.executable, arguments=["-c"')[0] + "    ])\n"
+
+DIES = """\
+import sys
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+def generate_launch_description():
+    return LaunchDescription([ExecuteProcess(cmd=[sys.executable, "-c", "exit(3)"], name="dies")])
+"""
+
+
+def test_wait_ready_passes_once_ready_and_fails_fast_on_a_launch_that_dies(
+    tmp_path: Path, ros_env: dict[str, str]
+) -> None:
+    marker = tmp_path / "joined"
+    late = tmp_path / "late.py"
+    late.write_text(LATE_NODE.format(marker=str(marker)))
+    env = clean_env(**ros_env, ROS_LOG_DIR=str(tmp_path / "log"))
+    launch = tmp_path / "late.launch.py"
+    launch.write_text(LATE_ONLY.format(late=str(late)))
+    run = Running(mlaunch(str(launch)), env=env)
+    try:
+        done = wait_ready(env, str(run.proc.pid), "--timeout", "60")
+        assert done.returncode == 0, done.stdout + done.stderr
+        assert marker.exists()  # not ready before the late node was up
+        assert done.stdout.startswith("ready: 2 checks met"), done.stdout
+    finally:
+        run.signal(signal.SIGINT)
+        run.finish(30)
+    dies = tmp_path / "dies.launch.py"
+    dies.write_text(DIES)
+    run = Running(mlaunch(str(dies)), env=env)
+    try:
+        started = time.monotonic()
+        done = wait_ready(env, str(run.proc.pid), "--timeout", "60")
+        assert done.returncode == 1, done.stdout + done.stderr
+        assert time.monotonic() - started < 30  # not the whole timeout
+        assert "ended before it was ready" in done.stderr or "dies" in done.stderr, done.stderr
+    finally:
+        run.finish(30)

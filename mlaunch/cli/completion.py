@@ -134,13 +134,14 @@ def ros1_file_completer(prefix: str, parsed_args: Any) -> list[str]:
 @quietly
 def ctl_completer(prefix: str, parsed_args: Any) -> list[str]:
     """``mlaunch ctl [RUN] OPERATION LABEL``: the operations, then the live run's labels."""
+    from mlaunch.commands.ctl import WAIT_READY
     from mlaunch.parts.control import OPERATIONS
 
     words = list(parsed_args.words or ())
-    at = next((i for i, w in enumerate(words) if w in OPERATIONS), None)
+    at = next((i for i, w in enumerate(words) if w in (*OPERATIONS, WAIT_READY)), None)
     if at is None:
-        return [op for op in OPERATIONS if op.startswith(prefix)]
-    if words[at] == "list" or len(words) > at + 1:
+        return [op for op in (*OPERATIONS, WAIT_READY) if op.startswith(prefix)]
+    if words[at] in ("list", WAIT_READY) or len(words) > at + 1:
         return []
     return [label for label in live_labels(words[0] if at else None) if label.startswith(prefix)]
 

@@ -1,4 +1,5 @@
-"""``mlaunch ctl [RUN] list|stop|start|restart|mute|unmute|logs [LABEL]``: control a running launch.
+"""``mlaunch ctl [RUN] list|stop|start|restart|mute|unmute|logs [LABEL]``: control a running launch;
+``mlaunch ctl wait-ready [RUN] [--timeout S]``: wait until it is ready (mlaunch.commands.readiness).
 
 Another shell talks to a running mlaunch through its control socket (mlaunch.parts.control_socket,
 in the run's log folder, private to the user). RUN picks the run: by default the newest one that
@@ -18,7 +19,7 @@ import sys
 
 from mlaunch.engine.logfiles import log_base_dir
 from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
-from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, Address
+from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, READY, Address
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
@@ -30,6 +31,10 @@ ANSWER_TIMEOUT = 5.0
 # The longest answer line read (a logs answer is at most a few MiB of JSON).
 MAX_ANSWER = 64 * 1024 * 1024
 RUN_ID = re.compile(r"(\d+)-[0-9a-f]{8}")
+WAIT_READY = "wait-ready"
+DEFAULT_READY_TIMEOUT = 60.0
+# How often wait-ready asks the run (or looks for it, before it is there).
+READY_POLL = 0.2
 
 DESCRIPTION = """\
 Control a running launch from another shell: list its processes, stop, start or restart one,
@@ -46,6 +51,9 @@ operations:
   mute LABEL      keep its output off mlaunch's screen; its log file still gets every line
   unmute LABEL    show its output again
   logs LABEL      its last lines (-n)
+  wait-ready      wait until the launch is ready by mlaunch test's checks (processes up, nodes
+                  in the graph, lifecycle nodes active, /clock under sim time, the file's own
+                  expectations); a run that is not there yet is waited for (--timeout)
 
 LABEL: a process's label (talker-1, as mlaunch prints it), or its name without the counter
 (talker) or its node's name, when only one process has it.
@@ -60,6 +68,9 @@ exit status:
      control socket), the process is not running or already running, the launch is
      shutting down
   2  bad input: an unknown operation or label, a RUN that names nothing or several runs
+
+wait-ready: 0 ready; 1 not ready when --timeout passed (what is missing is said), a check
+failed (a process it watches died) or the run ended; 2 no such run within --timeout
 
 A launch whose processes were all stopped this way keeps running (they can be started again);
 Ctrl-C ends it. The launch file's exit handlers see each stop as they would see ros2 launch's
@@ -93,6 +104,13 @@ def parser() -> argparse.ArgumentParser:
         help=f"logs: how many of the last lines (default: {DEFAULT_LINES})",
     )
     p.add_argument("--json", action="store_true", help="print the answer as JSON (one object)")
+    p.add_argument(
+        "--timeout",
+        type=float,
+        default=DEFAULT_READY_TIMEOUT,
+        metavar="S",
+        help=f"wait-ready: how long to wait (default: {DEFAULT_READY_TIMEOUT:g} s)",
+    )
     p.add_argument("-d", "--debug", action="store_true", help="show tracebacks of errors")
     return p
 
@@ -122,6 +140,8 @@ def command(args: Sequence[str]) -> int:
     """``mlaunch ctl ...``: find the run, send the request, say the answer; raises on failure."""
     # Intermixed: options go anywhere, as the README writes them (ctl logs -n 3 talker).
     ns = parser().parse_intermixed_args(list(args))
+    if WAIT_READY in ns.words[:2]:
+        return wait_ready(ns.words, ns.timeout, as_json=ns.json)
     run, op, label = split_words(ns.words)
     request: dict[str, object] = {"version": PROTOCOL, "op": op}
     if label is not None:
@@ -153,6 +173,96 @@ def command(args: Sequence[str]) -> int:
             f" many, and 4 MiB); every line is in {label}'s log file in {target.folder}\n"
         )
     return EXIT_OK
+
+
+# --- wait-ready -----------------------------------------------------------------------------------
+
+
+def wait_ready(words: Sequence[str], timeout: float, *, as_json: bool) -> int:
+    """``wait-ready [RUN]`` (or ``RUN wait-ready``): 0 ready, 1 not ready, 2 no such run."""
+    import time
+
+    rest = [w for w in words if w != WAIT_READY]
+    if len(rest) > 1 or len(words) - len(rest) != 1:
+        raise CtlError(f"wait-ready takes at most one RUN (got {' '.join(words)!r})", EXIT_USAGE)
+    if not timeout >= 0 or timeout == float("inf"):
+        raise CtlError(f"--timeout {timeout!r}: expected a number of seconds >= 0", EXIT_USAGE)
+    run = rest[0] if rest else None
+    deadline = time.monotonic() + timeout
+    found, answer, error = False, None, None
+    while True:
+        try:
+            target = find_run(run, os.environ)
+            found = True
+            answer = ask(target, {"version": PROTOCOL, "op": READY})
+            if not answer.get("ok"):  # the run cannot tell (a mlaunch test run): no waiting
+                error, answer = CtlError(f"{target.folder}: {answer.get('error')}"), None
+                break
+            if answer.get("ready") or answer.get("failed"):
+                break
+        except CtlError as e:
+            error = e
+            if e.exit_code == EXIT_FAILURE and run is not None:
+                found = True  # its folder is there: not running (yet, or any more)
+            if run is not None and run.isdigit() and found and not _alive(int(run)):
+                error = CtlError(f"run {run} ended before it was ready ({e})")
+                break
+        left = deadline - time.monotonic()
+        if left <= 0:
+            break
+        time.sleep(min(READY_POLL, left))
+    return _say_ready(answer, error, found, timeout, as_json)
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, ended but not yet reaped by its parent, does not)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", encoding="utf-8", errors="replace") as f:
+            return f.read().rsplit(") ", 1)[1][:1] != "Z"
+    except (OSError, IndexError):
+        return True
+
+
+def _say_ready(
+    answer: dict[str, object] | None,
+    error: CtlError | None,
+    found: bool,
+    timeout: float,
+    as_json: bool,
+) -> int:
+    ready = bool(answer and answer.get("ready"))
+    if ready:
+        status = EXIT_OK
+    elif answer is None and not found:
+        status = EXIT_USAGE
+    else:
+        status = EXIT_FAILURE
+    out: dict[str, object] = dict(answer or {})
+    out.update(ok=ready, status=status, ready=ready)
+    if not ready and answer is None and error is not None:
+        out["error"] = str(error)
+    elif not ready and not out.get("failed"):
+        out["error"] = f"not ready after {timeout:g} s"
+    if as_json:
+        sys.stdout.write(json.dumps(out, indent=2) + "\n")
+        return status
+    if ready:
+        sys.stdout.write(f"{answer.get('summary') if answer else 'ready'}\n")
+        return status
+    lines = [f"mlaunch ctl: wait-ready: {out.get('failed') or out.get('error')}"]
+    if answer is None and error is not None and str(error) != out.get("error"):
+        lines.append(f"  {error}")
+    for check in answer.get("checks", []) if answer else []:  # type: ignore[attr-defined]
+        if check.get("state") != "met":
+            lines.append(f"  {check['state']}: {check['description']} (seen: {check['seen']})")
+    sys.stderr.write("\n".join(lines) + "\n")
+    return status
 
 
 # --- finding the run ------------------------------------------------------------------------------
