@@ -258,6 +258,6 @@ def test_wait_ready_passes_once_ready_and_fails_fast_on_a_launch_that_dies(
         done = wait_ready(env, str(run.proc.pid), "--timeout", "60")
         assert done.returncode == 1, done.stdout + done.stderr
         assert time.monotonic() - started < 30  # not the whole timeout
-        assert "ended before it was ready" in done.stderr or "dies" in done.stderr, done.stderr
+        assert "ended before it was ready" in done.stderr, done.stderr
     finally:
         run.finish(30)

@@ -198,6 +198,7 @@ def wait_ready(words: Sequence[str], timeout: float, *, as_json: bool) -> int:
             if not answer.get("ok"):  # the run cannot tell (a mlaunch test run): no waiting
                 error, answer = CtlError(f"{target.folder}: {answer.get('error')}"), None
                 break
+            error = None
             if answer.get("ready") or answer.get("failed"):
                 break
         except CtlError as e:
@@ -245,8 +246,8 @@ def _say_ready(
         status = EXIT_FAILURE
     out: dict[str, object] = dict(answer or {})
     out.update(ok=ready, status=status, ready=ready)
-    if not ready and answer is None and error is not None:
-        out["error"] = str(error)
+    if not ready and error is not None:
+        out["error"] = str(error)  # the last word: the run ended, or cannot tell
     elif not ready and not out.get("failed"):
         out["error"] = f"not ready after {timeout:g} s"
     if as_json:
@@ -255,9 +256,7 @@ def _say_ready(
     if ready:
         sys.stdout.write(f"{answer.get('summary') if answer else 'ready'}\n")
         return status
-    lines = [f"mlaunch ctl: wait-ready: {out.get('failed') or out.get('error')}"]
-    if answer is None and error is not None and str(error) != out.get("error"):
-        lines.append(f"  {error}")
+    lines = [f"mlaunch ctl: wait-ready: {out.get('error') or out.get('failed')}"]
     for check in answer.get("checks", []) if answer else []:  # type: ignore[attr-defined]
         if check.get("state") != "met":
             lines.append(f"  {check['state']}: {check['description']} (seen: {check['seen']})")
