@@ -27,7 +27,7 @@ import uuid
 from collections.abc import Mapping
 from typing import Any
 
-from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.ros1.actions import MappingWarning
 from mlaunch.ros1.config import Config, Ros1Node, load
 from mlaunch.ros1.lookup import package_finder
@@ -61,11 +61,20 @@ def description(
     env = dict(environ)
     config = load(path, args, environ=env, core=True)
     uri = env.get("ROS_MASTER_URI") or DEFAULT_MASTER
+    host, port = master_address(uri)
     env["ROS_MASTER_URI"] = uri
     actions: list[Any] = [MappingWarning(w, path) for w in config.warnings]
     from mlaunch.parts.ros1_params import master_ready
 
     start_master = not master_ready(uri)
+    if start_master and port_answers(host, port):
+        # A master mlaunch started could not bind it: rosmaster waits for the port forever,
+        # and the parameter loader for the master.
+        raise UsageError(
+            f"ROS_MASTER_URI={uri}: port {port} is held by a program that is not a ROS master"
+            " (it does not answer the master's getPid); stop it, or set ROS_MASTER_URI to a"
+            " free port (http://localhost:PORT/)"
+        )
     run_id = str(uuid.uuid1())
     if start_master:
         actions.append(master_process(uri, env))
@@ -110,6 +119,35 @@ def native_run(description: object) -> NativeRun | None:
     """The NativeRun of a description ``description()`` made (None: any other)."""
     found = getattr(description, "__dict__", {}).get(_RUN)
     return found if isinstance(found, NativeRun) else None
+
+
+def master_address(uri: str) -> tuple[str, int]:
+    """The host and port of ``ROS_MASTER_URI``; a value that is not an http URL with a host is
+    a usage error (was an internal error from the XML-RPC client)."""
+    from urllib.parse import urlsplit
+
+    why = ""
+    try:
+        parts = urlsplit(uri)
+        if parts.hostname and parts.scheme in ("http", "https"):
+            return parts.hostname, parts.port or 11311
+    except ValueError as e:  # a port that is not a number, or out of range
+        why = f" ({e})"
+    raise UsageError(
+        f"ROS_MASTER_URI={uri!r} is not a ROS master's address{why}: write it as"
+        " http://HOST:PORT/ (such as http://localhost:11311/)"
+    )
+
+
+def port_answers(host: str, port: int) -> bool:
+    """Whether something accepts TCP connections at ``host``:``port`` (within a second)."""
+    import socket
+
+    try:
+        with socket.create_connection((host, port), timeout=1.0):
+            return True
+    except OSError:
+        return False
 
 
 def master_process(uri: str, env: dict[str, str]) -> Any:
