@@ -226,6 +226,10 @@ def supervise(
         raise UsageError(
             f"--log-max-bytes is {opts.log_max_bytes}; valid: 0 (never rotate) or more"
         )
+    from mlaunch.engine import fdlimit
+
+    # 500 processes need more descriptors than the common soft limit: raised, or refused now.
+    fdlimit.limit().prepare(len(plan.processes()))
     guard, run_id = life.guard, life.run_id
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes

@@ -254,6 +254,8 @@ class Process:
             args = " ".join(spec.argv)
         env = {**spec.env, **extra_env} if extra_env else spec.env
         ttys = _ptys() if spec.emulate_tty else None
+        from mlaunch.engine import fdlimit
+
         try:
             self.popen = subprocess.Popen(
                 args,
@@ -267,6 +269,8 @@ class Process:
                 shell=spec.shell,
                 start_new_session=True,
                 close_fds=True,
+                # The user's own open-file limit, when the run raised its own (only then).
+                preexec_fn=fdlimit.LIMIT.child_setup() if fdlimit.LIMIT is not None else None,
             )
         except BaseException:
             for fd in [fd for pair in ttys or () for fd in pair]:

@@ -27,6 +27,7 @@ plan's steps are carried out by its ``Executor`` (mlaunch.engine.executor).
 
 from __future__ import annotations
 
+import errno
 import itertools
 import selectors
 import signal
@@ -34,8 +35,8 @@ import time
 from collections.abc import Callable, Mapping
 from types import MappingProxyType
 
+from mlaunch.engine import fdlimit, proctable
 from mlaunch.engine import guard as guards
-from mlaunch.engine import proctable
 from mlaunch.engine.executor import Executor
 from mlaunch.engine.handlers import LaunchHandlers
 from mlaunch.engine.ladder import StopLadder
@@ -412,7 +413,12 @@ class Supervisor:
             record = self.records[spec.label] = ProcessRecord(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
         try:
-            process.spawn(self.clock, self._marker_env)
+            try:
+                process.spawn(self.clock, self._marker_env)
+            except OSError as e:
+                if e.errno != errno.EMFILE or not fdlimit.limit().make_room():
+                    raise
+                process.spawn(self.clock, self._marker_env)  # once more, with a higher limit
         except OSError as e:
             reason = e.strerror or str(e)
             process.returncode = 127
