@@ -30,7 +30,7 @@ from typing import Any
 from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.ros1.actions import MappingWarning
 from mlaunch.ros1.config import Config, Ros1Node, load
-from mlaunch.ros1.lookup import package_finder
+from mlaunch.ros1.lookup import catkin_find, package_finder
 
 DEFAULT_MASTER = "http://localhost:11311/"
 # Programs of older ROS 1 releases the seeds use -> what replaced them.
@@ -232,7 +232,7 @@ def node_process(
     cannot start (in roslaunch's words), or what it runs instead of an old name."""
     from mlaunch.launch.actions import ExecuteProcess
 
-    program, note = find_node(node, finder)
+    program, note = find_node(node, finder, env)
     if program is None:
         return None, f"cannot launch node of type [{node.package}/{node.type}]: {note}"
     log_dir = os.path.join(ros_log_dir(env), run_id)
@@ -292,8 +292,9 @@ def remote_env(node: Ros1Node, uri: str) -> list[str]:
     return ["env", *scope, f"ROS_MASTER_URI={uri}", *(f"{k}={v}" for k, v in node.env)]
 
 
-def find_node(node: Ros1Node, finder: Any) -> tuple[str | None, str]:
-    """roslib's find_node: the executable ``type`` in the package's libexec or its folder."""
+def find_node(node: Ros1Node, finder: Any, environ: Mapping[str, str]) -> tuple[str | None, str]:
+    """roslib's find_node: the executable ``type`` where catkin_find looks (a workspace's
+    ``lib/PKG``, ``share/PKG``, source spaces), then in the package's folder; the first."""
     kind, note = node.type, ""
     renamed = RENAMED.get((node.package, kind))
     if renamed is not None:
@@ -306,11 +307,24 @@ def find_node(node: Ros1Node, finder: Any) -> tuple[str | None, str]:
         folder = finder(node.package)
     except LaunchFileError as e:
         return None, str(e)
-    for root in (os.path.join("/usr/lib", node.package), folder):
-        for base, _, files in os.walk(root):
-            if kind in files and os.access(os.path.join(base, kind), os.X_OK):
-                return os.path.join(base, kind), note
+    for root in (*catkin_find(node.package, environ), folder):
+        for base, dirs, files in os.walk(root, followlinks=True):
+            dirs[:] = [d for d in dirs if not d.startswith(".")]
+            if kind in files and is_executable(os.path.join(base, kind)):
+                return os.path.abspath(os.path.join(base, kind)), note
     return None, f"Cannot locate node of type [{kind}] in package [{node.package}]"
+
+
+def is_executable(path: str) -> bool:
+    """roslib's test: readable and executable by its owner."""
+    import stat
+
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return False
+    wanted = stat.S_IRUSR | stat.S_IXUSR
+    return mode & wanted == wanted
 
 
 def system_python_env(env: Mapping[str, str]) -> dict[str, str]:

@@ -48,6 +48,53 @@ def _crawl(folder: str, found: dict[str, str], depth: int) -> None:
             _crawl(entry.path, found, depth - 1)
 
 
+CATKIN_MARKER = ".catkin"
+
+
+def catkin_workspaces(environ: Mapping[str, str]) -> list[str]:
+    """catkin's workspaces: the ``CMAKE_PREFIX_PATH`` entries with a ``.catkin`` marker, then
+    ``/usr`` (where Debian installs ROS 1)."""
+    paths = [p for p in environ.get("CMAKE_PREFIX_PATH", "").split(os.pathsep) if p]
+    return [p for p in paths if os.path.isfile(os.path.join(p, CATKIN_MARKER))] + ["/usr"]
+
+
+def catkin_find(package: str, environ: Mapping[str, str]) -> list[str]:
+    """Where roslaunch looks for a package's programs before its own folder (catkin_find with
+    ``libexec`` and ``share``, the first workspace that has any): ``lib/PKG``, ``libexec/PKG``,
+    ``share/PKG`` and the package in the workspace's source spaces (a devel space's marker
+    names them)."""
+    for workspace in catkin_workspaces(environ):
+        found = []
+        for sub in ("lib", "libexec", "share"):
+            folder = os.path.join(workspace, sub, package)
+            if os.path.exists(folder):
+                found.append(folder)
+        for source in source_spaces(workspace):
+            packages: dict[str, str] = {}
+            _crawl(source, packages, depth=16)
+            if package in packages:
+                found.append(packages[package])
+        if found:
+            return found
+    return []
+
+
+def source_spaces(workspace: str) -> list[str]:
+    """The source folders a workspace's ``.catkin`` marker lists (``;``-separated)."""
+    if workspace == "/usr":
+        return []
+    try:
+        with open(os.path.join(workspace, CATKIN_MARKER), encoding="utf-8") as f:
+            text = f.read()
+    except OSError:
+        return []
+    out: list[str] = []
+    for path in text.split(";") if text else []:
+        if path and os.path.realpath(path) not in {os.path.realpath(p) for p in out}:
+            out.append(path)
+    return out
+
+
 def package_finder(
     launch_file: str, environ: Mapping[str, str], index: Any = None
 ) -> Callable[[str], str]:
