@@ -369,6 +369,85 @@ class BadRequest(Exception):
     """A request that is JSON but not one of the protocol's (exit status 2 for the client)."""
 
 
+Reply = Callable[[dict[str, object]], None]
+
+
+def answer_request(
+    control: Callable[[], Control],
+    request: dict[str, object],
+    *,
+    by: str,
+    answer: Reply,
+    fail: Callable[..., None],
+    accepted: Reply | None = None,
+    shown: str = "",
+) -> None:
+    """Carry out one request of the protocol (``mlaunch ctl``'s, the dashboard's), on the loop
+    thread: ``answer(payload)`` once it is done, or ``fail(error, status, **more)``; a stop or
+    restart first says ``accepted({"accepted": True, "wait": s})``. Nothing here raises."""
+    from mlaunch.parts.control import AmbiguousLabel, ControlError, UnknownLabel
+
+    try:
+        carry_out(control(), request, by=by, answer=answer, accepted=accepted)
+    except UnknownLabel as e:
+        fail(str(e), e.exit_code, labels=e.labels, close=e.close)
+    except AmbiguousLabel as e:
+        fail(str(e), e.exit_code, labels=e.labels)
+    except ControlError as e:
+        fail(str(e), e.exit_code)
+    except BadRequest as e:
+        fail(str(e), EXIT_USAGE)
+    except Exception as e:  # an odd value this code did not foresee: said, not raised
+        fail(f"the request {shown or repr(request)[:60]} failed: {type(e).__name__}: {e}")
+
+
+def carry_out(
+    control: Control,
+    request: dict[str, object],
+    *,
+    by: str,
+    answer: Reply,
+    accepted: Reply | None = None,
+) -> None:
+    """What ``request`` asks of ``control`` (raises ControlError or BadRequest)."""
+    from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
+
+    op, label = request.get("op"), request.get("label")
+    if op not in OPERATIONS:
+        raise BadRequest(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
+    if op == "list":
+        answer({"processes": [info.as_dict() for info in control.processes()]})
+        return
+    if not isinstance(label, str):
+        raise BadRequest(f"{op} needs a process label")
+
+    def done(info: ProcessInfo) -> None:
+        answer({"process": info.as_dict()})
+
+    if op == "logs":
+        lines = request.get("lines", DEFAULT_LINES)
+        if not isinstance(lines, int) or isinstance(lines, bool):
+            raise BadRequest(f"lines must be a whole number, not {lines!r}")
+        payload: dict[str, object] = {"label": label}
+        payload["lines"] = control.logs(label, min(lines, MAX_LOG_LINES))
+        if lines > MAX_LOG_LINES:
+            payload["limit"] = MAX_LOG_LINES
+        answer(payload)
+    elif op in ("mute", "unmute"):
+        done(control.mute(label, by=by) if op == "mute" else control.unmute(label, by=by))
+    elif op == "start":
+        control.start(label, by=by, done=done)
+    else:
+        spec = control.record(label).spec  # raises before anything is said for a bad label
+        if accepted is not None:
+            wait = spec.sigterm_timeout + spec.sigkill_timeout + WAIT_MARGIN
+            accepted({"accepted": True, "wait": wait})
+        if op == "stop":
+            control.stop(label, by=by, done=done)
+        else:
+            control.restart(label, by=by, done=done)
+
+
 class _Client:
     """One connection: a request line in, JSON lines out, then closed."""
 
@@ -438,23 +517,21 @@ class _Client:
 
     def handle(self, line: bytes) -> None:
         """Carry out one request line; whatever it holds, the client gets an answer."""
-        from mlaunch.parts.control import AmbiguousLabel, ControlError, UnknownLabel
-
         request = self._parse(line)
         if request is None:
             return
-        try:
-            self.carry_out(request)
-        except UnknownLabel as e:
-            self.fail(str(e), e.exit_code, labels=e.labels, close=e.close)
-        except AmbiguousLabel as e:
-            self.fail(str(e), e.exit_code, labels=e.labels)
-        except ControlError as e:
-            self.fail(str(e), e.exit_code)
-        except BadRequest as e:
-            self.fail(str(e), EXIT_USAGE)
-        except Exception as e:  # an odd value this code did not foresee: said, not raised
-            self.fail(f"the request {_shown(line)} failed: {type(e).__name__}: {e}")
+        if request.get("op") == READY:
+            self.ready()
+            return
+        answer_request(
+            self.server.control,
+            request,
+            by="ctl",
+            answer=self.answer,
+            fail=self.fail,
+            accepted=self.queue,
+            shown=_shown(line),
+        )
 
     def _parse(self, line: bytes) -> dict[str, object] | None:
         """The request as an object, or None once the error is answered."""
@@ -474,45 +551,6 @@ class _Client:
             return None
         return request
 
-    def carry_out(self, request: dict[str, object]) -> None:
-        from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
-
-        op, label = request.get("op"), request.get("label")
-        if op == READY:
-            self.ready()
-            return
-        control = self.server.control()
-        if op not in OPERATIONS:
-            raise BadRequest(f"unknown operation {op!r}; valid: {', '.join(OPERATIONS)}")
-        if op == "list":
-            rows = [info.as_dict() for info in control.processes()]
-            self.answer({"processes": rows})
-            return
-        if not isinstance(label, str):
-            raise BadRequest(f"{op} needs a process label")
-        if op == "logs":
-            lines = request.get("lines", DEFAULT_LINES)
-            if not isinstance(lines, int) or isinstance(lines, bool):
-                raise BadRequest(f"lines must be a whole number, not {lines!r}")
-            payload: dict[str, object] = {"label": label}
-            payload["lines"] = control.logs(label, min(lines, MAX_LOG_LINES))
-            if lines > MAX_LOG_LINES:
-                payload["limit"] = MAX_LOG_LINES
-            self.answer(payload)
-        elif op in ("mute", "unmute"):
-            info = (
-                control.mute(label, by="ctl") if op == "mute" else control.unmute(label, by="ctl")
-            )
-            self.answer({"process": info.as_dict()})
-        elif op == "start":
-            control.start(label, by="ctl", done=self.done)
-        else:
-            self.accepted(control, label)
-            if op == "stop":
-                control.stop(label, by="ctl", done=self.done)
-            else:
-                control.restart(label, by="ctl", done=self.done)
-
     def ready(self) -> None:
         """``ready``: the readiness checks and their states (``mlaunch ctl wait-ready``)."""
         state = self.server.readiness()
@@ -520,14 +558,6 @@ class _Client:
             self.fail("this run does not watch its readiness (mlaunch test's own checks do)")
             return
         self.answer(state())
-
-    def accepted(self, control: Control, label: str) -> None:
-        spec = control.record(label).spec  # raises before anything is said for a bad label
-        wait = spec.sigterm_timeout + spec.sigkill_timeout + WAIT_MARGIN
-        self.queue({"accepted": True, "wait": wait})
-
-    def done(self, info: ProcessInfo) -> None:
-        self.answer({"process": info.as_dict()})
 
     # --- answers ---------------------------------------------------------------------------
 
