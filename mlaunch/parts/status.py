@@ -34,8 +34,6 @@ from mlaunch.plan.events import Event, Output, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
-    from typing import Any
-
     from rich.console import Console
 
     from mlaunch.engine.keyboard import Keyboard
@@ -43,6 +41,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.control import Control
     from mlaunch.parts.status_keys import StatusKeys
+    from mlaunch.parts.usage import GroupSampler
 
 REFRESH = 0.5
 # The table takes at most this share of the terminal's height; output scrolls above it.
@@ -118,7 +117,7 @@ class StatusView(Part):
         self._redraw = False
         self._urgent = False
         self._closed = False
-        self._psutil: dict[int, Any] = {}
+        self._usage: GroupSampler | None = None  # psutil, on the first refresh
         # Keys (mlaunch.parts.status_keys), when the terminal can type them: ``enable_keys``.
         self.keys: StatusKeys | None = None
         self.keyboard: Keyboard | None = None
@@ -237,43 +236,19 @@ class StatusView(Part):
 
     def _groups(self) -> dict[int, list[int]]:
         """Living members of each running process's group (one /proc scan for all)."""
-        from mlaunch.engine.proctable import scan
+        from mlaunch.parts.usage import group_members
 
-        running = {p.pid for p in self.supervisor.processes if p.running}
-        groups: dict[int, list[int]] = {pgid: [] for pgid in running}
-        for proc in scan():
-            if proc.pgrp in groups and not proc.zombie:
-                groups[proc.pgrp].append(proc.pid)
-        return groups
+        return group_members({p.pid for p in self.supervisor.processes if p.running})
 
     def _sample(self) -> dict[int, tuple[float, int]]:
         groups = self._groups()
         if self.sampler is not None:
             return self.sampler(groups)
-        return self._psutil_sample(groups)
+        if self._usage is None:
+            from mlaunch.parts.usage import GroupSampler
 
-    def _psutil_sample(self, groups: dict[int, list[int]]) -> dict[int, tuple[float, int]]:
-        import psutil
-
-        usage: dict[int, tuple[float, int]] = {}
-        alive: dict[int, Any] = {}
-        for pgid, pids in groups.items():
-            cpu, rss = 0.0, 0
-            for pid in pids:
-                proc = self._psutil.get(pid)
-                try:
-                    if proc is None:
-                        proc = psutil.Process(pid)
-                        proc.cpu_percent(None)  # the first call only starts the measurement
-                    with proc.oneshot():
-                        cpu += proc.cpu_percent(None)
-                        rss += proc.memory_info().rss
-                except psutil.Error:
-                    continue
-                alive[pid] = proc
-            usage[pgid] = (cpu, rss)
-        self._psutil = alive
-        return usage
+            self._usage = GroupSampler(details=False)
+        return {pgid: (u.cpu, u.rss) for pgid, u in self._usage.sample(groups).items()}
 
     def rows(self) -> list[tuple[ProcessRecord, str, str, str, str, str, str]]:
         """(record, state, pid, uptime, cpu, memory, last line) for each process, as text."""
