@@ -63,6 +63,9 @@ class Options:
         self.log_keep = log_keep
         self.format = "text"  # --format: how --print and --show-args write (text or json)
         self.noninteractive = False  # -n: the launch context's noninteractive, as ros2 launch
+        # --dashboard / --dashboard-port: the launch panel's own port (None: only the viewer's)
+        self.dashboard_port: int | None = None
+        self.metrics: str | None = None  # --metrics FILE.csv
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -253,6 +256,23 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="port of the viewer stand-in's page on 127.0.0.1 (default: any free port;"
         f" also ${VIEWER_PORT_ENV})",
     )
+    parser.add_argument(
+        "--dashboard",
+        action="store_true",
+        help="serve the launch panel (every process, its output, the controls) on 127.0.0.1"
+        " (a run with the viewer stand-in has it on the viewer's page anyway)",
+    )
+    parser.add_argument(
+        "--dashboard-port",
+        metavar="PORT",
+        help="the launch panel's port on 127.0.0.1 (implies --dashboard; default: any free port)",
+    )
+    parser.add_argument(
+        "--metrics",
+        metavar="FILE.csv",
+        help="write each process's CPU, memory, threads and open files every second to FILE.csv,"
+        " and a report with plots to FILE.html at the end",
+    )
     parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
     parser.add_argument(
         "--log-keep",
@@ -280,6 +300,8 @@ VALUE_OPTIONS = frozenset(
         "--log-max-bytes",
         "--log-keep",
         "--viewer-port",
+        "--dashboard-port",
+        "--metrics",
     }
 )
 
@@ -359,18 +381,43 @@ def parse_options(argv: Sequence[str]) -> Options:
     if ns.viewer_port is not None:
         # The viewer stand-in reads it from its environment, as when the variable is set.
         os.environ[VIEWER_PORT_ENV] = str(_viewer_port(ns.viewer_port))
+    if ns.dashboard or ns.dashboard_port is not None:
+        opts.dashboard_port = _port("--dashboard-port", ns.dashboard_port or "0")
+    if ns.metrics is not None:
+        opts.metrics = _metrics_file(ns.metrics)
     return opts
+
+
+def _metrics_file(value: str) -> str:
+    """--metrics: a file that can be written (its folder exists), as an absolute path."""
+    from mlaunch.plan.errors import UsageError
+
+    path = os.path.abspath(value)
+    folder = os.path.dirname(path)
+    if not value or os.path.isdir(path) or not os.path.isdir(folder):
+        raise UsageError(
+            f"--metrics {value!r}: not a file in an existing folder; valid: a path such as"
+            " run.csv (the report goes beside it, run.html)"
+        )
+    if not os.access(folder, os.W_OK) or (os.path.exists(path) and not os.access(path, os.W_OK)):
+        raise UsageError(f"--metrics {value!r}: {path} cannot be written")
+    return path
 
 
 def _viewer_port(value: str) -> int:
     """--viewer-port: 0 (any free port) or a port of 127.0.0.1 that nothing listens on now."""
+    return _port("--viewer-port", value)
+
+
+def _port(option: str, value: str) -> int:
+    """``option``'s value: 0 (any free port) or a port of 127.0.0.1 nothing listens on now."""
     from mlaunch.plan.errors import UsageError
 
     text = value.strip()
     port = int(text) if text.isdigit() else -1
     if not 0 <= port <= 65535:
         raise UsageError(
-            f"--viewer-port is {value!r}; valid: a port number 1..65535, or 0 for any free port"
+            f"{option} is {value!r}; valid: a port number 1..65535, or 0 for any free port"
         )
     if port:
         import socket
@@ -382,7 +429,7 @@ def _viewer_port(value: str) -> int:
             probe.bind(("127.0.0.1", port))
         except OSError as e:
             raise UsageError(
-                f"--viewer-port {port}: 127.0.0.1:{port} cannot be used ({e.strerror});"
+                f"{option} {port}: 127.0.0.1:{port} cannot be used ({e.strerror});"
                 " valid: a free port, or 0 for any free port"
             ) from None
         finally:

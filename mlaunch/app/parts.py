@@ -22,7 +22,9 @@ if TYPE_CHECKING:
     from mlaunch.parts.components import ComponentDriver
     from mlaunch.parts.control import Control
     from mlaunch.parts.control_socket import ControlSocket
+    from mlaunch.parts.dashboard import Dashboard
     from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.parts.metrics import Metrics
     from mlaunch.parts.ros_clock import RosClock
 
 
@@ -36,7 +38,16 @@ class Run:
     use (a run that is never controlled imports nothing for it).
     """
 
-    __slots__ = ("_control", "lifecycle", "opts", "plan", "printer", "readiness", "supervisor")
+    __slots__ = (
+        "_control",
+        "_metrics",
+        "lifecycle",
+        "opts",
+        "plan",
+        "printer",
+        "readiness",
+        "supervisor",
+    )
 
     def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor, printer: Printer) -> None:
         self.opts = opts
@@ -48,6 +59,22 @@ class Run:
         # The run's readiness as ``ctl wait-ready`` asks it (mlaunch.commands.readiness), when
         # a part that can tell is attached.
         self.readiness: Callable[[], dict[str, object]] | None = None
+        self._metrics: Metrics | None = None
+
+    def metrics(self) -> Metrics:
+        """Each process's CPU, memory, threads and open files once a second (--metrics' file,
+        the dashboard), made on first use as a part of its own."""
+        if self._metrics is None:
+            from mlaunch.parts.metrics import Metrics
+
+            def make() -> Metrics:
+                return Metrics(self.supervisor, self.control, csv_path=self.opts.metrics)
+
+            metrics = self.supervisor.reactor.attach("the metrics", make)
+            if not isinstance(metrics, Metrics):
+                raise RuntimeError("the metrics failed when they were made (said above)")
+            self._metrics = metrics
+        return self._metrics
 
     def control(self) -> Control:
         """Stop, start, restart, mute, unmute a process by label, list them, read their last
@@ -99,6 +126,9 @@ def standard_parts(opts: Options) -> list[PartMaker]:
         PartMaker("the ROS clock", ros_clock),
         PartMaker("the control socket", control_socket),
     ]
+    if opts.metrics is not None:
+        parts.append(PartMaker("the metrics", metrics))
+    parts.append(PartMaker("the dashboard", dashboard))
     if opts.status:
         parts.append(PartMaker("the status view", status_view))
     parts.append(PartMaker("the exit summary", exit_summary))
@@ -267,6 +297,48 @@ class _ControlSocketPart(Part):
     def close(self) -> None:
         if self.server is not None:
             self.server.close()
+
+
+def metrics(run: Run) -> None:
+    """--metrics FILE.csv: the run's metrics, a part of their own (``Run.metrics``)."""
+    run.metrics()
+
+
+# The viewer stand-in's module: its page shows the launch panel (mlaunch.parts.dashboard).
+VIEWER_MODULE = "mlaunch.standins.viewer"
+
+
+def dashboard(run: Run) -> Part | None:
+    """The launch panel: with --dashboard at once, else when the viewer stand-in starts."""
+    if run.opts.dashboard_port is not None:
+        return dashboard_part(run)
+    return _ViewerWatch(run)
+
+
+def dashboard_part(run: Run) -> Dashboard:
+    from mlaunch.parts.dashboard import Dashboard
+
+    return Dashboard(run.supervisor, run.control, run.metrics(), port=run.opts.dashboard_port)
+
+
+class _ViewerWatch(Part):
+    """Attaches the launch panel when a viewer stand-in starts (its page shows the panel)."""
+
+    def __init__(self, run: Run) -> None:
+        self.run = run
+        self.panel: Dashboard | None = None
+        run.supervisor.events.subscribe(self._on_event)
+
+    def _on_event(self, event: Event) -> None:
+        if not isinstance(event, Started) or VIEWER_MODULE not in event.process.spec.argv:
+            return
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        self.panel = dashboard_part(self.run)
+
+    def close(self) -> None:
+        self.run.supervisor.events.unsubscribe(self._on_event)
+        if self.panel is not None:
+            self.panel.close()
 
 
 def status_view(run: Run) -> Part | None:

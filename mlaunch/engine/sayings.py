@@ -233,7 +233,7 @@ def _seconds(value: float) -> str:
 
 
 # How the user's requests came (Controlled.by), in words.
-_VIA = {"ctl": " (mlaunch ctl)", "keys": " (--status keys)"}
+_VIA = {"ctl": " (mlaunch ctl)", "keys": " (--status keys)", "page": " (the launch panel)"}
 
 
 # Which words each record becomes (records not listed are not said; Output is the Printer's own).

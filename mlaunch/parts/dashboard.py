@@ -1,0 +1,274 @@
+"""The launch panel: every process of the run, its health and output, and the controls, in a page.
+
+Served by mlaunch itself (http.server in threads of its own), to two kinds of front:
+
+- the viewer stand-in's page (mlaunch.standins.viewer_http), which passes every ``/launch/``
+  request on to this process over an abstract unix socket named after the run id
+  (``dashboard_socket``); only a process of the same user is answered there (SO_PEERCRED), and
+  the front says which port the browser saw (``X-Mlaunch-Front``), so the checks below are the
+  same for both fronts;
+- with ``--dashboard``, a port of its own on 127.0.0.1 (``--dashboard-port``, default any free).
+
+What a browser can do (mlaunch.parts.dashboard_http): read the page, a stream of the processes'
+state (server-sent events, one message a second), the last lines of one process and what it
+writes next. Every control is a same-origin POST carrying the run's token (which the page gets
+from the server) and goes through mlaunch.parts.control_socket's ``answer_request`` on the
+loop thread, exactly as ``mlaunch ctl``'s requests do. Nothing reads a file but through the
+control layer (the process's own log file in the run's log folder).
+
+What it costs the run: the loop only hands the output lines to a bounded ring per process and
+takes each second's list of processes (mlaunch.parts.metrics does, for both); each browser is
+served by a thread of its own, which sends only the latest state (a slow browser skips states,
+never queues them) and drops the browser once a write has been blocked for WRITE_TIMEOUT s.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import threading
+from collections import deque
+from collections.abc import Callable
+
+from mlaunch.engine.part import Part
+from mlaunch.plan.events import Event, Output, Said
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
+if TYPE_CHECKING:
+    from socketserver import BaseServer
+
+    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.control import Control
+    from mlaunch.parts.handoff import LoopCall
+    from mlaunch.parts.metrics import Metrics, Sample
+
+# Lines kept per process for the log view's follow (older ones are read from its log file).
+RING = 2000
+# Samples of CPU and memory kept per process for the sparklines (a second each).
+HISTORY = 300
+# Browser streams served at once; more are refused (503) rather than given a thread each.
+MAX_STREAMS = 64
+LINE_MAX = 2000  # characters of one output line sent to the page
+
+
+def dashboard_socket(run_id: str) -> str:
+    """The abstract unix socket the run's launch panel is reached at (viewer_http's too)."""
+    from mlaunch.standins.viewer_config import dashboard_socket as named
+
+    return named(run_id)
+
+
+class Hub:
+    """What the browsers' threads read, written by the loop and the metrics thread.
+
+    ``state`` is the latest message (JSON bytes) and ``version`` counts them; the state streams
+    wait on ``changed``, which is notified once per message. ``lines`` keeps each label's last
+    RING output lines numbered from ``first[label]``; the log views look at them a few times a
+    second (``ended`` is set at the end), so a line of output wakes no thread.
+    """
+
+    def __init__(self) -> None:
+        self.changed = threading.Condition()
+        self.lock = threading.Lock()
+        self.ended = threading.Event()
+        self.version = 0
+        self.state = b"{}"
+        self.lines: dict[str, deque[str]] = {}
+        self.first: dict[str, int] = {}  # the number of lines[label][0]
+        self.last: dict[str, str] = {}
+        self.history: dict[str, deque[tuple[float, int]]] = {}
+        self.closed = False
+        self.streams = 0
+
+    def add_output(self, label: str, data: bytes) -> None:
+        text = data.decode("utf-8", "replace").splitlines()
+        if not text:
+            return
+        with self.lock:
+            ring = self.lines.get(label)
+            if ring is None:
+                ring = self.lines[label] = deque(maxlen=RING)
+                self.first[label] = 0
+            for line in text:
+                if len(ring) == RING:
+                    self.first[label] += 1
+                ring.append(line[:LINE_MAX])
+            self.last[label] = text[-1][:LINE_MAX]
+
+    def end(self, label: str) -> int:
+        """The number the label's next line will get (loop thread: no line arrives meanwhile)."""
+        ring = self.lines.get(label)
+        return self.first.get(label, 0) + (len(ring) if ring is not None else 0)
+
+    def lines_since(self, label: str, number: int) -> tuple[int, list[str], int]:
+        """(lines skipped, the lines from ``number`` on, the next number) for the log view."""
+        with self.lock:
+            ring = self.lines.get(label)
+            if ring is None:
+                return 0, [], number
+            first = self.first[label]
+            skipped = max(0, first - number)
+            start = max(number, first) - first
+            return skipped, list(ring)[start:], first + len(ring)
+
+    def publish(self, state: bytes) -> None:
+        with self.changed:
+            self.state = state
+            self.version += 1
+            self.changed.notify_all()
+
+    def close(self) -> None:
+        with self.changed:
+            self.closed = True
+            self.changed.notify_all()
+        self.ended.set()
+
+
+class Dashboard(Part):
+    """The launch panel's servers and state; opened on the loop's first turn.
+
+    ``port`` None serves only the viewer's front (the abstract socket); a number also listens
+    on 127.0.0.1:port (0: any free port) and says the page's address.
+    """
+
+    def __init__(
+        self,
+        supervisor: Supervisor,
+        control: Callable[[], Control],
+        metrics: Metrics,
+        *,
+        port: int | None,
+    ) -> None:
+        self.supervisor = supervisor
+        self.control = control
+        self.metrics = metrics
+        self.port = port
+        self.hub = Hub()
+        self.token = secrets.token_urlsafe(24)
+        self.servers: list[BaseServer] = []
+        self.loop: LoopCall | None = None
+        self.url = ""
+        supervisor.events.subscribe(self._on_event)
+        metrics.listeners.append(self._sampled)
+        supervisor.schedule(0.0, self._open, keeps_alive=False)
+
+    def _open(self) -> None:
+        from mlaunch.parts.dashboard_http import serve_tcp, serve_unix
+        from mlaunch.parts.handoff import LoopCall
+
+        self.loop = LoopCall(self.supervisor.selector)
+        try:
+            self.servers.append(serve_unix(self, dashboard_socket(self.supervisor.run_id)))
+        except OSError as e:
+            text = f"dashboard: the viewer's page cannot reach the launch panel: {e.strerror or e}"
+            self.supervisor.events.emit(Said("WARNING", "launch", text))
+        if self.port is not None:
+            try:
+                server = serve_tcp(self, self.port)
+            except OSError as e:
+                text = (
+                    f"dashboard: cannot listen on 127.0.0.1:{self.port}: {e.strerror or e};"
+                    " valid: a free port, or 0 for any free port (--dashboard-port)"
+                )
+                self.supervisor.events.emit(Said("ERROR", "launch", text))
+                return
+            self.servers.append(server)
+            self.url = f"http://127.0.0.1:{server.server_address[1]}/launch/"
+            self.supervisor.events.emit(Said("INFO", "launch", f"dashboard: open {self.url}"))
+
+    # --- fed by the run ---------------------------------------------------------------------
+
+    def _on_event(self, event: Event) -> None:
+        if type(event) is Output:
+            self.hub.add_output(event.process.label, event.data)
+
+    def _sampled(self, sample: Sample) -> None:
+        """The metrics thread: each second's state, as the message every browser gets."""
+        import json
+
+        hub = self.hub
+        processes = []
+        for info, usage in sample.rows:
+            entry = info.as_dict()
+            history = hub.history.setdefault(info.label, deque(maxlen=HISTORY))
+            if usage is not None:
+                history.append((round(usage.cpu, 1), usage.rss))
+                entry.update(cpu=round(usage.cpu, 1), rss=usage.rss)
+                entry.update(threads=usage.threads, files=usage.files)
+            else:
+                history.append((0.0, 0))
+            entry["last"] = hub.last.get(info.label, "")
+            entry["history"] = list(history)
+            processes.append(entry)
+        run = {"pid": os.getpid(), "run_id": self.supervisor.run_id, "elapsed": sample.elapsed}
+        message = {"run": run, "processes": processes}
+        hub.publish(json.dumps(message, separators=(",", ":")).encode())
+
+    # --- asked by the browsers' threads -----------------------------------------------------
+
+    def call(
+        self, fn: Callable[[Callable[[dict[str, object]], None]], None], timeout: float
+    ) -> dict[str, object]:
+        """Run ``fn(reply)`` on the loop thread; its reply, or an error once ``timeout`` passed."""
+        done = threading.Event()
+        result: list[dict[str, object]] = []
+
+        def reply(payload: dict[str, object]) -> None:
+            if not result:
+                result.append(payload)
+                done.set()
+
+        loop = self.loop
+        if loop is None or self.hub.closed:
+            return {"ok": False, "error": "the launch has ended", "status": 1}
+        loop.call_soon(lambda: fn(reply))
+        if not done.wait(timeout):
+            return {"ok": False, "error": f"no answer from the run within {timeout:.0f} s"}
+        return result[0]
+
+    def request(self, request: dict[str, object], timeout: float) -> dict[str, object]:
+        """A control request (``mlaunch ctl``'s protocol) carried out on the loop thread."""
+        from mlaunch.parts.control_socket import answer_request
+
+        def carry_out(reply: Callable[[dict[str, object]], None]) -> None:
+            def fail(error: str, status: int = 1, **more: object) -> None:
+                reply({"ok": False, "error": error, "status": status, **more})
+
+            answer_request(
+                self.control,
+                request,
+                by="page",
+                answer=lambda payload: reply({"ok": True, **payload}),
+                fail=fail,
+            )
+
+        return self.call(carry_out, timeout)
+
+    def follow_start(self, label: str, lines: int) -> dict[str, object]:
+        """The label's last ``lines`` (from its log file) and the number of the next line, read
+        together on the loop thread, so the follow that continues from there misses nothing."""
+
+        def tail(reply: Callable[[dict[str, object]], None]) -> None:
+            from mlaunch.parts.control import ControlError
+
+            try:
+                control = self.control()
+                resolved = control.resolve(label)
+                text = control.logs(resolved, lines)
+            except ControlError as e:
+                reply({"ok": False, "error": str(e)})
+                return
+            reply({"ok": True, "label": resolved, "lines": text, "next": self.hub.end(resolved)})
+
+        return self.call(tail, 10.0)
+
+    def close(self) -> None:
+        self.supervisor.events.unsubscribe(self._on_event)
+        if self._sampled in self.metrics.listeners:
+            self.metrics.listeners.remove(self._sampled)
+        self.hub.close()
+        for server in self.servers:
+            server.shutdown()
+            server.server_close()
+        if self.loop is not None:
+            self.loop.close()

@@ -1,0 +1,315 @@
+"""The launch panel's HTTP side: the page, its event streams and its controls.
+
+Every request must be addressed to 127.0.0.1 or localhost at the port the browser used (the
+panel's own, or the viewer's that passed the request on): a web page elsewhere that points a
+name of its own at 127.0.0.1 (DNS rebinding) is refused (421). A control is a POST from the
+page itself: an ``Origin`` of that same address, a small JSON body, and the run's token in
+``X-Mlaunch-Token`` (the page gets it from the server; another site can neither read the page
+nor send the header without the browser asking first, which this server never allows). What a
+browser can ask is the control layer's (list, stop, start, restart, mute, unmute, logs), by a
+label of the run; no request names a file or a command.
+
+    GET  /launch/                  the page (with the token)
+    GET  /launch/events            server-sent events: ``state`` once a second
+    GET  /launch/follow?label=L&lines=N
+                                   server-sent events: ``lines`` (the last N, then each new one)
+    POST /launch/control           {"op": ..., "label": ...}: the control layer's answer
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import socketserver
+import struct
+import sys
+import threading
+import time
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+from typing import Any
+from urllib.parse import parse_qs
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
+if TYPE_CHECKING:
+    from mlaunch.parts.dashboard import Dashboard
+
+PAGE = Path(__file__).with_name("dashboard.html")
+LOCAL_NAMES = ("127.0.0.1", "localhost")
+FRONT_HEADER = "X-Mlaunch-Front"
+TOKEN_HEADER = "X-Mlaunch-Token"
+# A browser whose socket takes nothing for this long is dropped (its thread ends).
+WRITE_TIMEOUT = 10.0
+KEEPALIVE = 15.0  # seconds between comments on a quiet stream (proxies and browsers keep it)
+FOLLOW_PERIOD = 0.2  # how often a log view looks for new lines
+MAX_BODY = 1024
+MAX_LINES = 5000  # lines a log view starts with, at most
+# What the page may ask of the control layer (``mlaunch ctl``'s operations).
+PAGE_OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs")
+CONTROL_TIMEOUT = 120.0  # a stop waits for the process's whole stop ladder
+
+
+def _page(token: str) -> bytes:
+    return PAGE.read_bytes().replace(b"__MLAUNCH_TOKEN__", token.encode())
+
+
+def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
+    page = _page(dashboard.token)
+    hub = dashboard.hub
+
+    class Handler(BaseHTTPRequestHandler):
+        timeout = WRITE_TIMEOUT
+        server_version = "mlaunch"
+
+        # --- who may ask ---------------------------------------------------------------
+
+        def port(self) -> int | None:
+            """The port the browser used: this server's, or the viewer's that passed it on."""
+            if isinstance(self.server, UnixPanelServer):
+                front = (self.headers.get(FRONT_HEADER) or "").strip()
+                return int(front) if front.isdigit() and 0 < int(front) < 65536 else None
+            address = self.server.server_address
+            return address[1] if isinstance(address, tuple) else None
+
+        def origins(self) -> set[str]:
+            port = self.port()
+            return set() if port is None else {f"{name}:{port}" for name in LOCAL_NAMES}
+
+        def host_allowed(self) -> bool:
+            host = (self.headers.get("Host") or "").strip().lower()
+            if host in self.origins():
+                return True
+            self._text(421, "this server answers 127.0.0.1 only\n")
+            return False
+
+        def post_allowed(self) -> bool:
+            origin = (self.headers.get("Origin") or "").lower()
+            if not origin.startswith("http://") or origin[7:] not in self.origins():
+                self._text(403, "controls are taken only from the launch panel's own page\n")
+                return False
+            token = self.headers.get(TOKEN_HEADER) or ""
+            if not secrets_equal(token, dashboard.token):
+                self._text(403, f"a control needs this run's token ({TOKEN_HEADER})\n")
+                return False
+            return True
+
+        # --- requests ------------------------------------------------------------------
+
+        def do_GET(self) -> None:
+            if not self.host_allowed():
+                return
+            path, _, query = self.path.partition("?")
+            if path in ("/", "/launch") and not isinstance(self.server, UnixPanelServer):
+                self.send_response(302)
+                self.send_header("Location", "/launch/")
+                self.send_header("Content-Length", "0")
+                self.end_headers()
+            elif path in ("/launch/", "/launch/index.html"):
+                self._send(200, "text/html; charset=utf-8", page)
+            elif path == "/launch/events":
+                self._stream(lambda: self._states())
+            elif path == "/launch/follow":
+                self._follow(parse_qs(query))
+            else:
+                self._text(404, "not found: try /launch/\n")
+
+        def do_POST(self) -> None:
+            if not self.host_allowed():
+                return
+            if self.path.partition("?")[0] != "/launch/control":
+                self._text(404, "not found: controls are POST /launch/control\n")
+                return
+            if not self.post_allowed():
+                return
+            request = self._body()
+            if request is None:
+                return
+            if request.get("op") not in PAGE_OPERATIONS:
+                valid = ", ".join(PAGE_OPERATIONS)
+                self._json(400, {"ok": False, "error": f"op {request.get('op')!r}; valid: {valid}"})
+                return
+            answer = dashboard.request(request, CONTROL_TIMEOUT)
+            status = 200 if answer.get("ok") else (400 if answer.get("status") == 2 else 409)
+            self._json(status, answer)
+
+        def _body(self) -> dict[str, Any] | None:
+            kind = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
+            try:
+                length = int(self.headers.get("Content-Length") or "-1")
+            except ValueError:
+                length = -1
+            if kind != "application/json" or not 0 <= length <= MAX_BODY:
+                self._text(400, f"expected a JSON body of at most {MAX_BODY} bytes\n")
+                return None
+            try:
+                body = json.loads(self.rfile.read(length))
+            except ValueError:
+                body = None
+            if not isinstance(body, dict):
+                self._text(400, 'expected {"op": ..., "label": ...}\n')
+                return None
+            return body
+
+        # --- streams -------------------------------------------------------------------
+
+        def _stream(self, body: Any) -> None:
+            """Serve one event stream, if fewer than MAX_STREAMS are open."""
+            from mlaunch.parts.dashboard import MAX_STREAMS
+
+            with hub.lock:
+                if hub.streams >= MAX_STREAMS:
+                    full = True
+                else:
+                    full = False
+                    hub.streams += 1
+            if full:
+                self._text(503, f"at most {MAX_STREAMS} pages at once\n")
+                return
+            try:
+                self.send_response(200)
+                self.send_header("Content-Type", "text/event-stream")
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                body()
+            finally:
+                with hub.lock:
+                    hub.streams -= 1
+
+        def _event(self, name: str, data: bytes) -> None:
+            self.wfile.write(b"event: " + name.encode() + b"\ndata: " + data + b"\n\n")
+            self.wfile.flush()
+
+        def _states(self) -> None:
+            """Each new state as it comes (only the latest: a slow page skips some)."""
+            seen = -1
+            while True:
+                with hub.changed:
+                    if hub.version == seen and not hub.closed:
+                        hub.changed.wait(KEEPALIVE)
+                    if hub.closed:
+                        return
+                    version, state = hub.version, hub.state
+                if version == seen:
+                    self.wfile.write(b": still here\n\n")
+                    self.wfile.flush()
+                    continue
+                seen = version
+                self._event("state", state)
+
+        def _follow(self, query: dict[str, list[str]]) -> None:
+            label = (query.get("label") or [""])[0]
+            try:
+                lines = min(MAX_LINES, max(0, int((query.get("lines") or ["200"])[0])))
+            except ValueError:
+                lines = -1
+            if not label or lines < 0:
+                self._text(400, "expected ?label=LABEL&lines=N (N: 0 or more)\n")
+                return
+            start = dashboard.follow_start(label, lines)
+            if not start.get("ok"):
+                self._json(404, start)
+                return
+            self._stream(lambda: self._lines(start))
+
+        def _lines(self, start: dict[str, Any]) -> None:
+            label, number = start["label"], start["next"]
+            first = {"label": label, "lines": start["lines"], "skipped": 0}
+            self._event("lines", json.dumps(first).encode())
+            quiet_since = time.monotonic()
+            while not hub.ended.wait(FOLLOW_PERIOD):
+                skipped, new, number = hub.lines_since(label, number)
+                if new or skipped:
+                    message = {"label": label, "lines": new, "skipped": skipped}
+                    self._event("lines", json.dumps(message).encode())
+                    quiet_since = time.monotonic()
+                elif time.monotonic() - quiet_since > KEEPALIVE:
+                    self.wfile.write(b": still here\n\n")
+                    self.wfile.flush()
+                    quiet_since = time.monotonic()
+
+        # --- answers -------------------------------------------------------------------
+
+        def _json(self, status: int, payload: dict[str, Any]) -> None:
+            self._send(status, "application/json", json.dumps(payload).encode())
+
+        def _text(self, status: int, text: str) -> None:
+            self._send(status, "text/plain; charset=utf-8", text.encode())
+
+        def _send(self, status: int, kind: str, body: bytes) -> None:
+            self.send_response(status)
+            self.send_header("Content-Type", kind)
+            self.send_header("Content-Length", str(len(body)))
+            self.send_header("Cache-Control", "no-store")
+            self.send_header("X-Content-Type-Options", "nosniff")
+            self.send_header("X-Frame-Options", "SAMEORIGIN")
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, format: str, *args: Any) -> None:
+            pass  # every request would be a line in the launch output
+
+    return Handler
+
+
+def secrets_equal(given: str, token: str) -> bool:
+    import hmac
+
+    return hmac.compare_digest(given.encode(), token.encode())
+
+
+# A browser that goes away mid-request (a reload, a closed tab) is routine.
+BROWSER_GONE = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError, TimeoutError)
+
+
+class _Quiet:
+    """A failed request is one line on mlaunch's stderr, a browser gone none."""
+
+    gone = 0
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        error = sys.exc_info()[1]
+        if isinstance(error, BROWSER_GONE):
+            self.gone += 1
+            return
+        line = f"dashboard: a request failed: {type(error).__name__}: {error}\n"
+        try:
+            os.write(2, line.encode("utf-8", "replace"))
+        except OSError:
+            pass
+
+
+class PanelServer(_Quiet, ThreadingHTTPServer):
+    daemon_threads = True
+
+
+class UnixPanelServer(_Quiet, socketserver.ThreadingMixIn, socketserver.UnixStreamServer):
+    """The panel behind the viewer's page: an abstract unix socket, this user's processes only."""
+
+    daemon_threads = True
+
+    def verify_request(self, request: Any, client_address: Any) -> bool:
+        creds = request.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, struct.calcsize("3i"))
+        _, uid, _ = struct.unpack("3i", creds)
+        return bool(uid == os.getuid())
+
+
+def _run(server: socketserver.BaseServer, name: str) -> None:
+    thread = threading.Thread(
+        target=server.serve_forever, kwargs={"poll_interval": 0.1}, name=name, daemon=True
+    )
+    thread.start()
+
+
+def serve_tcp(dashboard: Dashboard, port: int) -> PanelServer:
+    """The panel on 127.0.0.1:port (0: any free port), served from a thread."""
+    server = PanelServer(("127.0.0.1", port), make_handler(dashboard))
+    _run(server, "mlaunch-dashboard")
+    return server
+
+
+def serve_unix(dashboard: Dashboard, address: str) -> UnixPanelServer:
+    """The panel at the abstract unix socket ``address``, for the viewer's page."""
+    server = UnixPanelServer(address, make_handler(dashboard))
+    _run(server, "mlaunch-dashboard-viewer")
+    return server

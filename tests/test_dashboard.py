@@ -1,0 +1,310 @@
+"""The launch panel (--dashboard, and on the viewer's page) and --metrics, driven as a user
+would: the page in headless Chromium (tests/browser.py), requests from elsewhere refused, the
+metrics file of a run read back (issue 36)."""
+
+from __future__ import annotations
+
+import csv
+import http.client
+import itertools
+import json
+import re
+import signal
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from browser import Browser, available
+from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_for
+
+needs_chromium = pytest.mark.skipif(not available(), reason="chromium not installed (apt chromium)")
+
+# ticker: a numbered line every 0.1 s; busy: CPU and no output.
+LAUNCH = f"""from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+TICK = "import time\\ni = 0\\nwhile True:\\n    print('tick', i, flush=True); i += 1; time.sleep(0.1)"
+BUSY = "import time\\nwhile True:\\n    sum(range(100000)); time.sleep(0.005)"
+def generate_launch_description():
+    return LaunchDescription([
+        ExecuteProcess(cmd=[{sys.executable!r}, "-c", TICK], name="ticker", output="screen"),
+        ExecuteProcess(cmd=[{sys.executable!r}, "-c", BUSY], name="busy", output="screen"),
+    ])
+"""
+OPEN = r"dashboard: open (http://127\.0\.0\.1:(\d+)/launch/)"
+
+
+class Run:
+    """mlaunch running LAUNCH with the panel; ``url`` is the page, ``env`` reaches it by ctl."""
+
+    def __init__(self, tmp_path: Path, *options: str) -> None:
+        path = tmp_path / "panel.launch.py"
+        path.write_text(LAUNCH)
+        self.env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+        self.running = Running(mlaunch(str(path), *options), env=self.env, cwd=str(tmp_path))
+        match = self.running.wait_for(OPEN, 30)
+        self.url, self.port = match.group(1), int(match.group(2))
+
+    def ctl(self, *words: str) -> dict[str, Any]:
+        done = run_mlaunch("ctl", *words, "--json", env=self.env, timeout=30)
+        assert done.returncode == 0, done.stdout + done.stderr
+        answer: dict[str, Any] = json.loads(done.stdout)
+        return answer
+
+    def stop(self) -> None:
+        if self.running.proc.poll() is None:
+            self.running.signal(signal.SIGINT)
+            assert self.running.finish(30) == 130
+
+
+@pytest.fixture
+def run(tmp_path: Path) -> Iterator[Run]:
+    launched = Run(tmp_path, "--dashboard")
+    try:
+        yield launched
+    finally:
+        try:
+            launched.stop()
+        finally:
+            if launched.running.proc.poll() is None:
+                launched.running.kill()
+
+
+def rows_of(page: Any) -> dict[str, dict[str, str]]:
+    rows = page.eval(
+        "[...document.querySelectorAll('#procs tbody tr')].map(r => Object.assign({}, r.dataset))"
+    )
+    return {row["label"]: row for row in rows}
+
+
+@needs_chromium
+@pytest.mark.timeout(120)
+def test_the_page_shows_every_process_live_and_restarts_the_one_clicked(
+    run: Run, tmp_path: Path
+) -> None:
+    with Browser(tmp_path / "profile") as browser:
+        page = browser.open(run.url)
+        # live CPU: the busy process is seen using some, in an update after the first
+        page.wait(
+            "(() => { const r = document.querySelector('tr[data-label=\"busy-2\"]');"
+            " return r && Number(document.body.dataset.updates) > 1 && Number(r.dataset.cpu) > 1 })()",
+            30,
+            "busy-2's CPU in the table",
+        )
+        rows = rows_of(page)
+        assert set(rows) == {"ticker-1", "busy-2"}
+        assert all(row["state"] == "running" for row in rows.values()), rows
+        listed = {p["label"]: p for p in run.ctl("list")["processes"]}
+        before = int(rows["ticker-1"]["pid"])
+        assert before == listed["ticker-1"]["pid"]
+
+        page.click('tr[data-label="ticker-1"] button[data-op="restart"]')
+        control = page.wait("document.body.dataset.lastControl", 30, "the restart's answer")
+        answer = json.loads(control)
+        assert answer["ok"] and answer["op"] == "restart", answer
+        assert answer["pid"] not in (0, before), answer
+        # the table follows, and ctl (the same control layer) agrees
+        page.wait(
+            f"document.querySelector('tr[data-label=\"ticker-1\"]').dataset.pid == {answer['pid']}"
+            " && document.querySelector('tr[data-label=\"ticker-1\"]').dataset.restarts == 1",
+            15,
+            "the new pid in the table",
+        )
+        listed = {p["label"]: p for p in run.ctl("list")["processes"]}
+        assert listed["ticker-1"]["pid"] == answer["pid"]
+        assert listed["ticker-1"]["restarts"] == 1
+        assert listed["busy-2"]["restarts"] == 0
+        run.running.wait_for(r"\[ticker-1\]: restart asked by the user \(the launch panel\)", 10)
+
+        page.click('tr[data-label="busy-2"] button[data-op="stop"]')
+        page.wait(
+            "document.querySelector('tr[data-label=\"busy-2\"]').dataset.state == 'stopped'",
+            30,
+            "busy-2 stopped",
+        )
+        assert {p["label"]: p for p in run.ctl("list")["processes"]}["busy-2"]["state"] == "stopped"
+        page.click('tr[data-label="busy-2"] button[data-op="start"]')
+        page.wait(
+            "document.querySelector('tr[data-label=\"busy-2\"]').dataset.state == 'running'",
+            30,
+            "busy-2 running again",
+        )
+
+
+@needs_chromium
+@pytest.mark.timeout(120)
+def test_the_log_view_follows_new_lines_and_searches(run: Run, tmp_path: Path) -> None:
+    with Browser(tmp_path / "profile") as browser:
+        page = browser.open(run.url)
+        page.wait("!!document.querySelector('tr[data-label=\"ticker-1\"]')", 30, "the table")
+        page.click('tr[data-label="ticker-1"] button[data-op="logs"]')
+
+        def last_tick() -> int:
+            text = page.eval("document.getElementById('log').textContent")
+            ticks = re.findall(r"^tick (\d+)$", text, re.M)
+            return int(ticks[-1]) if ticks else -1
+
+        first = wait_for(lambda: last_tick() + 1, 20, "ticks in the log view") - 1
+        # lines written after the view opened arrive without a reload
+        wait_for(lambda: last_tick() >= first + 10, 20, "the log view to follow")
+        lines = page.eval("document.getElementById('log').textContent").splitlines()
+        numbers = [int(line.split()[1]) for line in lines if line.startswith("tick ")]
+        assert numbers == list(range(numbers[0], numbers[0] + len(numbers))), "lost or repeated"
+        page.eval(
+            "(() => { const s = document.getElementById('search'); s.value = 'tick 1';"
+            " s.dispatchEvent(new Event('input')); })()"
+        )
+        shown = page.eval("document.getElementById('log').textContent").splitlines()
+        assert shown and all(line.startswith("tick 1") for line in shown), shown
+        assert page.eval("document.querySelectorAll('#log mark').length") == len(shown)
+
+
+def request(
+    port: int,
+    method: str,
+    path: str,
+    *,
+    host: str | None = None,
+    origin: str | None = None,
+    token: str | None = None,
+    body: dict[str, Any] | None = None,
+) -> tuple[int, bytes]:
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    headers = {"Host": host or f"127.0.0.1:{port}"}
+    if origin is not None:
+        headers["Origin"] = origin
+    if token is not None:
+        headers["X-Mlaunch-Token"] = token
+    data = None
+    if body is not None:
+        data = json.dumps(body).encode()
+        headers["Content-Type"] = "application/json"
+    conn.request(method, path, body=data, headers=headers)
+    reply = conn.getresponse()
+    status, text = reply.status, reply.read()
+    conn.close()
+    return status, text
+
+
+def token_of(port: int) -> str:
+    status, page = request(port, "GET", "/launch/")
+    assert status == 200
+    match = re.search(rb'name="mlaunch-token" content="([^"]+)"', page)
+    assert match, page[:300]
+    return match.group(1).decode()
+
+
+def assert_refuses_strangers(port: int) -> None:
+    """What a page elsewhere, a rebinding name or a request without the token gets."""
+    own = f"http://127.0.0.1:{port}"
+    token = token_of(port)
+    mute = {"op": "mute", "label": "ticker-1"}
+    assert request(port, "GET", "/launch/", host="evil.example:80")[0] == 421
+    assert request(port, "GET", "/launch/events", host=f"attacker.test:{port}")[0] == 421
+    assert request(port, "POST", "/launch/control", origin=own, body=mute)[0] == 403
+    status = request(port, "POST", "/launch/control", origin=own, token="x" * 32, body=mute)[0]
+    assert status == 403
+    foreign = "http://evil.example"
+    assert (
+        request(port, "POST", "/launch/control", origin=foreign, token=token, body=mute)[0] == 403
+    )
+    assert request(port, "POST", "/launch/control", token=token, body=mute)[0] == 403  # no Origin
+    evil = f"evil.example:{port}"
+    rebound = request(
+        port, "POST", "/launch/control", host=evil, origin=own, token=token, body=mute
+    )
+    assert rebound[0] == 421
+    # nothing outside the control layer: no file, no command
+    assert request(port, "GET", "/launch/../../etc/passwd")[0] == 404
+    status, text = request(
+        port, "POST", "/launch/control", origin=own, token=token, body={"op": "exec", "label": "ls"}
+    )
+    assert status == 400 and b"valid" in text
+    status, text = request(port, "GET", "/launch/follow?label=../../etc/passwd&lines=5")
+    assert status == 404 and b"no process" in text
+
+
+def test_requests_from_elsewhere_or_without_the_token_are_refused(run: Run) -> None:
+    assert_refuses_strangers(run.port)
+    listed = {p["label"]: p for p in run.ctl("list")["processes"]}
+    assert not listed["ticker-1"]["muted"]
+    own = f"http://127.0.0.1:{run.port}"
+    status, text = request(
+        run.port,
+        "POST",
+        "/launch/control",
+        origin=own,
+        token=token_of(run.port),
+        body={"op": "mute", "label": "ticker-1"},
+    )
+    assert status == 200, text
+    assert json.loads(text)["process"]["muted"] is True
+    said = run.running.wait_for(r"output muted by the user \(the launch panel\)", 10)
+    assert run.running.text.count("muted by the user") == 1, said  # the refused ones did not
+    assert {p["label"]: p for p in run.ctl("list")["processes"]}["ticker-1"]["muted"]
+
+
+@pytest.mark.timeout(90)
+def test_metrics_file_has_a_row_per_process_per_second_and_a_report(tmp_path: Path) -> None:
+    path = tmp_path / "panel.launch.py"
+    path.write_text(LAUNCH)
+    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+    metrics = tmp_path / "cost.csv"
+    running = Running(mlaunch(str(path), "--metrics", str(metrics)), env=env, cwd=str(tmp_path))
+    try:
+
+        def samples() -> int:
+            text = metrics.read_text() if metrics.exists() else ""
+            return text.count('"busy-2"')
+
+        wait_for(lambda: samples() >= 8, 60, "eight seconds of samples")
+        running.signal(signal.SIGINT)
+        assert running.finish(30) == 130
+    finally:
+        if running.proc.poll() is None:
+            running.kill()
+    with open(metrics, newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert list(rows[0]) == [
+        "time",
+        "elapsed",
+        "label",
+        "pid",
+        "state",
+        "cpu_percent",
+        "rss_bytes",
+        "threads",
+        "open_files",
+    ]
+    by_label: dict[str, list[dict[str, str]]] = {}
+    for row in rows:
+        by_label.setdefault(row["label"], []).append(row)
+    assert set(by_label) == {"ticker-1", "busy-2"}
+    for label, mine in by_label.items():
+        times = [float(r["elapsed"]) for r in mine]
+        span = times[-1] - times[0]
+        # one row a second: as many intervals as seconds covered (one skipped under load at most)
+        assert span - 1.5 < len(mine) - 1 <= span + 0.5, (label, len(mine), span)
+        gaps = [b - a for a, b in itertools.pairwise(times)]
+        assert all(0.5 < gap < 2.5 for gap in gaps), (label, gaps)
+        assert all(int(r["rss_bytes"]) > 1_000_000 for r in mine)
+        assert all(int(r["threads"]) >= 1 and int(r["open_files"]) >= 3 for r in mine)
+        assert len({r["pid"] for r in mine}) == 1
+    busy = [float(r["cpu_percent"]) for r in by_label["busy-2"][1:]]
+    assert max(busy) > 5.0, busy
+    report = (tmp_path / "cost.html").read_text()
+    assert "ticker-1" in report and "busy-2" in report and report.count("<polyline") == 4
+    assert "report" in running.text and str(metrics) in running.text
+
+
+def test_bad_metrics_file_and_dashboard_port_are_clear_errors(tmp_path: Path) -> None:
+    path = tmp_path / "panel.launch.py"
+    path.write_text(LAUNCH)
+    env = clean_env(ROS_LOG_DIR=str(tmp_path / "logs"))
+    done = run_mlaunch(str(path), "--metrics", str(tmp_path / "no" / "such.csv"), env=env)
+    assert done.returncode == 2
+    assert "--metrics" in done.stderr and "such.csv" in done.stderr and "valid" in done.stderr
+    done = run_mlaunch(str(path), "--dashboard-port", "99999", env=env)
+    assert done.returncode == 2
+    assert "--dashboard-port is '99999'" in done.stderr
