@@ -133,3 +133,13 @@ def viewer_port(environ: dict[str, str]) -> int:
     if not 0 <= port <= 65535:
         raise ViewerError(f"{PORT_ENV}={text!r} is not a port; use 0..65535 (0 = any free port)")
     return port
+
+
+# The launch panel (mlaunch.parts.dashboard) of the run a viewer belongs to is reached at this
+# abstract unix socket, named after the run id every process of the run has in its environment.
+RUN_ID_ENV = "MLAUNCH_RUN_ID"
+
+
+def dashboard_socket(run_id: str) -> str:
+    """The abstract unix socket name (a leading NUL) of run ``run_id``'s launch panel."""
+    return f"\0mlaunch-dashboard-{run_id}"

@@ -9,6 +9,11 @@ otherwise point a name of its own at 127.0.0.1 (DNS rebinding) and read ``/state
 connection that sends nothing for ``IDLE_TIMEOUT`` seconds is closed (each holds a thread).
 ``POST /cmd_vel`` (the page's keys) is taken only from the page itself: same Host, an
 ``Origin`` of this server, and a JSON body, which a cross-site form cannot send.
+
+``/launch/...`` is the launch panel (mlaunch.parts.dashboard) of the run this viewer belongs to:
+passed on, as it came, to mlaunch over an abstract unix socket named after the run id
+(``MLAUNCH_RUN_ID``), and its answer passed back; mlaunch makes the same checks as for its own
+port, against this server's. Without mlaunch (or without the panel) it answers 503.
 """
 
 from __future__ import annotations
@@ -16,13 +21,14 @@ from __future__ import annotations
 import json
 import math
 import os
+import socket
 import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
-from mlaunch.standins.viewer_config import PORT_ENV, ViewerError
+from mlaunch.standins.viewer_config import PORT_ENV, RUN_ID_ENV, ViewerError, dashboard_socket
 
 if TYPE_CHECKING:
     from mlaunch.standins.viewer import ViewerState
@@ -32,6 +38,11 @@ IDLE_TIMEOUT = 5.0  # seconds a connection may stay silent (the page polls every
 LOCAL_NAMES = ("127.0.0.1", "localhost")
 # The fastest the page may ask for (m/s, rad/s): a key held is a command, not a typo's 1e9.
 MAX_LINEAR, MAX_ANGULAR = 2.0, 3.0
+PANEL = "/launch/"  # the launch panel's paths, passed on to mlaunch
+# What of a browser's request the panel needs (the rest stays here).
+PANEL_HEADERS = ("Host", "Origin", "Content-Type", "Accept", "X-Mlaunch-Token")
+PANEL_BODY_MAX = 4096
+PANEL_TIMEOUT = 30.0  # mlaunch's streams say something every 15 s at least
 
 
 class Drive(Protocol):
@@ -61,6 +72,9 @@ def make_handler(
 
         def do_POST(self) -> None:
             if not self.host_allowed():
+                return
+            if self.path.startswith(PANEL):
+                self._panel("POST")
                 return
             if self.path.split("?", 1)[0] != "/cmd_vel" or drive is None:
                 self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
@@ -103,7 +117,9 @@ def make_handler(
             if not self.host_allowed():
                 return
             path = self.path.split("?", 1)[0]
-            if path in ("/", "/index.html"):
+            if path.startswith(PANEL):
+                self._panel("GET")
+            elif path in ("/", "/index.html"):
                 self._send(200, "text/html; charset=utf-8", page)
             elif path == "/state.json":
                 state.note_poll(clock())
@@ -113,6 +129,43 @@ def make_handler(
                 self._send(200, "image/png", png)
             else:
                 self._send(404, "text/plain; charset=utf-8", b"not found: try /\n")
+
+        def _panel(self, method: str) -> None:
+            """Pass the request on to the run's launch panel, and its answer back as it comes
+            (the panel's streams too); the panel closes the connection after it."""
+            length = int(self.headers.get("Content-Length") or "0") if method == "POST" else 0
+            if not 0 <= length <= PANEL_BODY_MAX:
+                self._send(400, "text/plain; charset=utf-8", b"too large a request\n")
+                return
+            body = self.rfile.read(length) if length else b""
+            run_id = os.environ.get(RUN_ID_ENV, "")
+            panel = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+            panel.settimeout(PANEL_TIMEOUT)
+            try:
+                if not run_id:
+                    raise ConnectionRefusedError
+                panel.connect(dashboard_socket(run_id))
+            except OSError:
+                panel.close()
+                text = b"no launch panel: this viewer does not run under mlaunch\n"
+                self._send(503, "text/plain; charset=utf-8", text)
+                return
+            port = (
+                self.server.server_address[1]
+                if isinstance(self.server.server_address, tuple)
+                else 0
+            )
+            head = [f"{method} {self.path} HTTP/1.0", f"X-Mlaunch-Front: {port}"]
+            head += [
+                f"{name}: {self.headers[name]}" for name in PANEL_HEADERS if name in self.headers
+            ]
+            head.append(f"Content-Length: {len(body)}")
+            with panel:
+                panel.sendall(("\r\n".join(head) + "\r\n\r\n").encode("latin-1") + body)
+                self.close_connection = True
+                while chunk := panel.recv(65536):
+                    self.wfile.write(chunk)
+                    self.wfile.flush()
 
         def _send(self, status: int, kind: str, body: bytes) -> None:
             self.send_response(status)
