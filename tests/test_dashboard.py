@@ -195,11 +195,11 @@ def token_of(port: int) -> str:
     return match.group(1).decode()
 
 
-def assert_refuses_strangers(port: int) -> None:
+def assert_refuses_strangers(port: int, label: str = "ticker-1") -> None:
     """What a page elsewhere, a rebinding name or a request without the token gets."""
     own = f"http://127.0.0.1:{port}"
     token = token_of(port)
-    mute = {"op": "mute", "label": "ticker-1"}
+    mute = {"op": "mute", "label": label}
     assert request(port, "GET", "/launch/", host="evil.example:80")[0] == 421
     assert request(port, "GET", "/launch/events", host=f"attacker.test:{port}")[0] == 421
     assert request(port, "POST", "/launch/control", origin=own, body=mute)[0] == 403

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from browser import CHROMIUM, FLAGS
 from conftest import requires_rclpy
 from procutil import wait_for
 
@@ -300,8 +301,6 @@ FAKE_ROBOT = textwrap.dedent(
     """
 )
 
-CHROMIUM = "/usr/bin/chromium"
-
 
 class Child:
     """A child process with its output in files, stopped (SIGTERM, then SIGKILL) at the end."""
@@ -429,14 +428,7 @@ def load_page(url: str, profile: Path) -> dict[str, str]:
     """Load ``url`` in headless chromium and return #stats's data attributes and the HUD pose."""
     argv = [
         CHROMIUM,
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
+        *FLAGS,
         f"--user-data-dir={profile}",
         "--window-size=1000,800",
         "--virtual-time-budget=3000",

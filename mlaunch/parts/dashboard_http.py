@@ -23,13 +23,14 @@ import os
 import socket
 import socketserver
 import struct
-import sys
 import threading
 import time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs
+
+from mlaunch.standins.viewer_http import QuietErrors
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -258,35 +259,18 @@ def secrets_equal(given: str, token: str) -> bool:
     return hmac.compare_digest(given.encode(), token.encode())
 
 
-# A browser that goes away mid-request (a reload, a closed tab) is routine.
-BROWSER_GONE = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError, TimeoutError)
+class PanelServer(QuietErrors, ThreadingHTTPServer):
+    """The panel on a port of its own (--dashboard)."""
 
-
-class _Quiet:
-    """A failed request is one line on mlaunch's stderr, a browser gone none."""
-
-    gone = 0
-
-    def handle_error(self, request: Any, client_address: Any) -> None:
-        error = sys.exc_info()[1]
-        if isinstance(error, BROWSER_GONE):
-            self.gone += 1
-            return
-        line = f"dashboard: a request failed: {type(error).__name__}: {error}\n"
-        try:
-            os.write(2, line.encode("utf-8", "replace"))
-        except OSError:
-            pass
-
-
-class PanelServer(_Quiet, ThreadingHTTPServer):
     daemon_threads = True
+    name = "dashboard"
 
 
-class UnixPanelServer(_Quiet, socketserver.ThreadingMixIn, socketserver.UnixStreamServer):
+class UnixPanelServer(QuietErrors, socketserver.ThreadingMixIn, socketserver.UnixStreamServer):
     """The panel behind the viewer's page: an abstract unix socket, this user's processes only."""
 
     daemon_threads = True
+    name = "dashboard"
 
     def verify_request(self, request: Any, client_address: Any) -> bool:
         creds = request.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, struct.calcsize("3i"))

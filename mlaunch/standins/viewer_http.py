@@ -203,16 +203,17 @@ def _clamp(value: float, limit: float) -> float:
 BROWSER_GONE = (BrokenPipeError, ConnectionResetError, ConnectionAbortedError, TimeoutError)
 
 
-class PageServer(ThreadingHTTPServer):
-    """The page's HTTP server: a browser that resets its connection is not an error.
+class QuietErrors:
+    """A page server's errors: a browser that resets its connection is not an error.
 
     socketserver prints a 20-line traceback into the launch output for every failed request;
     here a reset is counted (``gone``) and anything else is one line on stderr, written in one
-    call so that concurrent requests do not interleave.
+    call so that concurrent requests do not interleave, starting with ``name``. (The launch
+    panel's servers, mlaunch.parts.dashboard_http, share it.)
     """
 
-    daemon_threads = True
     gone = 0
+    name = "viewer"
 
     def handle_error(self, request: Any, client_address: Any) -> None:
         error = sys.exc_info()[1]
@@ -220,14 +221,20 @@ class PageServer(ThreadingHTTPServer):
             self.gone += 1
             return
         try:
-            where = f"{client_address[0]}:{client_address[1]}"
+            where = f" from {client_address[0]}:{client_address[1]}"
         except (TypeError, IndexError):
-            where = str(client_address)
-        line = f"viewer: a request from {where} failed: {type(error).__name__}: {error}\n"
+            where = f" from {client_address}" if client_address else ""
+        line = f"{self.name}: a request{where} failed: {type(error).__name__}: {error}\n"
         try:
             os.write(2, line.encode("utf-8", "replace"))
         except OSError:
             pass
+
+
+class PageServer(QuietErrors, ThreadingHTTPServer):
+    """The page's HTTP server (QuietErrors)."""
+
+    daemon_threads = True
 
 
 def serve(state: ViewerState, port: int, clock: Any, drive: Drive | None = None) -> PageServer:
