@@ -283,7 +283,7 @@ def supervise(
         return code
     smoke = runs[0]
     smoke.conclude()
-    report = Report(path, expectations, smoke.rings, smoke.elapsed())
+    report = Report(path, expectations, smoke.rings, smoke.elapsed(), smoke.window())
     sys.stdout.write(report.table())
     sys.stdout.flush()
     if settings.junit:

@@ -28,7 +28,7 @@ from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.launch_ros.node import same_name_warning
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
-from mlaunch.plan.events import Event, Exited, HandedOff, Said, ShutdownBegun
+from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Said, ShutdownBegun
 from mlaunch.plan.record import Record
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -87,12 +87,14 @@ class ComponentLoader:
         finished: Callable[[threading.Thread], None] | None = None,
         loaded: Callable[[LoadComponents, str], None] | None = None,
         failed: Callable[[LoadComponents], None] | None = None,
+        refused: Callable[[LoadComponents, LoadResult], None] | None = None,
     ) -> None:
         self.context = context  # an initialised rclpy Context
         self.log = log
         self.finished = finished
         self.loaded = loaded  # (step, the node's full name) after each successful load
         self.failed = failed  # (step) when sending its requests raised
+        self.refused = refused  # (step, result) when the container answered it did not load
         self.stop = threading.Event()
         self.results: list[LoadResult] = []
         self._threads: list[threading.Thread] = []
@@ -256,13 +258,16 @@ class ComponentLoader:
                 f"Failed to load node '{name}' of type '{request.plugin_name}' in container"
                 f" '{step.container_name}': {response.error_message}",
             )
-        return LoadResult(
+        result = LoadResult(
             request,
             bool(response.success),
             response.full_node_name,
             int(response.unique_id),
             response.error_message,
         )
+        if not response.success and self.refused is not None:
+            self.refused(step, result)
+        return result
 
 
 # --- attached to a run ---------------------------------------------------------------------
@@ -297,7 +302,7 @@ class ComponentDriver(Part):
         context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
         self.loader = ComponentLoader(
-            context, self._log, self._finished, self._loaded, self._failed
+            context, self._log, self._finished, self._loaded, self._failed, self._refused
         )
         supervisor.events.subscribe(self.on_event)
 
@@ -350,6 +355,14 @@ class ComponentDriver(Part):
             supervisor.begin_shutdown(f"loading into container '{step.container_name}' failed")
 
         self.loop.call_soon(fail)
+
+    def _refused(self, step: LoadComponents, result: LoadResult) -> None:
+        """A container refused a load: said on the stream (``mlaunch test`` fails at once; a
+        run goes on, as launch_ros's)."""
+        request = result.request
+        node = request.full_name if request.node_name else request.plugin_name
+        event = LoadRefused(step.target, node, request.plugin_name, result.error_message)
+        self.loop.call_soon(lambda: self.supervisor.events.emit(event))
 
     def _finished(self, thread: threading.Thread) -> None:
         self.loop.call_soon(lambda: self.supervisor.done(thread))

@@ -296,6 +296,19 @@ class Unclaimed(Event):
         self.launch_event = launch_event
 
 
+class LoadRefused(Event):
+    """A container answered that it did not load a composable node: ``node`` its full name as
+    requested (or its plugin when unnamed), ``reason`` the container's error message."""
+
+    __slots__ = ("container", "node", "plugin", "reason")
+
+    def __init__(self, container: str, node: str, plugin: str, reason: str) -> None:
+        self.container = container
+        self.node = node
+        self.plugin = plugin
+        self.reason = reason
+
+
 class Transition(Event):
     """A managed node changed state: ``event`` is launch_ros's StateTransition for ``spec``."""
 

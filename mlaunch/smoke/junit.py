@@ -15,8 +15,8 @@ import socket
 import stat
 import time
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 from mlaunch.plan.errors import OutputError, UsageError
 
@@ -43,27 +43,65 @@ def xml_text(text: str) -> str:
     return _INVALID_XML.sub("\ufffd", _ANSI.sub("", text))
 
 
+@dataclass
+class Suite:
+    """One launch's testsuite: its cases and ``properties`` (the watched window, the domain)."""
+
+    name: str
+    cases: Sequence[Case]
+    duration: float
+    properties: Mapping[str, str] = field(default_factory=dict)
+    started: float | None = None
+
+
 def render(
-    suite: str, cases: Sequence[Case], *, duration: float, started: float | None = None
+    suite: str,
+    cases: Sequence[Case],
+    *,
+    duration: float,
+    started: float | None = None,
+    properties: Mapping[str, str] | None = None,
 ) -> str:
     """The XML document for one suite."""
-    failures = sum(1 for c in cases if c.failure is not None)
+    return render_suites([Suite(suite, cases, duration, properties or {}, started)])
+
+
+def render_suites(suites: Sequence[Suite]) -> str:
+    """The XML document for several suites (``mlaunch test -j``: one per launch file)."""
+    tests = sum(len(s.cases) for s in suites)
+    failures = sum(_failures(s.cases) for s in suites)
+    root = ET.Element("testsuites", tests=str(tests), failures=str(failures))
+    root.set("time", f"{max((s.duration for s in suites), default=0.0):.3f}")
+    for suite in suites:
+        _suite(root, suite)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _failures(cases: Sequence[Case]) -> int:
+    return sum(1 for c in cases if c.failure is not None)
+
+
+def _suite(root: ET.Element, suite: Suite) -> None:
+    cases = suite.cases
     skipped = sum(1 for c in cases if c.skipped is not None and c.failure is None)
-    stamp = time.strftime("%Y-%m-%dT%H:%M:%S", time.localtime(started or time.time()))
-    root = ET.Element("testsuites", tests=str(len(cases)), failures=str(failures))
-    root.set("time", f"{duration:.3f}")
+    stamp = time.strftime("%Y-%m-%dT%H:%M:%S", time.localtime(suite.started or time.time()))
     node = ET.SubElement(
         root,
         "testsuite",
-        name=xml_text(suite),
+        name=xml_text(suite.name),
         tests=str(len(cases)),
-        failures=str(failures),
+        failures=str(_failures(cases)),
         errors="0",
         skipped=str(skipped),
-        time=f"{duration:.3f}",
+        time=f"{suite.duration:.3f}",
         timestamp=stamp,
         hostname=socket.gethostname(),
     )
+    if suite.properties:
+        properties = ET.SubElement(node, "properties")
+        for name, value in suite.properties.items():
+            ET.SubElement(properties, "property", name=xml_text(name), value=xml_text(value))
     for case in cases:
         element = ET.SubElement(
             node,
@@ -81,14 +119,24 @@ def render(
             ET.SubElement(element, "skipped", message=xml_text(case.skipped))
         if case.system_out:
             ET.SubElement(element, "system-out").text = xml_text(case.system_out)
-    ET.indent(root)
-    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
 
 
-def write(path: str, suite: str, cases: Sequence[Case], *, duration: float) -> None:
+def write(
+    path: str,
+    suite: str,
+    cases: Sequence[Case],
+    *,
+    duration: float,
+    properties: Mapping[str, str] | None = None,
+) -> None:
     """Write the report to ``path`` (raises OutputError when it cannot: exit status 74)."""
+    write_suites(path, [Suite(suite, cases, duration, properties or {})])
+
+
+def write_suites(path: str, suites: Sequence[Suite]) -> None:
+    """Write several suites as one report (raises OutputError when it cannot: exit status 74)."""
     try:
-        write_report(path, render(suite, cases, duration=duration).encode("utf-8"))
+        write_report(path, render_suites(suites).encode("utf-8"))
     except OSError as e:
         raise OutputError(f"cannot write the JUnit report {path}: {e.strerror or e}") from None
 

@@ -7,7 +7,52 @@ from collections import deque
 
 from mlaunch.smoke.expectations import Expectation
 
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from mlaunch.smoke import junit
+
 STATUS_MARKS = {"met": "ok", "failed": "FAIL", "skipped": "--", "pending": "--"}
+
+
+class Window:
+    """What the run watched: ready ``ready_at`` s in (None: never), ``--hold`` ``hold`` s, the
+    watch ended ``ended_at`` s in; a failure later than that is not seen, so the verdict says it."""
+
+    __slots__ = ("ended_at", "hold", "ready_at")
+
+    def __init__(self, ready_at: float | None, hold: float, ended_at: float) -> None:
+        self.ready_at = ready_at
+        self.hold = hold
+        self.ended_at = ended_at
+
+    @property
+    def watched(self) -> float:
+        """Seconds watched after ready (0 when never ready)."""
+        return 0.0 if self.ready_at is None else max(0.0, self.ended_at - self.ready_at)
+
+    def line(self, failed: bool) -> str:
+        if self.ready_at is None:
+            stop = "stopped at a failure" if failed else "stopped"
+            return f"never ready: {stop} {self.ended_at:.1f} s in"
+        held = f"--hold {self.hold:g}"
+        if failed and self.watched < self.hold:
+            return (
+                f"ready after {self.ready_at:.1f} s; failed {self.watched:.1f} s into the"
+                f" {self.hold:g} s hold"
+            )
+        return (
+            f"ready after {self.ready_at:.1f} s, then watched {self.watched:.1f} s ({held}):"
+            f" a failure after {self.ended_at:.1f} s is not seen"
+        )
+
+    def properties(self) -> dict[str, str]:
+        """The JUnit suite's properties."""
+        return {
+            "ready_after": "" if self.ready_at is None else f"{self.ready_at:.3f}",
+            "hold": f"{self.hold:g}",
+            "watched_after_ready": f"{self.watched:.3f}",
+        }
+
 
 # --- the report -----------------------------------------------------------------------------------
 
@@ -21,11 +66,16 @@ class Report:
         expectations: list[Expectation],
         rings: dict[str, deque[str]],
         duration: float,
+        window: Window | None = None,
+        properties: dict[str, str] | None = None,
     ) -> None:
         self.path = path
         self.expectations = expectations
         self.rings = rings
         self.duration = duration
+        self.window = window
+        # More of the run for the JUnit suite's properties (its ROS domain ...).
+        self.properties = dict(properties or {})
 
     @property
     def failures(self) -> list[Expectation]:
@@ -42,6 +92,9 @@ class Report:
             "",
             f"mlaunch test {verdict} in {self.duration:.1f} s: {self.path}",
         ]
+        if self.window is not None:
+            out.append(f"  {self.window.line(bool(failed))}")
+        out += [f"  {name}: {value}" for name, value in self.properties.items()]
         rows = [
             (STATUS_MARKS.get(e.status, "?"), _at(e), e.describe(), e.seen)
             for e in self.expectations
@@ -77,6 +130,13 @@ class Report:
     def write_junit(self, path: str) -> None:
         from mlaunch.smoke import junit
 
+        junit.write_suites(path, [self.suite()])
+
+    def suite(self) -> junit.Suite:
+        """The JUnit testsuite of this run: a testcase per expectation, the window's and the
+        run's properties."""
+        from mlaunch.smoke import junit
+
         stem = os.path.basename(self.path).split(".")[0] or "launch"
         cases = []
         for e in self.expectations:
@@ -92,9 +152,12 @@ class Report:
                     system_out=self.excerpt(e) if failure else "",
                 )
             )
-        junit.write(
-            path, f"mlaunch test {os.path.basename(self.path)}", cases, duration=self.duration
-        )
+        name = f"mlaunch test {os.path.basename(self.path)}"
+        return junit.Suite(name, cases, self.duration, self.junit_properties())
+
+    def junit_properties(self) -> dict[str, str]:
+        window = self.window.properties() if self.window is not None else {}
+        return {**window, **{k.replace(" ", "_"): v for k, v in self.properties.items()}}
 
 
 def _at(e: Expectation) -> str:

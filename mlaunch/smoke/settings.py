@@ -24,6 +24,13 @@ started less than STARTUP_GRACE seconds ago is given the rest of that time befor
 signals, so it is not interrupted half-way through its imports. Processes started later by
 timers or event handlers are watched from when they start.
 
+What cannot heal ends the wait at once, with its reason: a composable node whose load the
+container refused, a lifecycle bring-up that failed, a process that failed, and a check whose
+processes all ended for good (their output, their nodes once the graph had a second to show
+them). The rest is waited for until its deadline (a topic not published yet). The verdict says
+how long the launch was watched after ready (the hold and the start-up grace): a failure later
+than that is not seen (JUnit properties ready_after, hold, watched_after_ready).
+
 More expectations, from the command line (each has the overall ``--timeout`` as deadline unless
 ``--within S`` follows it):
   --expect-topic /scan[:RATE_HZ]     messages arrive (at >= 90% of RATE_HZ, when given)

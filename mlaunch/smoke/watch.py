@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 import signal
@@ -11,7 +12,7 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, Exited, HandedOff, Output, Said, Started
+from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Output, Said, Started
 from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
@@ -22,6 +23,7 @@ if TYPE_CHECKING:
     from mlaunch.parts.ros1_graph import SharedMaster
     from mlaunch.plan.events import ProcessView
     from mlaunch.plan.steps import Plan, ProcessSpec
+    from mlaunch.smoke.report import Window
 
 # At the end, the youngest process is given up to this long since its start before the stop
 # signals: SIGINT during a Python node's imports leaves a traceback in a passing run.
@@ -36,6 +38,9 @@ GRAPH_PERIOD = 0.2
 TICK = 0.1
 # Waiting for a lifecycle node's get_state answer while checking (it is asked again later).
 STATE_QUERY_TIMEOUT = 1.0
+# A node whose processes all ended for good cannot appear any more; the graph is given this
+# long after the last one ended to report what it saw of the node while it ran.
+ENDED_GRACE = 1.0
 # Where the run was when a process ended, in the words of the report's table.
 _PHASES = {
     "waiting": "before the launch was ready",
@@ -72,6 +77,9 @@ class SmokeRun(Part):
         self.phase = "waiting"  # waiting -> holding -> done
         self.failed_reason = ""
         self.rings: dict[str, deque[str]] = {}
+        self._ended: set[str] = set()  # labels of processes that ended and are not respawned
+        self.ready_at: float | None = None  # seconds from the start; None: never ready
+        self.ended_at: float | None = None  # when the watch ended (the shutdown was asked)
         self.loop = LoopCall(supervisor.selector)
         self.started_at = supervisor.clock()
         self._stop = threading.Event()
@@ -110,6 +118,8 @@ class SmokeRun(Part):
             self._on_transition(event)
         elif isinstance(event, HandedOff):
             self._on_handoff(event.step)
+        elif isinstance(event, LoadRefused):
+            self._on_refused(event)
 
     def _on_output(self, label: str, data: bytes) -> None:
         lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
@@ -137,11 +147,57 @@ class SmokeRun(Part):
             e = Expectation("process", label, origin="started later", labels=[label])
             self.expectations.insert(len(self.expectations) - 1, e)
         if not exited:
+            self._ended.discard(label)
             _name_label(self.expectations, process)
             if e.status == "pending":
                 self._met(e, f"running (pid {process.pid})")
             return
         self._exited(e, process)
+        if process.spec.respawn.mode == "never" or process.user_stop:
+            self._ended.add(label)
+            self._cannot_appear(process)
+
+    def _cannot_appear(self, process: ProcessView) -> None:
+        """Fail what only processes that ended for good could have shown: their output at
+        once, their nodes once the graph had ENDED_GRACE to say it saw them."""
+        from mlaunch.engine.process import describe_status
+
+        if self.phase != "waiting":
+            return
+        code = process.returncode if process.returncode is not None else 0
+        why = f"{process.label} ended ({describe_status(code)}) and is not started again"
+        for e in self.expectations:
+            if e.status != "pending" or not e.labels or not set(e.labels) <= self._ended:
+                continue
+            if e.kind == "output" and e.process:
+                self._fail(e, f"no line matched before {why}")
+            elif e.kind in ("node", "lifecycle"):
+                self.supervisor.schedule(
+                    ENDED_GRACE, functools.partial(self._gone, e, why), keeps_alive=False
+                )
+
+    def _gone(self, e: Expectation, why: str) -> None:
+        if e.status == "pending" and set(e.labels) <= self._ended:
+            self._fail(e, f"{e.seen}; it cannot appear: {why}")
+
+    def _on_refused(self, event: LoadRefused) -> None:
+        """A container refused a load: that node cannot appear, whatever the deadline (a
+        refusal that comes as the launch stops still counts: it is an answer, not a race)."""
+        e = next((x for x in self.expectations if x.key() == ("node", event.node)), None)
+        if e is None:
+            labels = [
+                p.label
+                for p in self.supervisor.processes
+                if p.spec.node is not None and p.spec.node.fully_qualified_name == event.container
+            ]
+            e = Expectation("node", event.node, origin="loaded later", labels=labels)
+            self.expectations.insert(len(self.expectations) - 1, e)  # before 'shutdown'
+        reason = event.reason or "no reason given"
+        seen = f"container {event.container} refused to load {event.plugin}: {reason}"
+        if self.phase == "done":
+            self._mark(e, "failed", seen)
+        else:
+            self._fail(e, seen)
 
     def _on_handoff(self, step: object) -> None:
         """Components loaded later (a timer's or a handler's loads) are nodes the graph must
@@ -265,7 +321,10 @@ class SmokeRun(Part):
             return
         if any(e.status == "pending" and e.kind != "shutdown" for e in self.expectations):
             return
+        if any(e.status == "failed" for e in self.expectations):
+            return  # stopping at a failure (the youngest process may still finish starting)
         self.phase = "holding"
+        self.ready_at = self.elapsed()
         emit = self.supervisor.events.emit
         count = sum(1 for e in self.expectations if e.status == "met")
         emit(Said("INFO", "test", f"ready after {self.elapsed():.1f} s ({count} checks met)"))
@@ -287,6 +346,7 @@ class SmokeRun(Part):
             self.supervisor.schedule(wait, lambda: self._finish(reason), keeps_alive=False)
             return
         self.phase = "done"
+        self.ended_at = self.elapsed()
         self.failed_reason = reason if "failed" in reason else ""
         self._stop.set()
         self.supervisor.begin_shutdown(reason)
@@ -334,6 +394,13 @@ class SmokeRun(Part):
         return [e for e in self.expectations if e.kind in GRAPH_KINDS and e.status == "pending"]
 
     # --- the end ----------------------------------------------------------------------------------
+
+    def window(self) -> Window:
+        """How long the run was watched, and how long of that after ready."""
+        from mlaunch.smoke.report import Window
+
+        end = self.ended_at if self.ended_at is not None else self.elapsed()
+        return Window(self.ready_at, self.settings.hold, end)
 
     def conclude(self) -> None:
         """After the run: pending checks did not happen; the stop ladder check."""
