@@ -84,10 +84,11 @@ def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) ->
     from mlaunch.app import pipeline
     from mlaunch.engine.privatedir import private_temp_dir, remove_private_dir
     from mlaunch.export import systemd
+    from mlaunch.export.folder import Folder
     from mlaunch.resolve.resolver import resolve_deferred
 
-    if os.path.isdir(out_dir) and os.listdir(out_dir) and not settings.force:
-        raise UsageError(f"{out_dir!r} is not empty; choose an empty directory or pass --force")
+    if os.path.lexists(out_dir):  # refused now, before loading the file
+        Folder.open(out_dir, force=settings.force).close()
     path, description = pipeline.load_target(opts)
     prefix = systemd.unit_name(settings.name or _stem(path))
     temp_dir = private_temp_dir()
@@ -151,24 +152,25 @@ def write_units(
     }  # every unit is checked before any file is written
     target = systemd.target_text(units, os.path.basename(source))
     environment = systemd.environment_file(chosen).encode()
-    os.makedirs(out_dir, exist_ok=True)
-    systemd.write_private(os.path.join(out_dir, f"{prefix}.env"), environment)
-    for source_file, name in copies:
-        os.makedirs(os.path.join(out_dir, "params"), mode=0o700, exist_ok=True)
-        with open(source_file, "rb") as f:
-            systemd.write_private(os.path.join(out_dir, "params", name), f.read())
-    for name, text in texts.items():
-        _write(os.path.join(out_dir, name), text)
-    _write(os.path.join(out_dir, f"{prefix}.target"), target)
-    _write(
-        os.path.join(out_dir, "README.md"),
-        systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings),
-    )
+    from mlaunch.export.folder import Folder
 
-
-def _write(path: str, text: str) -> None:
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text)
+    folder = Folder.open(out_dir, force=settings.force)
+    try:
+        folder.write(f"{prefix}.env", environment, 0o600)  # secrets: the owner's alone
+        params = folder.subfolder("params") if copies else None
+        for source_file, name in copies:
+            assert params is not None
+            with open(source_file, "rb") as f:
+                params.write(name, f.read(), 0o600)
+        if params is not None:
+            params.close()
+        for name, text in texts.items():
+            folder.write(name, text.encode("utf-8"), 0o644)
+        folder.write(f"{prefix}.target", target.encode("utf-8"), 0o644)
+        readme = systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings)
+        folder.write("README.md", readme.encode("utf-8"), 0o644)
+    finally:
+        folder.close()
 
 
 def _stem(path: str) -> str:

@@ -382,14 +382,6 @@ def install_params(units: list[Unit], install_dir: str) -> list[tuple[str, str]]
     return copies
 
 
-def write_private(path: str, data: bytes) -> None:
-    """Write a file only its owner may read (parameters and environments can hold secrets)."""
-    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o600)
-    with open(fd, "wb") as f:
-        os.fchmod(f.fileno(), 0o600)  # an older file kept its mode through O_TRUNC (--force)
-        f.write(data)
-
-
 def readme_text(prefix: str, install_dir: str, source: str, warnings: list[str]) -> str:
     lines = [
         f"# {prefix}: systemd units of {source}",
