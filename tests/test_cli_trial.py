@@ -102,6 +102,32 @@ def test_quiet_keeps_childrens_stderr() -> None:
     printer.close()
 
 
+def test_quiet_shows_ros_warnings_and_errors_whatever_the_stream() -> None:
+    """rcutils logs INFO to stderr: -q kept it (10 of the seed's 13 lines were 'got segment')."""
+    seen: list[bytes] = []
+    printer = Printer(out=seen.append, quiet=True)
+    printer.register("rsp-1", 0)
+    stderr = (
+        b"[INFO] [1700000000.1] [robot_state_publisher]: got segment base_link\n"
+        b"\x1b[33m[WARN] [1700000000.2] [robot_state_publisher]: no joint states\x1b[0m\n"
+        b"[DEBUG] [1700000000.3] [robot_state_publisher]: tick\n"
+        b"Traceback (most recent call last):\n"
+    )
+    printer.output("rsp-1", "stderr", "screen", stderr)
+    printer.output(
+        "rsp-1", "stdout", "screen", b"[ERROR] [1.0] [x]: on stdout\n[INFO] [1.0] [x]: hi\n"
+    )
+    printer.output("rsp-1", "stdout", "screen", b"[ INFO] [1.0]: roslaunch's\n[ WARN] [1.0]: w\n")
+    shown = b"".join(seen).decode()
+    assert shown.splitlines() == [
+        "[rsp-1] \x1b[33m[WARN] [1700000000.2] [robot_state_publisher]: no joint states\x1b[0m",
+        "[rsp-1] Traceback (most recent call last):",
+        "[rsp-1] [ERROR] [1.0] [x]: on stdout",
+        "[rsp-1] [ WARN] [1.0]: w",
+    ]
+    printer.close()
+
+
 def test_version_and_help_defaults(env: dict[str, str]) -> None:
     done = run_mlaunch("--version", env=env)
     assert done.returncode == 0

@@ -235,7 +235,8 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         "-q",
         "--quiet",
         action="store_true",
-        help="only warnings and errors from mlaunch itself, and the processes' stderr",
+        help="only warnings and errors: mlaunch's, the processes' ROS log lines at WARN and above"
+        " (either stream) and the rest of their stderr",
     )
     parser.add_argument(
         "--color",

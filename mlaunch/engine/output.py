@@ -12,6 +12,7 @@ status view, and imported only when it is shown.
 from __future__ import annotations
 
 import os
+import re
 import sys
 import time
 from collections.abc import Callable, Mapping
@@ -59,6 +60,30 @@ def clean(data: bytes) -> bytes:
         return data
     except UnicodeDecodeError:
         return data.decode("utf-8", "replace").encode("utf-8")
+
+
+# The level of a ROS log line, where a line starts with one: rcutils/rclpy's ``[INFO] [stamp]
+# [node]: ...`` (in colour when the child writes to a terminal) and roslaunch's ``[ INFO] ...``.
+ROS_LOG_LEVEL = re.compile(
+    rb"^(?:\x1b\[[0-9;]*m)?\[ ?(DEBUG|INFO|WARN|WARNING|ERROR|FATAL)\]", re.MULTILINE
+)
+QUIET_LEVELS = frozenset({b"WARN", b"WARNING", b"ERROR", b"FATAL"})
+
+
+def quiet_lines(stream: str, data: bytes) -> bytes:
+    """The lines ``-q`` shows of a chunk: ROS log lines at WARN and above, from either stream,
+    and the stderr lines that are not ROS log lines (a traceback, a program's own complaint)."""
+    if ROS_LOG_LEVEL.search(data) is None:
+        return data if stream == "stderr" else b""  # the common case, without a line loop
+    kept = []
+    for line in data.splitlines(keepends=True):
+        level = ROS_LOG_LEVEL.match(line)
+        if level is None:
+            if stream == "stderr":
+                kept.append(line)
+        elif level.group(1) in QUIET_LEVELS:
+            kept.append(line)
+    return b"".join(kept)
 
 
 def prefix_lines(prefix: bytes, data: bytes) -> bytes:
@@ -228,17 +253,17 @@ class Printer:
     def output(self, label: str, stream: str, mode: str, data: bytes) -> None:
         """Complete lines from a process (bytes ending in newline)."""
         data = clean(data)
-        # -q quiets mlaunch's own messages and children's stdout; their stderr stays visible.
-        if (
-            stream in SCREEN_STREAMS.get(mode, ())
-            and (not self.quiet or stream == "stderr")
-            and label not in self._muted
-        ):
-            if self._write is self._screen:
+        # -q quiets mlaunch's own messages and the children's lines below WARN: their ROS log
+        # lines by level, whatever the stream, and the rest of their stdout.
+        if stream in SCREEN_STREAMS.get(mode, ()) and label not in self._muted:
+            shown = quiet_lines(stream, data) if self.quiet else data
+            if not shown:
+                pass
+            elif self._write is self._screen:
                 # Counted per process, for per-process flow control (Screen.holding).
-                self._screen.write(prefix_lines(self._prefix[label], data), source=label)
+                self._screen.write(prefix_lines(self._prefix[label], shown), source=label)
             else:
-                self._write(prefix_lines(self._prefix[label], data))
+                self._write(prefix_lines(self._prefix[label], shown))
         own = self._own.get(label)
         if own is not None:
             own.write(data)
