@@ -128,6 +128,49 @@ def test_quiet_shows_ros_warnings_and_errors_whatever_the_stream() -> None:
     printer.close()
 
 
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (
+            ["talker.launch.py", "--use-sim-tme"],
+            "mlaunch: error: unrecognized arguments: --use-sim-tme (did you mean"
+            " '--use-sim-time'?); 'mlaunch --help' lists the options",
+        ),
+        (
+            ["test", "talker.launch.py", "--hold", "x"],
+            "mlaunch test: error: argument --hold: invalid float value: 'x'; 'mlaunch test"
+            " --help' lists the options",
+        ),
+        (
+            ["ctl", "--jsn", "list"],
+            "mlaunch ctl: error: unrecognized arguments: --jsn (did you mean '--json'?);"
+            " 'mlaunch ctl --help' lists the options",
+        ),
+        (
+            ["ctl", "lst"],
+            "mlaunch: error: no operation in 'lst' (did you mean 'list'?); valid: list, stop,"
+            " start, restart, mute, unmute, logs",
+        ),
+    ],
+    ids=["option", "test-value", "ctl-option", "ctl-operation"],
+)
+def test_an_option_error_is_one_line_with_the_fix(
+    env: dict[str, str], argv: list[str], line: str
+) -> None:
+    """argparse printed its 9-line usage before the one line that matters, with no did-you-mean."""
+    done = run_mlaunch(*argv, env=env)
+    assert done.returncode == 2
+    assert done.stderr.splitlines() == [line]
+
+
+def test_an_abbreviation_of_one_options_spellings_is_that_option(tmp_path: Path) -> None:
+    """--show-arg was 'ambiguous' between --show-args and --show-arguments, the same option."""
+    ns = build_parser().parse_args(["f.launch.py", "--show-arg"])
+    assert ns.show_args
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["f.launch.py", "--s"])  # --show-args or --status: ambiguous
+
+
 def test_version_and_help_defaults(env: dict[str, str]) -> None:
     done = run_mlaunch("--version", env=env)
     assert done.returncode == 0

@@ -10,6 +10,8 @@ import argparse
 import os
 import sys
 
+from mlaunch.plan.argparser import ArgumentParser
+
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -102,7 +104,7 @@ def _help_width() -> int:
 
 
 def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog=prog,
         formatter_class=_HelpFormatter,
         description="Run a ROS 2 launch file (Python, YAML, XML or ROS 1 XML) and supervise it.",

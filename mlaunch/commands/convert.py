@@ -23,6 +23,7 @@ from mlaunch.convert.to_python import PythonWriter
 from mlaunch.convert.to_xml import XmlWriter
 from mlaunch.convert.to_yaml import YamlWriter
 from mlaunch.convert.writing import FORMATS, ConversionError, Source
+from mlaunch.plan.argparser import ArgumentParser
 from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.ros1.reading import read
 
@@ -43,7 +44,7 @@ def convert(path: str, fmt: str, output: str | None = None) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="mlaunch convert",
         description="Convert a ROS 1 roslaunch XML file to a ROS 2 launch file that resolves to"
         " the same plan as running the ROS 1 file with mlaunch.",

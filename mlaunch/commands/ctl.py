@@ -20,7 +20,8 @@ import sys
 from mlaunch.engine.logfiles import log_base_dir
 from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
 from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, READY, Address
-from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError
+from mlaunch.plan.argparser import ArgumentParser
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, did_you_mean
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -88,7 +89,7 @@ class CtlError(MlaunchError):
 
 
 def parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = ArgumentParser(
         prog="mlaunch ctl",
         usage="mlaunch ctl [-h] [-n LINES] [--json] [RUN] OPERATION [LABEL]",
         description=DESCRIPTION,
@@ -122,8 +123,13 @@ def split_words(words: Sequence[str]) -> tuple[str | None, str, str | None]:
     elif len(words) > 1 and words[1] in OPERATIONS:
         run, rest = words[0], list(words[1:])
     else:
+        # The operation is the middle word of three, else the first (or the second: RUN list).
+        hint = next(
+            filter(None, (did_you_mean(w, OPERATIONS) for w in words[len(words) > 2 :])), ""
+        )
         raise CtlError(
-            f"no operation in {' '.join(words)!r}; valid: {', '.join(OPERATIONS)}", EXIT_USAGE
+            f"no operation in {' '.join(words)!r}{hint}; valid: {', '.join(OPERATIONS)}",
+            EXIT_USAGE,
         )
     op, args = rest[0], rest[1:]
     if op == "list":

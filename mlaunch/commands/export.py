@@ -12,6 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from mlaunch.plan.argparser import ArgumentParser
 from mlaunch.plan.errors import MlaunchError, UsageError
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -34,7 +35,7 @@ def parse(args: list[str]) -> tuple[argparse.Namespace, list[str]]:
 
 def build_parser() -> argparse.ArgumentParser:
     """``mlaunch export``'s own options (the rest are mlaunch FILE's)."""
-    parser = argparse.ArgumentParser(prog="mlaunch export", usage=USAGE, add_help=True)
+    parser = ArgumentParser(prog="mlaunch export", usage=USAGE, add_help=True)
     parser.add_argument(
         "--to",
         nargs=2,

@@ -63,6 +63,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from mlaunch.plan.argparser import ArgumentParser
 from mlaunch.plan.errors import UsageError
 from mlaunch.smoke.expectations import KINDS, Expectation, parse_spec, parse_target
 
@@ -110,7 +111,7 @@ VALUE_FLAGS = (
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = ArgumentParser(
         prog="mlaunch test",
         usage="mlaunch test FILE [name:=value ...] [options of mlaunch FILE] [test options]",
         description="Start a launch, wait until it is ready, hold it, stop it: exit 0 when"
