@@ -62,7 +62,7 @@ def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
     """Where this run looks for ROS packages: --package-path, the launch file, the environment."""
     from mlaunch.ros.search import PackageSearch
 
-    return PackageSearch(opts.package_path, launch_file, os.environ)
+    return PackageSearch(opts.package_path, launch_file, os.environ, standins=opts.standins)
 
 
 def load_target(opts: Options, temp_dir: str | None = None) -> tuple[str, LaunchDescription]:

@@ -8,10 +8,12 @@ from types import TracebackType
 
 # mlaunch/plan/origin.py -> mlaunch/: every frame of mlaunch's own code
 _PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+# The stand-ins' shares hold launch files (mlaunch.standins.SHARE): their lines are a user's.
+_SHARE_DIR = os.path.join(_PACKAGE_DIR, "standins", "share") + os.sep
 
 
 def is_mlaunch_file(filename: str) -> bool:
-    return filename.startswith(_PACKAGE_DIR)
+    return filename.startswith(_PACKAGE_DIR) and not filename.startswith(_SHARE_DIR)
 
 
 def caller_origin() -> str:
@@ -22,7 +24,7 @@ def caller_origin() -> str:
     frame = sys._getframe(1)
     while frame is not None:
         filename = frame.f_code.co_filename
-        if not filename.startswith(_PACKAGE_DIR) and not filename.startswith("<frozen"):
+        if not is_mlaunch_file(filename) and not filename.startswith("<frozen"):
             return f"{filename}:{frame.f_lineno}"
         frame = frame.f_back  # type: ignore[assignment]
     return ""

@@ -64,14 +64,17 @@ class PackageNotFoundError(errors.PackageNotFoundError, KeyError):
 class Package(Record):
     """Where one package is: its share directory, and the prefix it is installed in."""
 
-    _fields = ("name", "share_directory", "prefix", "installed")
+    _fields = ("name", "share_directory", "prefix", "installed", "standin")
     __slots__ = _fields
 
-    def __init__(self, name: str, share_directory: str, prefix: str, installed: bool) -> None:
+    def __init__(
+        self, name: str, share_directory: str, prefix: str, installed: bool, standin: bool = False
+    ) -> None:
         self.name = name
         self.share_directory = share_directory
         self.prefix = prefix  # the ament prefix; for a source package, its folder
         self.installed = installed
+        self.standin = standin  # a share of mlaunch's stand-ins (mlaunch.standins.SHARE)
 
     @property
     def libexec_directory(self) -> str:
@@ -99,10 +102,12 @@ class PackageIndex:
         environ: Mapping[str, str],
         explicit_paths: tuple[str, ...] = (),
         trees_from: tuple[str, ...] = (),
+        standins: bool = False,
     ) -> None:
         self.environ = environ
         self.explicit_paths = explicit_paths
         self.trees_from = trees_from  # files or folders whose source trees are searched
+        self.standins = standins  # the stand-ins' shares answer last (PackageSearch.standins)
         self._sources: dict[str, str] | None = None
 
     # --- ament prefixes -------------------------------------------------------------------------
@@ -173,9 +178,20 @@ class PackageIndex:
 
     # --- lookups ------------------------------------------------------------------------------
 
+    def standin_share(self, name: str) -> Package | None:
+        """A stand-in's share of the package (its launch files), when stand-ins are on."""
+        if not self.standins or not VALID_NAME.fullmatch(name):
+            return None
+        from mlaunch.standins import SHARE
+
+        folder = os.path.join(SHARE, name)
+        if not os.path.isfile(os.path.join(folder, "package.xml")):
+            return None
+        return Package(name, folder, folder, installed=False, standin=True)
+
     def find(self, name: str) -> Package | None:
-        """The package, installed first, else from source; None when it is nowhere."""
-        return self.installed(name) or self.source(name)
+        """The package: installed, else from source, else a stand-in's share; None: nowhere."""
+        return self.installed(name) or self.source(name) or self.standin_share(name)
 
     def get(self, name: str) -> Package:
         """The package, or a PackageNotFoundError saying where it was looked for."""
@@ -184,8 +200,16 @@ class PackageIndex:
             from mlaunch.plan.errors import did_you_mean
 
             hint = did_you_mean(name, self.all_packages())
-            raise PackageNotFoundError(f"package {name!r} not found{hint} ({self.searched()})")
+            raise PackageNotFoundError(
+                f"package {name!r} not found{hint} ({self.searched()}){self._missing_hint(name)}"
+            )
         return package
+
+    def _missing_hint(self, name: str) -> str:
+        """What a user does about a package found nowhere: install it, or let a stand-in serve."""
+        if not self.standins and PackageIndex(self.environ, standins=True).standin_share(name):
+            return "; mlaunch's stand-ins serve its launch files: run without --no-standins"
+        return f"; mlaunch has no stand-in for it: install it ({install_hint(name)})"
 
     def all_packages(self) -> dict[str, Package]:
         out = {
@@ -199,6 +223,12 @@ class PackageIndex:
     def executable(self, package: str, executable: str) -> str:
         """``<prefix>/lib/<package>/<executable>``, as launch_ros's ExecutableInPackage finds it."""
         found = self.get(package)
+        if found.standin:
+            raise PackageNotFoundError(
+                f"package {package!r} is not installed: mlaunch's stand-ins serve its launch"
+                f" files, but not its executable {executable!r} (install the package:"
+                f" {install_hint(package)})"
+            )
         if not found.installed:
             raise PackageNotFoundError(
                 f"package {package!r} is only a source package at {found.share_directory!r}:"
@@ -245,6 +275,12 @@ class PackageIndex:
         return f"{where}; source packages searched under: {', '.join(sources)}{hint}"
 
 
+def install_hint(package: str) -> str:
+    """How a ROS 2 Jazzy user gets a package: its Debian package name, as ROS packages them."""
+    debian = f"ros-jazzy-{package.replace('_', '-')}"
+    return f"sudo apt install {debian}, then source /opt/ros/jazzy/setup.bash"
+
+
 def _is_program(path: str) -> bool:
     return os.path.isfile(path) and os.access(path, os.X_OK)
 
@@ -280,6 +316,7 @@ def index(
         environ=search.environment() if environ is None else environ,
         explicit_paths=explicit,
         trees_from=tuple(starts),
+        standins=search.standins,
     )
 
 

@@ -30,10 +30,11 @@ CONTEXT_KEY = "mlaunch_package_search"
 class PackageSearch(Record):
     """Explicit source-package folders, the top launch file, and the environment lookups use.
 
-    ``environ`` None means the process environment at the time of the lookup.
+    ``environ`` None means the process environment at the time of the lookup; ``standins``
+    False leaves out the stand-ins' shares (--no-standins).
     """
 
-    _fields = ("paths", "launch_file", "environ")
+    _fields = ("paths", "launch_file", "environ", "standins")
     __slots__ = _fields
 
     def __init__(
@@ -41,10 +42,14 @@ class PackageSearch(Record):
         paths: Sequence[str] = (),
         launch_file: str | None = None,
         environ: Mapping[str, str] | None = None,
+        standins: bool = True,
     ) -> None:
         self.paths: tuple[str, ...] = tuple(os.path.abspath(p) for p in paths if p)
         self.launch_file = os.path.abspath(launch_file) if launch_file else None
         self.environ = None if environ is None else dict(environ)
+        # The stand-ins' own shares (mlaunch.standins.SHARE: ros_gz_sim's launch files, ...)
+        # answer last, for a package found nowhere else; off with --no-standins.
+        self.standins = standins
 
     def environment(self) -> Mapping[str, str]:
         return os.environ if self.environ is None else self.environ

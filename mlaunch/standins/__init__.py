@@ -11,13 +11,18 @@ import importlib.util
 import os
 import sys
 
+# The stand-ins' shares: a folder per package whose launch files other launch files include
+# (ros_gz_sim's gz_sim.launch.py, ...), found when the package is neither installed nor checked
+# out (mlaunch.ros.packages.PackageIndex.standin_share). Their programs are the stand-ins below.
+SHARE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "share")
+
 # Programs found on PATH by name: name -> (module, how many leading argv items the stand-in
 # replaces, the argv[1] the real program needs for this use, if any).
 PROGRAMS: dict[str, tuple[str, int, str | None]] = {
     "gazebo": ("sim", 1, None),
     "gzserver": ("sim", 1, None),
-    "gz": ("sim", 2, "sim"),
-    "ign": ("sim", 2, "gazebo"),
+    "gz": ("sim", 1, "sim"),
+    "ign": ("sim", 1, "gazebo"),
     "rviz2": ("viewer", 1, None),
     "spawn_entity.py": ("spawn", 0, None),
 }
@@ -30,6 +35,9 @@ PACKAGE_EXECUTABLES: dict[tuple[str, str], tuple[str, tuple[str, ...]]] = {
     ("rviz2", "rviz2"): ("viewer", ()),
     ("gazebo_ros", "spawn_entity.py"): ("spawn", ("spawn_entity.py",)),
     ("ros_gz_sim", "create"): ("spawn", ("create",)),
+    ("ros_gz_bridge", "parameter_bridge"): ("gz_bridge", ("parameter_bridge",)),
+    ("ros_gz_bridge", "bridge_node"): ("gz_bridge", ("bridge_node",)),
+    ("ros_gz_image", "image_bridge"): ("gz_bridge", ("image_bridge",)),
     ("gazebo_ros", "gzserver"): ("sim", ()),
     ("tf2_ros", "static_transform_publisher"): ("stp", ()),
     ("rclcpp_components", "component_container"): ("container", ()),
@@ -84,7 +92,16 @@ def standin_for(argv: list[str]) -> list[str] | None:
         return None
     if module == "spawn":
         return [*_module_argv(module), name, *argv[1:]]
+    if name in ("gz", "ign") and _gui_only(argv[consumed:]):
+        # `gz sim -g` is Gazebo's GUI alone, a client of the server another process runs:
+        # the viewer is the stand-ins' window onto the simulation, not a second simulator.
+        return _module_argv("viewer")
     return [*_module_argv(module), *argv[consumed:]]
+
+
+def _gui_only(args: list[str]) -> bool:
+    """A ``gz sim`` command line that starts only the GUI (``-g`` without ``-s``)."""
+    return "-g" in args and "-s" not in args
 
 
 def unmet_need(package: str, executable: str) -> str | None:

@@ -31,6 +31,7 @@ from typing import Any, NoReturn
 from mlaunch.plan.errors import StandinError
 from mlaunch.standins.common import StopFlag, install_stop_flag, latched
 from mlaunch.standins.diffdrive import Pose2D, describe_model
+from mlaunch.standins.gz_bridge import BRIDGES_TOPIC
 from mlaunch.standins.plugins import ModelError
 from mlaunch.standins.sim_topics import (
     PROG,
@@ -39,10 +40,11 @@ from mlaunch.standins.sim_topics import (
     make_publisher,
     make_subscription,
     say,
+    subscribe_cmd_vel,
     tf_support,
     warn,
 )
-from mlaunch.standins.simulation import STEP_NS, Schedule, Simulation
+from mlaunch.standins.simulation import STEP_NS, Schedule, SimRobot, Simulation
 from mlaunch.standins.spawn_request import SpawnRequest, free_name, parse_spawn_request
 from mlaunch.standins.world import RESOURCE_PATH_VARS, World, WorldError, load_world
 from mlaunch.standins.world_topic import WORLD_TOPIC, world_message
@@ -107,7 +109,9 @@ def _gz_parser() -> argparse.ArgumentParser:
     p.add_argument("--verbosity", type=int)
     p.add_argument("--seed", type=int)
     p.add_argument("-r", action="store_true", dest="run")
-    for flag in ("-s", "-g", "--levels", "--record", "--headless-rendering", "--wait-for-assets"):
+    # -s (the server alone) is what the stand-in is: nothing to say about it.
+    p.add_argument("-s", action="store_true", dest="server")
+    for flag in ("-g", "--levels", "--record", "--headless-rendering", "--wait-for-assets"):
         p.add_argument(flag, action="store_true", dest=f"ignored_{flag.lstrip('-')}")
     for flag in ("-z", "--iterations", "--network-role", "--network-secondaries", "--record-path",
                  "--playback", "--initial-sim-time", "--render-engine", "--render-engine-gui",
@@ -400,6 +404,10 @@ class RosBridge:
         self.tf = tf_support()
         # The world for the viewer: latched, and only the newest one matters.
         self.world_pub = make_publisher(node, String, WORLD_TOPIC, latched())
+        # cmd_vel subscriptions by topic, and the ROS types bridges announce for gz topics.
+        self.commands: dict[str, tuple[SimRobot, Any, bool]] = {}
+        self.bridged_types: dict[str, str] = {}
+        make_subscription(node, String, BRIDGES_TOPIC, self.on_bridges, latched(10))
         self.run = f"{os.getpid()}-{os.urandom(4).hex()}"  # this start, for the viewer
         self.publish_world()
 
@@ -407,6 +415,37 @@ class RosBridge:
         """The world's shapes and where the robots' odometry frames start in it, for the viewer."""
         text = world_message(self.sim.world, self.sim.robots.values(), self.run)
         self.world_pub.publish(self.String(data=text))
+
+    # -- bridges (ros_gz_bridge's stand-in: mlaunch.standins.gz_bridge)
+
+    def on_bridges(self, msg: Any) -> None:
+        """A bridge's list of topics: a cmd_vel bridged as TwistStamped is subscribed so."""
+        try:
+            bridges = json.loads(msg.data)["bridges"]
+            announced = {str(b["gz_topic"]): str(b["ros_type"]) for b in bridges}
+        except (ValueError, KeyError, TypeError) as exc:
+            warn(f"ignoring a malformed bridge list on {BRIDGES_TOPIC}: {exc}")
+            return
+        self.bridged_types.update(announced)
+        for topic in announced:
+            held = self.commands.get(topic)
+            if held is not None and held[2] != self.stamped(topic):
+                self.node.destroy_subscription(held[1])
+                self.subscribe_commands(held[0])
+
+    def stamped(self, topic: str) -> bool:
+        return self.bridged_types.get(topic) == "geometry_msgs/msg/TwistStamped"
+
+    def subscribe_commands(self, robot: SimRobot) -> None:
+        if robot.spec.drive is None or robot.drive is None:
+            return
+        topic = robot.spec.drive.cmd_topic
+        stamped = self.stamped(topic)
+        self.commands[topic] = (robot, subscribe_cmd_vel(self.node, robot, stamped), stamped)
+        if stamped:
+            say(
+                f"model {robot.spec.name!r}: {topic} takes geometry_msgs/msg/TwistStamped (bridged)"
+            )
 
     # -- spawning
 
@@ -455,6 +494,7 @@ class RosBridge:
         x, y, z, roll, pitch, yaw = request.pose
         sim_robot = self.sim.add_robot(spec, Pose2D(x, y, yaw))
         self.outputs.extend(make_outputs(self.node, self.sim, sim_robot, self.sensor_qos, self.tf))
+        self.subscribe_commands(sim_robot)
         self.publish_world()
         say(f"spawned {spec.summary()} at x={x:g} y={y:g} z={z:g} yaw={yaw:g}")
         if roll or pitch:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mlaunch.standins.camera import CameraParams, DepthRenderer, camera_info
-from mlaunch.standins.diffdrive import DiffDrive, ModelSpec, Pose2D
+from mlaunch.standins.diffdrive import Pose2D
 from mlaunch.standins.sensors import ImuParams, LidarParams
 from mlaunch.standins.simulation import Schedule, SimRobot, Simulation
 
@@ -70,13 +70,11 @@ def tf_support() -> Any:
 
 
 def make_outputs(node: Any, sim: Simulation, robot: SimRobot, qos: Any, tf: Any) -> list[Output]:
-    """Publishers and closures for every topic a spawned robot serves."""
+    """Publishers and closures for every topic a spawned robot serves (cmd_vel apart)."""
     spec = robot.spec
     outputs: list[Output] = []
     start = sim.now_ns
     if spec.drive and robot.drive:
-        drive = robot.drive
-        _subscribe_cmd_vel(node, spec, drive)
         if spec.drive.publish_odom:
             outputs.append(
                 Output(
@@ -119,12 +117,18 @@ def make_outputs(node: Any, sim: Simulation, robot: SimRobot, qos: Any, tf: Any)
     return outputs
 
 
-def _subscribe_cmd_vel(node: Any, spec: ModelSpec, drive: DiffDrive) -> None:
-    from geometry_msgs.msg import Twist
+def subscribe_cmd_vel(node: Any, robot: SimRobot, stamped: bool = False) -> Any:
+    """The robot's diff-drive command subscription: geometry_msgs Twist, or TwistStamped where a
+    bridge says its ROS side has that type (ros_gz_bridge's configs of Jazzy robots do)."""
+    from geometry_msgs.msg import Twist, TwistStamped
 
+    spec, drive = robot.spec, robot.drive
+    assert spec.drive is not None and drive is not None
     warned = [False]
 
     def on_twist(msg: Any) -> None:
+        if stamped:
+            msg = msg.twist
         linear, angular = msg.linear.x, msg.angular.z
         if not (math.isfinite(linear) and math.isfinite(angular)):
             if not warned[0]:
@@ -133,8 +137,8 @@ def _subscribe_cmd_vel(node: Any, spec: ModelSpec, drive: DiffDrive) -> None:
             return
         drive.command(linear, angular)
 
-    assert spec.drive is not None
-    make_subscription(node, Twist, spec.drive.cmd_topic, on_twist, 10)
+    kind = TwistStamped if stamped else Twist
+    return make_subscription(node, kind, spec.drive.cmd_topic, on_twist, 10)
 
 
 def _quaternion(msg: Any, yaw: float) -> None:

@@ -226,20 +226,29 @@ def read_model(options: SpawnOptions, read_stdin: Callable[[], str] = sys.stdin.
     return None
 
 
-def check_model(options: SpawnOptions, xml: str) -> None:
-    """Refuse what the simulator would refuse, before bothering it."""
+def check_model(options: SpawnOptions, xml: str) -> str:
+    """Refuse what the simulator would refuse, before bothering it; the model as URDF.
+
+    An SDF model (``create -file model.sdf``) is written as the URDF robot it describes
+    (mlaunch.standins.sdf_model), with a warning for each part that does not carry over.
+    """
+    from mlaunch.standins.sdf_model import SdfError, is_sdf, sdf_to_urdf
     from mlaunch.standins.urdf import UrdfError, parse_urdf
 
-    head = xml.lstrip()[:400]
-    if "<sdf" in head and "<robot" not in head:
-        raise SpawnError(
-            f"{options.program}: the model for {options.name!r} is SDF; "
-            "the simulator stand-in spawns URDF robots only"
-        )
+    if is_sdf(xml):
+        source = options.value if options.source == "file" else "the SDF model"
+        try:
+            translation = sdf_to_urdf(xml, source)
+        except SdfError as exc:
+            raise SpawnError(f"{options.program}: bad SDF for {options.name!r}: {exc}") from None
+        for note in translation.notes:
+            print(f"{options.program}: warning: {note}", file=sys.stderr, flush=True)
+        xml = translation.urdf
     try:
         parse_urdf(xml)
     except UrdfError as exc:
         raise SpawnError(f"{options.program}: bad URDF for {options.name!r}: {exc}") from None
+    return xml
 
 
 def spawn_request(options: SpawnOptions, xml: str, request_id: str, node_namespace: str) -> str:
@@ -296,7 +305,7 @@ def _run(argv: list[str], stop: StopFlag) -> int:
         )
     xml = read_model(options)
     if xml is not None:
-        check_model(options, xml)
+        xml = check_model(options, xml)
     return _spawn(argv, options, xml, stop)
 
 
@@ -317,8 +326,7 @@ def _spawn(argv: list[str], options: SpawnOptions, xml: str | None, stop: StopFl
         executor.add_node(node)
         waiter = _Waiter(executor, stop, options.program)
         if xml is None:
-            xml = _model_from_topic(node, waiter, options)
-            check_model(options, xml)
+            xml = check_model(options, _model_from_topic(node, waiter, options))
         name = _hand_over(node, waiter, options, xml)
         print(f"{options.program}: spawned entity {name!r}", flush=True)
         return 0

@@ -324,7 +324,11 @@ class _SdfReader:
         """Resolve ``<include><uri>model://NAME</uri>`` through the Gazebo model paths."""
         uri = (element.findtext("uri") or "").strip()
         model_name = uri.removeprefix("model://").strip("/").split("/")[-1]
-        if model_name in _HARMLESS_INCLUDES:
+        # Fuel names them "Ground Plane" and "Sun" (https://fuel.gazebosim.org/.../models/Sun).
+        if model_name.lower().replace(" ", "_") in _HARMLESS_INCLUDES:
+            return
+        if uri.startswith(("http://", "https://")):
+            self.warn(element, f"<include> {uri!r}: the stand-in downloads no Fuel models; skipped")
             return
         found = find_model_sdf(uri, self.environ)
         if found is None:
