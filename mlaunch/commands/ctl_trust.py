@@ -20,19 +20,11 @@ import stat
 import struct
 
 from mlaunch.commands.ctl import CtlError
+from mlaunch.engine.ownership import user_name as _user
 from mlaunch.parts.control_socket import FOLDER, NAME, WHERE
 
 # A ``where`` file holds one path; anything longer is not mlaunch's.
 MAX_WHERE = 4096
-
-
-def _user(uid: int) -> str:
-    import pwd
-
-    try:
-        return f"uid {uid} ({pwd.getpwuid(uid).pw_name})"
-    except KeyError:
-        return f"uid {uid}"
 
 
 def untrusted(path: str) -> str:

@@ -63,7 +63,9 @@ class LogFile:
             self._open()
 
     def _open(self) -> None:
-        self._file = open(self.path, "ab", buffering=LOG_BUFFER)  # noqa: SIM115
+        # Never through a link someone put at the name: only a file of the run's own folder.
+        flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC
+        self._file = open(os.open(self.path, flags, 0o666), "ab", buffering=LOG_BUFFER)  # noqa: SIM115
         self.size = self._file.tell()
 
     def write(self, data: bytes) -> None:
@@ -201,12 +203,27 @@ def log_base_dir(environ: Mapping[str, str]) -> str:
 
 
 def make_run_log_dir(environ: Mapping[str, str]) -> str:
-    """Create ``<base>/<timestamp>-<host>-<pid>/`` and point ``<base>/latest`` at it."""
+    """Create ``<base>/<timestamp>-<host>-<pid>/`` and point ``<base>/latest`` at it.
+
+    A base that another user owns, or may write into without the sticky bit (it or a folder
+    above it), is refused (UsageError): they could swap the run's folder for a link to the
+    caller's own files, which mlaunch would then write into and chmod.
+    """
+    from mlaunch.engine.ownership import unsafe_base
+    from mlaunch.plan.errors import UsageError
+
     base = log_base_dir(environ)
+    os.makedirs(base, exist_ok=True)
+    why = unsafe_base(base)
+    if why:
+        raise UsageError(
+            f"the log folder {base} is not safe for this run's logs: {why}, so they could swap"
+            " the run's folder for a link to your files; set ROS_LOG_DIR to a folder of your own"
+        )
     stamp = time.strftime("%Y-%m-%d-%H-%M-%S", time.localtime())
     micro = f"{time.time() % 1:.6f}"[2:]
     path = os.path.join(base, f"{stamp}-{micro}-{os.uname().nodename}-{os.getpid()}")
-    os.makedirs(path, exist_ok=True)
+    os.mkdir(path)  # a new name of this run's: something already there is not this run's
     latest = os.path.join(base, "latest")
     if not os.path.exists(latest) or os.path.islink(latest):
         tmp = f"{latest}.{os.getpid()}"

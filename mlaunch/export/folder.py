@@ -14,38 +14,12 @@ import errno
 import os
 import stat
 
+from mlaunch.engine.ownership import others_can_write
+from mlaunch.engine.ownership import user_name as _user
 from mlaunch.plan.errors import UsageError
 
 FOLDER_MODE = 0o755
 PRIVATE_FOLDER_MODE = 0o700
-
-
-def _user(uid: int) -> str:
-    import pwd
-
-    try:
-        return f"uid {uid} ({pwd.getpwuid(uid).pw_name})"
-    except KeyError:
-        return f"uid {uid}"
-
-
-def others_can_write(st: os.stat_result) -> bool:
-    """Whether someone besides the owner may add or replace entries of a folder."""
-    if st.st_mode & 0o002:
-        return True
-    if not st.st_mode & 0o020:
-        return False
-    import grp
-    import pwd
-
-    try:
-        group = grp.getgrgid(st.st_gid)
-        owner = pwd.getpwuid(st.st_uid).pw_name
-    except KeyError:
-        return True
-    # Only a user's private group (umask 002 setups: the group named after them, nobody else
-    # in it) lets no one else in.
-    return group.gr_name != owner or any(member != owner for member in group.gr_mem)
 
 
 class Folder:

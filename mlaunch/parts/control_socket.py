@@ -124,7 +124,14 @@ def _listen(path: str) -> socket.socket:
     """A listening socket at ``path`` (0600) in a folder of its own made 0700."""
     folder = os.path.dirname(path)
     os.makedirs(folder, mode=0o700, exist_ok=True)
-    os.chmod(folder, 0o700)  # made earlier with another mode: private all the same
+    # Made earlier with another mode: private all the same; but never through a link.
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)
+    try:
+        if os.fstat(fd).st_uid != os.geteuid():
+            raise PermissionError(f"{folder} is not a folder of yours")
+        os.fchmod(fd, 0o700)
+    finally:
+        os.close(fd)
     try:
         os.unlink(path)  # a run's socket path is its own: what is there is stale
     except FileNotFoundError:
@@ -202,7 +209,7 @@ class ControlSocket:
         where = os.path.join(self.log_dir, FOLDER, WHERE)
         try:
             os.makedirs(os.path.dirname(where), mode=0o700, exist_ok=True)
-            fd = os.open(where, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+            fd = os.open(where, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o600)
             with open(fd, "w", encoding="utf-8") as f:
                 f.write(path + "\n")
         except OSError as e:
