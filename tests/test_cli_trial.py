@@ -171,6 +171,28 @@ def test_an_abbreviation_of_one_options_spellings_is_that_option(tmp_path: Path)
         build_parser().parse_args(["f.launch.py", "--s"])  # --show-args or --status: ambiguous
 
 
+def test_print_names_no_params_file_that_is_gone_once_it_exits(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    """The text --print named /tmp/mlaunch-PID-.../launch_params_... files it had removed."""
+    path = tmp_path / "params.launch.xml"
+    path.write_text(
+        '<launch><node pkg="demo" exec="talker" name="t">'
+        '<param name="rate" value="5"/><param name="frame" value="map"/></node></launch>\n'
+    )
+    done = run_mlaunch(
+        str(path), "--print", env={**env, "AMENT_PREFIX_PATH": demo_package(tmp_path)}
+    )
+    assert done.returncode == 0, done.stderr
+    assert "/mlaunch-" not in done.stdout and "launch_params_" not in done.stdout, done.stdout
+    assert "--params-file <params-file 1> --params-file <params-file 2>" in done.stdout
+    assert "  files:   <params-file 1>, <params-file 2>: files mlaunch writes for the run" in (
+        done.stdout
+    )
+    assert "  param:   rate = 5   [/**]   (params-file 1)" in done.stdout
+    assert "  param:   frame = 'map'   [/**]   (params-file 2)" in done.stdout
+
+
 def test_version_and_help_defaults(env: dict[str, str]) -> None:
     done = run_mlaunch("--version", env=env)
     assert done.returncode == 0

@@ -78,7 +78,10 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
     if spec.standin:
         head += f"   (stand-in for {spec.standin})"
     lines = [head + (f"   {rel(spec.origin)}" if spec.origin else "")]
+    made = _made_files(spec.argv, temp_dir)
     argv = " ".join(spec.argv) if spec.shell else shlex.join(spec.argv)
+    for path, name in made.items():  # (a temporary path needs no shell quotes)
+        argv = argv.replace(path, name)
     lines.append(f"  argv:    {shorten(argv, 400)}" + ("   [via /bin/sh -c]" if spec.shell else ""))
     if spec.node is not None and spec.node.fully_qualified_name:
         kind = "lifecycle node" if spec.node.lifecycle else "node"
@@ -104,18 +107,35 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         lines.append("  exit:    required: its exit shuts the launch down")
     elif spec.on_exit is not None:
         lines.append(f"  on exit: {spec.on_exit.describe()}")
-    lines.extend(_params_files(spec, temp_dir))
+    if made:
+        lines.append(
+            f"  files:   {', '.join(made.values())}: files mlaunch writes for the run and removes"
+            " when it ends; their parameters are below"
+        )
+    lines.extend(_params_files(spec, made))
     return lines
 
 
-def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
+def _made_files(argv: Sequence[str], temp_dir: str | None) -> dict[str, str]:
+    """The argv items that are files of the run's temporary folder, each with the name --print
+    gives it (``<params-file 1>``): the paths --print saw are gone once it exits."""
+    if not temp_dir:
+        return {}
+    made: dict[str, str] = {}
+    for arg in argv:
+        if arg.startswith(temp_dir + os.sep) and arg not in made:
+            made[arg] = f"<params-file {len(made) + 1}>"
+    return made
+
+
+def _params_files(spec: ProcessSpec, made: dict[str, str]) -> list[str]:
     """The parameters in the params files mlaunch wrote for this process, one per line."""
     out = []
     for i, arg in enumerate(spec.argv[:-1]):
         if arg != "--params-file":
             continue
         path = spec.argv[i + 1]
-        if not temp_dir or not path.startswith(temp_dir):
+        if path not in made:
             continue
         try:
             import yaml
@@ -127,7 +147,9 @@ def _params_files(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         for node, section in (data or {}).items():
             params = (section or {}).get("ros__parameters", {})
             for name, value in _flatten(params):
-                out.append(f"  param:   {name} = {value_text(value)}   [{node}]")
+                out.append(
+                    f"  param:   {name} = {value_text(value)}   [{node}]   ({made[path][1:-1]})"
+                )
     return out
 
 
