@@ -32,6 +32,9 @@ MODEL = BRINGUP / "models/gzbot/model.sdf"
 def test_an_sdf_model_becomes_the_urdf_robot_it_describes() -> None:
     text = MODEL.read_text()
     assert is_sdf(text) and not is_sdf("<robot name='r'><link name='a'/></robot>")
+    # xacro puts a long comment banner before the root element.
+    assert is_sdf(f"<?xml version='1.0'?>\n<!-- {'=' * 500} -->\n<sdf version='1.8'/>")
+    assert not is_sdf(f"<?xml version='1.0'?>\n<!-- {'=' * 500} <sdf> -->\n<robot/>")
     translation = sdf_to_urdf(text, str(MODEL))
     robot = parse_urdf(translation.urdf)
     assert robot.name == "gzbot" and robot.root == "base_footprint"

@@ -197,10 +197,13 @@ def _start(node: Any, bridges: list[Bridge]) -> None:
         bridges = [*bridges, *_read_config(str(config))]
     if not bridges:
         raise BridgeError("no bridge: give TOPIC@ROS_TYPE@GZ_TYPE or the config_file parameter")
+    # As the real bridge: gz names are global unless this asks to put them in the namespace.
+    expand = node.declare_parameter("expand_gz_topic_names", False).value
+    prefix = node.get_namespace() if expand is True else ""
     announced = []
     for bridge in bridges:
         ros = node.resolve_topic_name(bridge.ros_topic)
-        gz = gz_name(bridge.gz_topic)
+        gz = gz_name(bridge.gz_topic, prefix)
         announced.append({"gz_topic": gz, "ros_topic": ros, "ros_type": bridge.ros_type})
         _bridge(node, bridge, ros, gz)
     note = {"node": node.get_fully_qualified_name(), "bridges": announced}

@@ -13,6 +13,7 @@ block, which the simulator stand-in reads as it reads a URDF's. Pure Python (xml
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
@@ -23,6 +24,8 @@ from mlaunch.standins.urdf import Matrix, Vec3, _matmul, _origin
 JOINT_TYPES = {"revolute": "revolute", "continuous": "continuous", "prismatic": "prismatic"}
 GEOMETRIES = ("box", "cylinder", "sphere", "mesh")
 UNBOUNDED = 1e16  # SDF's default joint limits: a revolute joint with them turns freely
+# Whitespace, <?...?>, <!--...--> and <!...> before the root element, then its name.
+_ROOT = re.compile(r"(?:\s+|<\?.*?\?>|<!--.*?-->|<![^>]*>)*<([A-Za-z_][\w.-]*)", re.S)
 
 
 class SdfError(StandinError, ValueError):
@@ -38,9 +41,12 @@ class Translation:
 
 
 def is_sdf(xml: str) -> bool:
-    """Whether a model's text is SDF (``<sdf>`` or a bare ``<model>``) rather than URDF."""
-    head = xml.lstrip()[:400]
-    return ("<sdf" in head or head.startswith("<model")) and "<robot" not in head
+    """Whether a model's root element is SDF's (``<sdf>`` or a bare ``<model>``), not URDF's.
+
+    The root is found past the XML declaration, comments and doctype (xacro writes a long
+    comment banner first)."""
+    match = _ROOT.match(xml)
+    return match is not None and match.group(1) in ("sdf", "model")
 
 
 def sdf_to_urdf(xml: str, source: str = "<model>") -> Translation:
