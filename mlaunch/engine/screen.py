@@ -205,7 +205,13 @@ class Screen:
         except OSError:
             mode = 0
         self._regular = stat.S_ISREG(mode)
-        self.pace = None if self._regular or not mode else ReaderPace(fd, mode, clock)
+        pace = None if self._regular or not mode else ReaderPace(fd, mode, clock)
+        if pace is not None and pace.unread() is None:
+            # A sink that cannot say what it holds: /dev/null (`>/dev/null`, `>&-`, systemd's
+            # StandardOutput=null) discards at once, the fastest reader there is. Paced as an
+            # unknown reader, it held every child to ~0.2 MB/s.
+            pace = None
+        self.pace = pace
 
     def __call__(self, data: bytes) -> None:
         self.write(data)
