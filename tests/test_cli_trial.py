@@ -193,6 +193,45 @@ def test_print_names_no_params_file_that_is_gone_once_it_exits(
     assert "  param:   frame = 'map'   [/**]   (params-file 2)" in done.stdout
 
 
+@pytest.mark.parametrize("where", ["generate", "opaque"])
+def test_an_unset_environment_variable_the_file_reads_is_named_as_one(
+    tmp_path: Path, env: dict[str, str], where: str
+) -> None:
+    """'KeyError in generate_launch_description(): 'TURTLEBOT3_MODEL'' did not say what it was."""
+    path = tmp_path / "tb3.launch.py"
+    path.write_text(
+        "import os\n"
+        "from launch import LaunchDescription\n"
+        "from launch.actions import OpaqueFunction\n"
+        "def model(context):\n"
+        "    return [] if os.environ['TURTLEBOT3_MODEL'] else []\n"
+        "def generate_launch_description():\n"
+        f"    {'model(None)' if where == 'generate' else 'pass'}\n"
+        "    return LaunchDescription([OpaqueFunction(function=model)])\n"
+    )
+    env.pop("TURTLEBOT3_MODEL", None)
+    done = run_mlaunch(str(path), "--print", env=env)
+    assert done.returncode == 2
+    assert f"{path}:5: " in done.stderr
+    assert (
+        "KeyError: 'TURTLEBOT3_MODEL' (TURTLEBOT3_MODEL is an environment variable the file"
+        " reads, and it is not set: 'export TURTLEBOT3_MODEL=VALUE' first, or run"
+        " 'TURTLEBOT3_MODEL=VALUE mlaunch ...')"
+        in done.stderr.replace("KeyError in generate_launch_description(): ", "KeyError: ")
+    ), done.stderr
+    done = run_mlaunch(str(path), "--print", env={**env, "TURTLEBOT3_MODEL": "burger"})
+    assert done.returncode == 0, done.stderr
+
+
+def test_a_keyerror_of_a_dict_is_not_called_an_environment_variable() -> None:
+    from mlaunch.plan.origin import unset_variable_hint
+
+    try:
+        {}["HOME"]
+    except KeyError as e:
+        assert unset_variable_hint(e) == ""
+
+
 def test_version_and_help_defaults(env: dict[str, str]) -> None:
     done = run_mlaunch("--version", env=env)
     assert done.returncode == 0

@@ -7,7 +7,7 @@ import sys
 import types
 
 from mlaunch.plan.errors import LaunchFileError, MlaunchError
-from mlaunch.plan.origin import user_location
+from mlaunch.plan.origin import unset_variable_hint, user_location
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -101,7 +101,8 @@ def run_user_code(path: str, call: Any, during: str) -> Any:
         raise
     except Exception as e:
         where = user_location(e.__traceback__, os.path.abspath(path)) or path
-        raise LaunchFileError(f"{type(e).__name__} {during}: {e}", where=where) from e
+        hint = unset_variable_hint(e)
+        raise LaunchFileError(f"{type(e).__name__} {during}: {e}{hint}", where=where) from e
 
 
 def exit_error(e: SystemExit, path: str, during: str) -> LaunchFileError:

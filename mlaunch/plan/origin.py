@@ -42,3 +42,20 @@ def user_location(tb: TracebackType | None, prefer: str | None = None) -> str | 
             best_other = f"{filename}:{tb.tb_lineno}"
         tb = tb.tb_next
     return best_preferred or best_other
+
+
+def unset_variable_hint(e: BaseException) -> str:
+    """What to do, when ``e`` is the KeyError of ``os.environ[NAME]`` in the user's code: a
+    bare ``KeyError: 'TURTLEBOT3_MODEL'`` does not say it is an environment variable."""
+    if not isinstance(e, KeyError) or len(e.args) != 1 or not isinstance(e.args[0], str):
+        return ""
+    tb = e.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    if tb is None or tb.tb_frame.f_locals.get("self") is not os.environ:
+        return ""
+    name = e.args[0]
+    return (
+        f" ({name} is an environment variable the file reads, and it is not set: 'export"
+        f" {name}=VALUE' first, or run '{name}=VALUE mlaunch ...')"
+    )

@@ -21,7 +21,7 @@ from mlaunch.plan.errors import (
     SubstitutionFailure,
     is_own_module,
 )
-from mlaunch.plan.origin import user_location
+from mlaunch.plan.origin import unset_variable_hint, user_location
 from mlaunch.plan.record import Record
 from mlaunch.plan.steps import (
     ArgumentInfo,
@@ -249,7 +249,8 @@ class Resolver:
             raise exit_error(e, path, "in a function of the launch file") from e
         except Exception as e:
             where = user_location(e.__traceback__, self.context.current_launch_file_path)
-            raise MlaunchError(f"{type(e).__name__}: {e}", where=where) from e
+            hint = unset_variable_hint(e)
+            raise MlaunchError(f"{type(e).__name__}: {e}{hint}", where=where) from e
 
     # --- what actions use ---------------------------------------------------------------------
 
