@@ -116,7 +116,39 @@ def test_a_node_that_never_registers_fails_naming_it(tmp_path: Path) -> None:
     assert not master_answers(port)
 
 
-def test_topic_checks_are_refused_on_a_native_run(tmp_path: Path) -> None:
-    done, _ = run_test(tmp_path, SLEEPER, "--expect-topic", "/joint_states")
+def test_lifecycle_checks_are_refused_on_a_native_run(tmp_path: Path) -> None:
+    done, _ = run_test(tmp_path, SLEEPER, "--expect-lifecycle", "/idle/sleeper")
     assert done.returncode == 2, done.stdout + done.stderr
-    assert "a native ROS 1 run checks process, output, node, service" in done.stderr
+    assert "a native ROS 1 run checks process, output, node, service, topic" in done.stderr
+
+
+def test_topics_are_read_through_rospy(tmp_path: Path) -> None:
+    """joint_state_publisher publishes /joint_states at 10 Hz (its default rate); nothing
+    publishes /odom here: the row names the topics the master has instead."""
+    done, port = run_test(
+        tmp_path,
+        SMARTCAR_NODES,
+        *("--expect-topic", "/joint_states:5", "--expect-topic", "/odom", "--timeout", "20"),
+    )
+    out = done.stdout + done.stderr
+    assert done.returncode == 1, out
+    rate = next(x for x in done.stdout.splitlines() if "topic /joint_states " in x)
+    assert re.search(r"\d+\.\d Hz over", rate) and "too" not in rate, rate
+    odom = next(x for x in done.stdout.splitlines() if "topic /odom" in x)
+    assert "not in the graph" in odom, odom
+    assert not master_answers(port)
+    # no reader outlives the run (each ends when mlaunch closes its stdin)
+    probes = [
+        p
+        for p in os.listdir("/proc")
+        if p.isdigit() and _cmdline(p).endswith(f"ros1_topic_probe.py\0{'/odom'}\0")
+    ]
+    assert not probes
+
+
+def _cmdline(pid: str) -> str:
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().decode("utf-8", "replace")
+    except OSError:
+        return ""

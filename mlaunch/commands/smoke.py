@@ -139,8 +139,9 @@ def _native_ros1(description: object) -> NativeRun | None:
     return None if module is None else module.native_run(description)
 
 
-# What a native ROS 1 run can check: its master knows nodes and services, not messages.
-ROS1_KINDS = ("process", "output", "node", "service")
+# What a native ROS 1 run can check: its master knows nodes and services; a topic's messages
+# are counted by a rospy helper (mlaunch.parts.ros1_graph).
+ROS1_KINDS = ("process", "output", "node", "service", "topic")
 
 
 def ros1_expectations(
@@ -161,7 +162,8 @@ def ros1_expectations(
             raise UsageError(
                 f"{expectation.kind} expectation ({expectation.origin}): a native ROS 1 run"
                 f" checks {', '.join(ROS1_KINDS)} (its master is asked which nodes and services"
-                " are registered; topics' messages, /clock and lifecycle states are not read)"
+                " are registered, topics' messages are counted; /clock and lifecycle states"
+                " are not read)"
             )
         out[expectation.key()] = expectation
         if expectation.kind == "output":

@@ -3,27 +3,75 @@
 ``mlaunch test`` on a native ROS 1 run (``mlaunch.parts.ros1_native``) checks it instead of the
 ROS 2 graph: a node is up once it is registered with the master (what ``rosnode list`` reads,
 ``getSystemState``), a service once the master lists it. Python's ``xmlrpc.client`` is all it
-needs: no rospy in mlaunch's own environment.
+needs: no rospy in mlaunch's own environment. A topic's messages are counted by a small helper
+under Debian's Python (``ros1_topic_probe.py``, rospy), one per topic, which writes a line per
+message; it ends when mlaunch closes its stdin (or is gone).
 """
 
 from __future__ import annotations
 
+import os
+import subprocess
 import threading
 import xmlrpc.client
 from typing import Any
 
-from mlaunch.parts.graph_types import GraphNotRunning, RosBridgeError
+from mlaunch.parts.graph_types import GraphNotRunning, RosBridgeError, TopicWatch
 
 # Each call to the master is given this long (a master that does not answer is not up yet).
 CALL_TIMEOUT = 2.0
 CALLER_ID = "/mlaunch_test"
 
 
+SYSTEM_PYTHON = "/usr/bin/python3"
+PROBE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ros1_topic_probe.py")
+
+
 class MasterGraph:
-    """The graph of one ROS 1 master: its registered nodes, topics and services."""
+    """The graph of one ROS 1 master: its registered nodes, topics and services, and the
+    messages of the topics watched."""
 
     def __init__(self, uri: str) -> None:
         self.uri = uri
+        self._probes: list[subprocess.Popen[bytes]] = []
+        self._lock = threading.Lock()
+        self._closed = False
+
+    def watch_topic(self, topic: str) -> TopicWatch:
+        """Counts the topic's messages (any type), through a rospy helper under Debian's Python."""
+        from mlaunch.parts.ros1_native import system_python_env
+
+        watch = TopicWatch(topic, None)
+        env = system_python_env(os.environ)
+        env["ROS_MASTER_URI"] = self.uri
+        try:
+            probe = subprocess.Popen(
+                [SYSTEM_PYTHON, PROBE, topic],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                stderr=subprocess.DEVNULL,
+                env=env,
+                start_new_session=True,
+            )
+        except OSError as e:
+            watch.error = f"cannot start {SYSTEM_PYTHON} to read ROS 1 messages: {e.strerror}"
+            return watch
+        with self._lock:
+            if self._closed:
+                _end(probe)
+                watch.error = "the launch is over"
+                return watch
+            self._probes.append(probe)
+        watch.subscribed = True
+        threading.Thread(target=_read, args=(probe, watch), daemon=True).start()
+        return watch
+
+    def close(self) -> None:
+        with self._lock:
+            self._closed = True
+            probes, self._probes = self._probes, []
+        for probe in probes:
+            _end(probe)
 
     def _call(self, method: str, *args: Any) -> Any:
         """One master API call; its value, or RosBridgeError saying why there is none."""
@@ -68,6 +116,30 @@ class MasterGraph:
         return {str(e[0]) for e in self._system_state()[2] if isinstance(e, list) and e}
 
 
+def _read(probe: subprocess.Popen[bytes], watch: TopicWatch) -> None:
+    """The probe's lines: a message each (``m``), or why none can come (``e WHY``)."""
+    assert probe.stdout is not None
+    for line in probe.stdout:
+        if line.startswith(b"m"):
+            watch._on_message(None)
+        elif line.startswith(b"e "):
+            watch.error = line[2:].decode("utf-8", "replace").strip()[:300]
+    if watch.error is None and probe.wait() not in (0, -15):
+        watch.error = f"the ROS 1 message reader ended with status {probe.returncode}"
+    watch._close()
+
+
+def _end(probe: subprocess.Popen[bytes]) -> None:
+    """Close its stdin (it ends on that), then make sure it has."""
+    try:
+        if probe.stdin is not None:
+            probe.stdin.close()
+        probe.wait(timeout=2.0)
+    except (OSError, subprocess.TimeoutExpired):
+        probe.kill()
+        probe.wait()
+
+
 def _nodes(group: list[Any]) -> set[str]:
     """The node names of one getSystemState list ([name, [node, ...]] entries)."""
     found: set[str] = set()
@@ -103,3 +175,4 @@ class SharedMaster:
 
     def close(self) -> None:
         self._closed.set()
+        self._graph.close()
