@@ -75,6 +75,12 @@ def render(samples: Sequence[Sample]) -> str:
             str(max(p[4] for p in s.points)),
         )
         rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>\n")
+    total_cpu = sum(s.cpu_seconds() for s in series.values())
+    peak_rss = sum(max(p[2] for p in s.points) for s in series.values()) / 2**20
+    rows.append(
+        f"<tr><th>all</th><td></td><td>{total_cpu:.1f}</td><td></td><td></td>"
+        f"<td>{peak_rss:.1f}</td><td></td><td></td></tr>\n"
+    )
     cpu_plot = _plot(series, 1, 1.0, "CPU (% of one core)")
     rss_plot = _plot(series, 2, 1 / 2**20, "memory (RSS, MiB)")
     legend = "".join(
