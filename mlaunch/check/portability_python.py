@@ -24,6 +24,11 @@ _PACKAGES = ("launch", "launch_ros", "launch_xml", "launch_yaml")
 # Classes mlaunch lets you join with ``/`` (newer launch has it; Jazzy does not).
 _SLASH_JOINS = ("PathJoinSubstitution", "FindPackageShare", "FindPackagePrefix", "FindPackage")
 _API: dict[str, Any] = {}
+# Modules newer than Jazzy that mlaunch serves on Jazzy: what ros2 launch (Jazzy) lacks.
+_NEWER = {
+    "launch_testing_ros.actions": "EnableRmwIsolation is launch_testing_ros's after Jazzy"
+    " (ros2/launch_ros#459)",
+}
 
 
 def api() -> dict[str, Any]:
@@ -90,6 +95,13 @@ class _Visitor(ast.NodeVisitor):
     def _module_known(self, node: ast.AST, module: str) -> bool:
         """Whether ``module`` is one Jazzy's launch has (False also for non-launch modules)."""
         top = module.split(".")[0]
+        if module in _NEWER:
+            self.add(
+                node,
+                f"Jazzy has no module {module!r}: an ImportError under ros2 launch (Jazzy);"
+                f" {_NEWER[module]}, and mlaunch runs it",
+            )
+            return False
         if top == "mlaunch":
             self.add(node, f"imports {module!r}: mlaunch's own, not there under ros2 launch")
             return False

@@ -52,6 +52,11 @@ def command(args: Sequence[str]) -> int:
         from mlaunch.launch_testing.launch_test import main as launch_test_main
 
         return launch_test_main(args, prog="mlaunch test")
+    many = _many(args)
+    if many is not None:
+        from mlaunch.commands.smoke_many import run_many
+
+        return run_many(*many)
     mine, rest = split_arguments(args)
     try:
         settings = parse_settings(mine)
@@ -71,6 +76,44 @@ def command(args: Sequence[str]) -> int:
     return run(opts, settings)
 
 
+def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None] | None:
+    """``mlaunch test FILE... [-j N]``: (files, the arguments every run gets, N, --junit), or
+    None for one launch. Several files are meant when -j is given, or when every positional
+    word names a launch file that exists (``PKG FILE`` names a package first)."""
+    from mlaunch.app.options import VALUE_OPTIONS
+    from mlaunch.commands.smoke_many import parse_jobs
+    from mlaunch.smoke.settings import VALUE_FLAGS
+
+    jobs: int | None = None
+    junit_path: str | None = None
+    files: list[str] = []
+    shared: list[str] = []
+    words = iter(args)
+    for arg in words:
+        if arg in ("-j", "--jobs"):
+            jobs = parse_jobs(next(words, ""))
+        elif arg.startswith("--jobs="):
+            jobs = parse_jobs(arg.split("=", 1)[1])
+        elif arg.startswith("-j") and arg[2:].isdigit():
+            jobs = parse_jobs(arg[2:])
+        elif arg in ("--junit", "--junit-xml"):
+            junit_path = next(words, None)
+        elif arg.startswith(("--junit=", "--junit-xml=")):
+            junit_path = arg.split("=", 1)[1]
+        elif arg in VALUE_FLAGS or arg in VALUE_OPTIONS:
+            shared += [arg, next(words, "")]
+        elif arg.startswith("-") or ":=" in arg:
+            shared.append(arg)
+        else:
+            files.append(arg)
+    several = len(files) > 1 and all(os.path.isfile(f) for f in files)
+    if jobs is None and not several:
+        return None
+    if not files:
+        raise UsageError("mlaunch test FILE... -j N: name the launch files to test")
+    return files, shared, jobs or 1, junit_path
+
+
 # --- running --------------------------------------------------------------------------------------
 
 
@@ -78,12 +121,24 @@ def run(opts: Options, settings: Settings) -> int:
     """Load, resolve, supervise with the smoke checks attached; report; the exit status."""
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.engine.logfiles import make_run_log_dir
+    from mlaunch.ros import domain
 
-    with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
-        log_dir = make_run_log_dir(os.environ)
-        path, plan, options, labels, expectations, native = prepare(opts, settings, life, log_dir)
-        checked = (path, expectations, native)
-        return supervise(opts, settings, plan, options, labels, log_dir, checked, life)
+    # A domain of its own (unless the user chose one): runs at the same time never meet.
+    claimed = domain.isolate(os.environ)
+    try:
+        with Lifeline() as life:  # signals, guard and marker from the first line of the launch on
+            log_dir = make_run_log_dir(os.environ)
+            path, plan, options, labels, expectations, native = prepare(
+                opts, settings, life, log_dir
+            )
+            checked = (path, expectations, native)
+            isolation = (domain.describe(os.environ, claimed), os.environ.get("ROS_DOMAIN_ID", ""))
+            return supervise(
+                opts, settings, plan, options, labels, log_dir, checked, life, isolation
+            )
+    finally:
+        if claimed is not None:
+            claimed.release()
 
 
 def print_plan(opts: Options, settings: Settings) -> int:
@@ -252,6 +307,7 @@ def supervise(
     log_dir: str,
     checked: tuple[str, list[Expectation], NativeRun | None],
     life: Lifeline,
+    isolation: tuple[str, str] = ("", ""),
 ) -> int:
     """Run the plan as ``mlaunch FILE`` would (the same parts attached), plus the smoke checks.
 
@@ -285,7 +341,16 @@ def supervise(
         return code
     smoke = runs[0]
     smoke.conclude()
-    report = Report(path, expectations, smoke.rings, smoke.elapsed(), smoke.window())
+    words, domain_id = isolation if native is None else ("", "")  # ROS 1 has no domains
+    report = Report(
+        path,
+        expectations,
+        smoke.rings,
+        smoke.elapsed(),
+        smoke.window(),
+        properties={"ros_domain_id": domain_id} if domain_id else {},
+        notes=[f"ROS domain {words}"] if words else [],
+    )
     sys.stdout.write(report.table())
     sys.stdout.flush()
     if settings.junit:

@@ -32,6 +32,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterator
     from typing import Any
 
+    from mlaunch.ros.domain import Isolation
+
 # How long a launch fixture waits for its ReadyToTest, and for its launch to end at shutdown.
 READY_TIMEOUT = 15.0
 END_TIMEOUT = 60.0
@@ -52,6 +54,7 @@ class LaunchRun:
         self.thread: threading.Thread | None = None
         self.deferred: list[Callable[[], None]] = []
         self.stopped = False
+        self.isolation: Isolation | None = None
         # One asyncio loop for the async tests of this launch: an async generator test's two
         # halves must run on the same loop (closing a loop finalizes its async generators).
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -71,8 +74,12 @@ class LaunchRun:
         cls, value: Any, *, name: str, shutdown_when_idle: bool, auto_shutdown: bool
     ) -> LaunchRun:
         """Launch what the fixture ``name`` returned, in a thread; wait for its ReadyToTest."""
+        from mlaunch.ros.domain import Isolation
+
         description = _description_of(value, name)
+        isolation = Isolation()  # a ROS domain of its own, unless the user set one
         run = cls(value, LaunchService(), auto_shutdown)
+        run.isolation = isolation
         ready = _the_ready_to_test(description)
         ready._add_callback(run.ready.set)
         recorders.register(run.service.context, run)
@@ -129,6 +136,8 @@ class LaunchRun:
             self.run_deferred()
         finally:
             self._by_value.pop(id(self.value), None)
+            if self.isolation is not None:
+                self.isolation.end()
             if self._loop is not None:
                 self._loop.close()
                 self._loop = None

@@ -148,8 +148,11 @@ def _xml_bytes(report: ElementTree) -> bytes:
 def main(argv: Sequence[str] | None = None, prog: str = "launch_test") -> int:
     parser = build_parser(prog)
     args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
+    from mlaunch.ros.domain import Isolation
+
     try:
-        return run(parser, args)
+        with Isolation():  # a ROS domain of its own for the file, unless the user set one
+            return run(parser, args)
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED
     except Exception as e:

@@ -68,14 +68,17 @@ class Report:
         duration: float,
         window: Window | None = None,
         properties: dict[str, str] | None = None,
+        notes: list[str] | None = None,
     ) -> None:
         self.path = path
         self.expectations = expectations
         self.rings = rings
         self.duration = duration
         self.window = window
-        # More of the run for the JUnit suite's properties (its ROS domain ...).
+        # More of the run for the JUnit suite's properties (its ROS domain ...), and in words
+        # for the table.
         self.properties = dict(properties or {})
+        self.notes = list(notes or [])
 
     @property
     def failures(self) -> list[Expectation]:
@@ -94,7 +97,7 @@ class Report:
         ]
         if self.window is not None:
             out.append(f"  {self.window.line(bool(failed))}")
-        out += [f"  {name}: {value}" for name, value in self.properties.items()]
+        out += [f"  {note}" for note in self.notes]
         rows = [
             (STATUS_MARKS.get(e.status, "?"), _at(e), e.describe(), e.seen)
             for e in self.expectations
@@ -157,7 +160,7 @@ class Report:
 
     def junit_properties(self) -> dict[str, str]:
         window = self.window.properties() if self.window is not None else {}
-        return {**window, **{k.replace(" ", "_"): v for k, v in self.properties.items()}}
+        return {**window, **self.properties}
 
 
 def _at(e: Expectation) -> str:

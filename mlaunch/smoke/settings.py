@@ -52,6 +52,12 @@ or from the launch file:
     ``service=``, ``node=``, ``lifecycle=`` with ``state=``, ``output=`` with ``process=``).
 A normal ``mlaunch FILE`` run ignores both.
 
+Each run gets a ROS domain of its own when ROS_DOMAIN_ID is not set: a free id, claimed with a
+lock for as long as the run lasts, and discovery on this machine
+(ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST); the verdict names it. ``mlaunch test A B C -j N``
+tests several launch files, N at a time, each in a domain of its own, with one report and one
+JUnit file holding a testsuite per file.
+
 Exit status: 0 ready (and held, and stopped cleanly); 1 an expectation failed; 2 bad command
 line or launch file; 128+N interrupted by signal N.
 """
@@ -164,6 +170,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE",
         dest="junit",
         help="write a JUnit XML report",
+    )
+    parser.add_argument(
+        "-j",
+        "--jobs",
+        metavar="N",
+        help="test several launch files (mlaunch test A B C -j N), N at a time, each in a ROS"
+        " domain of its own; one report, one JUnit file",
     )
     parser.add_argument(
         "--allow-exit",

@@ -176,7 +176,10 @@ class LaunchTestItem(pytest.Item):
             debug=bool(self.config.getoption("verbose")),
         )
         runner.validate()
-        results = runner.run()
+        from mlaunch.ros.domain import Isolation
+
+        with Isolation():  # a ROS domain of its own for the file, unless the user set one
+            results = runner.run()
         if not all(r.wasSuccessful() for r in results.values()):
             raise LaunchTestFailure("some test cases have failed", results)
 
