@@ -87,9 +87,7 @@ def held(value: str) -> bool:
     return value.strip().isdigit() and int(value) in _HELD
 
 
-def isolate(
-    environ: MutableMapping[str, str], pattern: str = LOCK_PATTERN
-) -> DomainClaim | None:
+def isolate(environ: MutableMapping[str, str], pattern: str = LOCK_PATTERN) -> DomainClaim | None:
     """Claim a domain and set it in ``environ`` when the user set none; None when they did.
 
     Discovery stays on this machine unless ``environ`` chose a range (or the deprecated
