@@ -134,3 +134,20 @@ def test_both_junit_flags_work_for_launch_files_and_launch_testing_files(
             done = run_mlaunch("test", path, *more, *form, env=clean_env(), timeout=120)
             assert done.returncode == status, done.stdout + done.stderr
             assert ET.parse(report).getroot().tag == "testsuites", (path, form)
+
+
+def test_a_long_label_keeps_the_table_s_seen_column() -> None:
+    """A row whose expectation is wider than the column (a long label) pushed its seen cell
+    right; it now goes on a line of its own, in the column."""
+    from collections import deque
+
+    from mlaunch.smoke.expectations import Expectation
+    from mlaunch.smoke.report import Report
+
+    short = Expectation("process", "rsp-1", status="met", seen="running", at=1.0)
+    long = Expectation("process", "x" * 70 + "-2", status="met", seen="running too", at=1.5)
+    table = Report("f.launch.py", [short, long], {"rsp-1": deque()}, 2.0).table().splitlines()
+    header = next(line for line in table if line.rstrip().endswith("seen"))
+    column = header.index("seen")
+    assert table[-1].index("running too") == column, table
+    assert table[-3].rindex("running") == column, table

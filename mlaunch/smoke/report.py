@@ -105,7 +105,12 @@ class Report:
         w_expect = min(60, max(len("expected"), *(len(r[2]) for r in rows)))
         out.append(f"  {'':4}  {'at':>6}  {'expected':<{w_expect}}  seen")
         for status, at, expected, seen in rows:
-            out.append(f"  {status:<4}  {at:>6}  {expected:<{w_expect}}  {seen}")
+            if len(expected) > w_expect:
+                # A long row (a long label) keeps the seen column: its seen goes on the next line.
+                out.append(f"  {status:<4}  {at:>6}  {expected}")
+                out.append(f"  {'':4}  {'':>6}  {'':<{w_expect}}  {seen}")
+            else:
+                out.append(f"  {status:<4}  {at:>6}  {expected:<{w_expect}}  {seen}")
         for label in self._labels(failed):
             out.append("")
             out.append(f"last output of {label}:")
