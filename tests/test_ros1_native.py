@@ -72,8 +72,11 @@ def children_argv(root: int) -> dict[str, list[str]]:
     return found
 
 
-def observe(argv: list[str], env: dict[str, str], port: int) -> tuple[dict[str, Any], Any]:
-    """Start a run, wait until its nodes are up, read its parameter server and command lines."""
+def observe(
+    argv: list[str], env: dict[str, str], port: int, said: list[str] | None = None
+) -> tuple[dict[str, Any], Any]:
+    """Start a run, wait until its nodes are up, read its parameter server and command lines
+    (and what it printed, into ``said``)."""
     run = Running(argv, env={**env, "ROS_MASTER_URI": f"http://localhost:{port}/"})
     try:
         wait_for(
@@ -86,6 +89,8 @@ def observe(argv: list[str], env: dict[str, str], port: int) -> tuple[dict[str, 
     finally:
         run.signal(signal.SIGINT)
         run.finish(timeout=30)
+        if said is not None:
+            said.append(run.text)
 
 
 def normal(argv: list[str], run_id: str) -> list[str]:
@@ -100,7 +105,8 @@ def test_native_smartcar_matches_roslaunch(tmp_path: Path) -> None:
     # a shell set up for ROS 1: the system's python3 first (as on a ROS 1 machine)
     env["PATH"] = os.pathsep.join(["/usr/bin", env.get("PATH", "")])
     theirs, their_nodes = observe([SYSTEM_PYTHON, "/usr/bin/roslaunch", launch], env, free_port())
-    ours, our_nodes = observe([sys.executable, "-m", "mlaunch", launch], env, free_port())
+    said: list[str] = []
+    ours, our_nodes = observe([sys.executable, "-m", "mlaunch", launch], env, free_port(), said)
     # roslaunch also lists its own server's URI (mlaunch has no roslaunch server)
     theirs.pop("roslaunch")
     assert ours.keys() == theirs.keys()
@@ -123,3 +129,8 @@ def test_native_smartcar_matches_roslaunch(tmp_path: Path) -> None:
         "__name:=robot_state_publisher",
         f"{log_dir}/robot_state_publisher-4.log",
     ]
+    # Each process is labelled as roslaunch names it, the name its __log:= file carries (the
+    # labels were mlaunch's count, which also counts the master and the parameter loader).
+    for name in ("rosout", "joint_state_publisher", "robot_state_publisher"):
+        label = our_nodes[name][-1].rsplit("/", 1)[1].removesuffix(".log")
+        assert f"[{label}]: process started" in said[0], (label, said[0][-3000:])

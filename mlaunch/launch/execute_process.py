@@ -94,6 +94,9 @@ class ExecuteProcess(Action):
         self._cmd = [_subs(item) for item in cmd]
         self.prefix = None if prefix is None else _subs(prefix)
         self._name = None if name is None else _subs(name)
+        # The label itself, not counted (a native ROS 1 node is labelled as roslaunch names
+        # its process, whose number its __log:= file carries).
+        self.exact_label: str | None = None
         self._cwd = None if cwd is None else _subs(cwd)
         self._env = _pairs(env)
         self.additional_env = _pairs(additional_env)
@@ -230,7 +233,7 @@ class ExecuteProcess(Action):
         env = self._environment(context)
         on_exit, required = self._exit_policy(context)
         spec = ProcessSpec(
-            label=planner.new_label(base),
+            label=self.exact_label or planner.new_label(base),
             argv=tuple(prefix + argv),
             launch_prefix=tuple(prefix),
             env=env,

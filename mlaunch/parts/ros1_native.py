@@ -273,6 +273,9 @@ def node_process(
         required=node.required,
     )
     process.origin = node.origin
+    # roslaunch's number for the process (its __log:= file's), not mlaunch's count, which
+    # also counts the master and the parameter loader and skips the nodes that cannot start.
+    process.exact_label = f"{node.name}-{number}"
     return process, note
 
 

@@ -107,12 +107,13 @@ def describe_process(spec: ProcessSpec, temp_dir: str | None) -> list[str]:
         lines.append("  exit:    required: its exit shuts the launch down")
     elif spec.on_exit is not None:
         lines.append(f"  on exit: {spec.on_exit.describe()}")
+    params = _params_files(spec, made)
     if made:
         lines.append(
             f"  files:   {', '.join(made.values())}: files mlaunch writes for the run and removes"
-            " when it ends; their parameters are below"
+            " when it ends" + ("; their parameters are below" if params else "")
         )
-    lines.extend(_params_files(spec, made))
+    lines.extend(params)
     return lines
 
 
@@ -122,9 +123,10 @@ def _made_files(argv: Sequence[str], temp_dir: str | None) -> dict[str, str]:
     if not temp_dir:
         return {}
     made: dict[str, str] = {}
-    for arg in argv:
+    for previous, arg in zip(("", *argv), argv, strict=False):
         if arg.startswith(temp_dir + os.sep) and arg not in made:
-            made[arg] = f"<params-file {len(made) + 1}>"
+            kind = "params-file" if previous == "--params-file" else "run-file"
+            made[arg] = f"<{kind} {len(made) + 1}>"
     return made
 
 
