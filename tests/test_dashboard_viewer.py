@@ -1,10 +1,13 @@
-"""The launch panel on the viewer's page: the jtbot's run seen and steered from the address the
-viewer prints, in headless Chromium (issue 36)."""
+"""The launch panel with ROS: on the viewer's page (the jtbot's run seen and steered from the
+address the viewer prints), and a composable node unloaded and loaded again from the page, in
+headless Chromium (issue 36)."""
 
 from __future__ import annotations
 
 import json
 import signal
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -71,6 +74,70 @@ def test_the_viewer_page_shows_the_jtbot_run_and_restarts_a_node(
             )
         # through the viewer's address, the same refusals as the panel's own port
         assert_refuses_strangers(port, "robot_state_publisher-2")
+        run.signal(signal.SIGINT)
+        assert run.finish(60) == 130
+    finally:
+        if run.proc.poll() is None:
+            run.kill()
+
+
+LIST_NODES = """
+import sys, rclpy
+from composition_interfaces.srv import ListNodes
+rclpy.init()
+node = rclpy.create_node("_list_nodes_probe")
+client = node.create_client(ListNodes, sys.argv[1])
+if not client.wait_for_service(timeout_sec=20):
+    sys.exit("no service")
+future = client.call_async(ListNodes.Request())
+rclpy.spin_until_future_complete(node, future, timeout_sec=20)
+print(" ".join(future.result().full_node_names))
+"""
+
+
+def container_nodes(env: dict[str, str]) -> list[str]:
+    """The nodes /jtbot_container says it holds (its list_nodes service)."""
+    done = subprocess.run(
+        [sys.executable, "-c", LIST_NODES, "/jtbot_container/_container/list_nodes"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    return done.stdout.split()
+
+
+@requires_rclpy
+@pytest.mark.timeout(150)
+@pytest.mark.skipif(not available(), reason="chromium not installed (apt chromium)")
+def test_a_composable_node_unloaded_from_the_page_is_gone_from_its_container(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    env = {**ros_env, "ROS_LOG_DIR": str(tmp_path / "logs"), "NO_COLOR": "1"}
+    launch = str(REPO / "launches" / "jtbot_composed.launch.py")
+    run = Running(mlaunch(launch, "rviz:=false", "--dashboard"), env=env, cwd=str(tmp_path))
+    node = 'tr[data-node="/robot_state_publisher"]'
+    try:
+        url = run.wait_for(r"dashboard: open (http://127\.0\.0\.1:\d+/launch/)", 60).group(1)
+        with Browser(tmp_path / "profile") as browser:
+            page = browser.open(url)
+            state = f"document.querySelector('{node}')?.dataset.state"
+            page.wait(f"{state} == 'loaded'", 60, "the component loaded")
+            assert container_nodes(env) == ["/robot_state_publisher"]
+            page.click(f'{node} button[data-op="unload"]')
+            answer = json.loads(page.wait("document.body.dataset.lastControl", 30, "unload"))
+            assert answer["ok"] and answer["op"] == "unload", answer
+            page.wait(f"{state} == 'unloaded'", 15, "the component unloaded")
+            assert container_nodes(env) == []
+            run.wait_for(r"Unloaded node '/robot_state_publisher' from container", 10)
+            run.wait_for(r"unload asked by the user \(the launch panel\)", 10)
+            page.eval("delete document.body.dataset.lastControl")
+            page.click(f'{node} button[data-op="load"]')
+            answer = json.loads(page.wait("document.body.dataset.lastControl", 60, "load"))
+            assert answer["ok"] and answer["op"] == "load", answer
+            page.wait(f"{state} == 'loaded'", 15, "the component loaded again")
+            assert container_nodes(env) == ["/robot_state_publisher"]
         run.signal(signal.SIGINT)
         assert run.finish(60) == 130
     finally:

@@ -41,6 +41,7 @@ class Run:
     __slots__ = (
         "_control",
         "_metrics",
+        "components",
         "lifecycle",
         "opts",
         "plan",
@@ -56,6 +57,7 @@ class Run:
         self.printer = printer
         self.lifecycle: LifecycleManager | None = None
         self._control: Control | None = None
+        self.components: ComponentDriver | None = None  # the LoadNode driver, once attached
         # The run's readiness as ``ctl wait-ready`` asks it (mlaunch.commands.readiness), when
         # a part that can tell is attached.
         self.readiness: Callable[[], dict[str, object]] | None = None
@@ -83,7 +85,9 @@ class Run:
             from mlaunch.parts.control import Control, ControlError
 
             # A part of its own, whichever part first asks for it (the socket, the keys).
-            make = lambda: Control(self.supervisor, self.printer)  # noqa: E731
+            make = lambda: Control(  # noqa: E731
+                self.supervisor, self.printer, lambda: self.components
+            )
             control = self.supervisor.reactor.attach("runtime control", make)
             if not isinstance(control, Control):
                 raise ControlError("runtime control failed when it was made (said above)")
@@ -185,12 +189,21 @@ def lifecycle_part(
 
 
 def components(run: Run) -> Part:
-    """Composable node loading (``components_part``)."""
-    return components_part(run.plan, run.supervisor)
+    """Composable node loading (``components_part``); the run's control reaches the driver."""
+
+    def attached(driver: ComponentDriver) -> None:
+        run.components = driver
+
+    return components_part(run.plan, run.supervisor, attached)
 
 
-def components_part(plan: Plan, supervisor: Supervisor) -> Part:
-    """The LoadNode driver: at once when the plan needs it, else on demand.
+def components_part(
+    plan: Plan,
+    supervisor: Supervisor,
+    attached: Callable[[ComponentDriver], None] | None = None,
+) -> Part:
+    """The LoadNode driver: at once when the plan needs it, else on demand (``attached(it)``
+    once it is made).
 
     Resolve notes in ``plan.needs`` the LoadComponents steps it made and the containers and
     LoadComposableNodes in timers and handlers not yet fired; a handler written as a function
@@ -201,7 +214,10 @@ def components_part(plan: Plan, supervisor: Supervisor) -> Part:
     def driver() -> ComponentDriver:
         from mlaunch.parts.components import ComponentDriver
 
-        return ComponentDriver(supervisor)
+        made = ComponentDriver(supervisor)
+        if attached is not None:
+            attached(made)
+        return made
 
     if Need.COMPONENTS in plan.needs:
         return driver()
@@ -318,7 +334,17 @@ def dashboard(run: Run) -> Part | None:
 def dashboard_part(run: Run) -> Dashboard:
     from mlaunch.parts.dashboard import Dashboard
 
-    return Dashboard(run.supervisor, run.control, run.metrics(), port=run.opts.dashboard_port)
+    def composable() -> list[dict[str, object]]:
+        driver = run.components
+        return [] if driver is None else driver.loader.listed()
+
+    return Dashboard(
+        run.supervisor,
+        run.control,
+        run.metrics(),
+        port=run.opts.dashboard_port,
+        composable=composable,
+    )
 
 
 class _ViewerWatch(Part):

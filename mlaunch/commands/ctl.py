@@ -52,6 +52,9 @@ operations:
   mute LABEL      keep its output off mlaunch's screen; its log file still gets every line
   unmute LABEL    show its output again
   logs LABEL      its last lines (-n)
+  unload NODE     ask its container to unload the composable node NODE (its full name, or
+                  its name when only one has it)
+  load NODE       load it into its container again (after an unload, or a failed load)
   wait-ready      wait until the launch is ready by mlaunch test's checks (processes up, nodes
                   in the graph, lifecycle nodes active, /clock under sim time, the file's own
                   expectations); a run that is not there yet is waited for (--timeout)
@@ -528,6 +531,9 @@ def say(op: str, answer: dict[str, object]) -> str:
     if op == "logs":
         lines = answer.get("lines") or []
         return "".join(f"{line}\n" for line in lines)  # type: ignore[attr-defined]
+    if op in ("unload", "load"):
+        node: dict[str, object] = answer.get("component") or {}  # type: ignore[assignment]
+        return f"{node.get('name')}: {node.get('state')} (container {node.get('container')})\n"
     info: dict[str, object] = answer.get("process") or {}  # type: ignore[assignment]
     label, state = info.get("label"), info.get("state")
     if op in ("mute", "unmute"):

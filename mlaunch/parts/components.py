@@ -67,6 +67,37 @@ class LoadResult(Record):
         self.error_message = error_message
 
 
+class Component:
+    """One composable node of the run, as the launch panel and ``mlaunch ctl unload``/``load``
+    see it: its container, its load request, and ``state`` ("loading", "loaded", "failed",
+    "not loaded": abandoned at shutdown, "unloading", "unloaded", "gone": its container exited).
+    ``name`` is its full name once loaded (the request's until then)."""
+
+    __slots__ = ("error", "name", "request", "state", "step", "unique_id")
+
+    def __init__(self, step: LoadComponents, request: LoadRequest) -> None:
+        self.step = step
+        self.request = request
+        self.state = "loading"
+        self.name = request.full_name if request.node_name else ""
+        self.unique_id = 0
+        self.error = ""
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "container": self.step.target,
+            "name": self.name,
+            "plugin": self.request.plugin_name,
+            "state": self.state,
+            "unique_id": self.unique_id,
+            "error": self.error,
+        }
+
+
+# How long an unload waits for the container's service and for its answer.
+UNLOAD_TIMEOUT = 10.0
+
+
 def describe_load(request: LoadRequest) -> str:
     """``node 'talker' of type 'composition::Talker'`` (the plugin alone when it is unnamed)."""
     if request.node_name:
@@ -104,8 +135,26 @@ class ComponentLoader:
         self._pending: dict[int, tuple[str, list[LoadRequest]]] = {}
         # When each client (by id) first saw its service (mlaunch.parts.discovery).
         self._settling = Settling()
+        # Every composable node the run asked for, in order; each step's, by its count.
+        self.components: list[Component] = []
+        self._entries: dict[int, list[Component]] = {}
 
-    def start(self, step: LoadComponents) -> threading.Thread:
+    def listed(self) -> list[dict[str, object]]:
+        """Every composable node of the run and its state (any thread)."""
+        with self._lock:
+            return [c.as_dict() for c in self.components]
+
+    def find(self, name: str) -> Component | None:
+        """The composable node ``name`` (its full name, or its name alone when only one has it)."""
+        with self._lock:
+            named = [c for c in self.components if c.name == name] or [
+                c for c in self.components if c.name.rsplit("/", 1)[-1] == name
+            ]
+            return named[0] if len(named) == 1 else None
+
+    def start(
+        self, step: LoadComponents, entries: list[Component] | None = None
+    ) -> threading.Thread:
         """Load ``step`` in a new thread (returned, so a caller can join it).
 
         Its requests are pending from now on (not from when the thread gets going), so a
@@ -115,6 +164,12 @@ class ComponentLoader:
             self._count += 1
             count = self._count
             self._pending[count] = (step.target, list(step.requests))
+            if entries is None:
+                entries = [Component(step, request) for request in step.requests]
+                self.components.extend(entries)
+            for entry in entries:
+                entry.state, entry.error = "loading", ""
+            self._entries[count] = entries
         thread = threading.Thread(
             target=self._run, args=(step, count), name=f"load {step.target}", daemon=True
         )
@@ -148,6 +203,9 @@ class ComponentLoader:
         finally:
             with self._lock:
                 self._pending.pop(count, None)
+                for entry in self._entries.pop(count, []):
+                    if entry.state == "loading":
+                        entry.state = "not loaded"
             if self.finished is not None:
                 self.finished(threading.current_thread())
 
@@ -164,6 +222,7 @@ class ComponentLoader:
 
         with self._lock:
             remaining = self._pending[count][1]
+            entries = list(self._entries.get(count, []))
         # Hidden (leading '_') and unique, so it never shows among the launched nodes.
         node = Node(
             f"_mlaunch_loader_{os.getpid()}_{count}",
@@ -176,12 +235,14 @@ class ComponentLoader:
         client = None
         try:
             client = node.create_client(LoadNode, step.service)
-            for request in step.requests:
+            for index, request in enumerate(step.requests):
                 result = None
                 if self._wait_for_service(client, step, request):
                     result = self._call(node, client, request, step)
                 with self._lock:
                     remaining.pop(0)
+                    if result is not None and index < len(entries):
+                        _note(entries[index], result)
                 if result is not None:
                     results.append(result)
                     with self._lock:
@@ -190,6 +251,91 @@ class ComponentLoader:
             node.destroy_node()
             self._settling.forget(id(client))  # the id may be reused by a later client
         return results
+
+    def unload(self, component: Component, done: Callable[[Component], None]) -> None:
+        """Ask its container to unload ``component`` (a thread of its own); ``done(component)``
+        from that thread once it answered (``error`` set when it did not unload it)."""
+        with self._lock:
+            if component.state != "loaded":
+                raise ValueError(f"{component.name} is {component.state}, not loaded")
+            component.state, component.error = "unloading", ""
+        thread = threading.Thread(
+            target=self._unload, args=(component, done), name="unload", daemon=True
+        )
+        thread.start()
+
+    def _unload(self, component: Component, done: Callable[[Component], None]) -> None:
+        try:
+            error = self._unload_call(component)
+        except Exception as e:  # an rclpy failure is the answer, not a dead thread
+            error = f"{type(e).__name__}: {e}"
+        with self._lock:
+            component.state, component.error = ("loaded", error) if error else ("unloaded", "")
+        if not error:
+            self.log(
+                "INFO",
+                f"Unloaded node '{component.name}' from container"
+                f" '{component.step.container_name}'",
+            )
+        done(component)
+
+    def _unload_call(self, component: Component) -> str:
+        """The container's UnloadNode answer: "" when it unloaded the node, else why not."""
+        import os
+        import time
+
+        from composition_interfaces.srv import UnloadNode
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.node import Node
+
+        node = Node(
+            f"_mlaunch_unloader_{os.getpid()}_{component.unique_id}",
+            context=self.context,
+            use_global_arguments=False,
+            start_parameter_services=False,
+            enable_rosout=False,
+        )
+        executor = SingleThreadedExecutor(context=self.context)
+        try:
+            service = f"{component.step.target}/_container/unload_node"
+            client = node.create_client(UnloadNode, service)
+            deadline = time.monotonic() + UNLOAD_TIMEOUT
+            while not client.service_is_ready():
+                if self._stopping() or time.monotonic() > deadline:
+                    return f"the container does not serve {service}"
+                self.stop.wait(POLL)
+            future = client.call_async(UnloadNode.Request(unique_id=component.unique_id))
+            executor.add_node(node)
+            while not future.done():
+                if self._stopping() or time.monotonic() > deadline:
+                    future.cancel()
+                    return f"no answer from {service} in {UNLOAD_TIMEOUT:.0f} s"
+                executor.spin_once(timeout_sec=POLL)
+            response = future.result()
+            return "" if response.success else (response.error_message or "refused")
+        finally:
+            executor.shutdown()
+            node.destroy_node()
+
+    def reload(self, component: Component) -> threading.Thread:
+        """Load ``component`` into its container again (an unloaded or failed one)."""
+        with self._lock:
+            if component.state not in ("unloaded", "failed", "not loaded"):
+                raise ValueError(f"{component.name} is {component.state}")
+        step = LoadComponents(
+            component.step.origin,
+            component.step.target,
+            (component.request,),
+            component.step.written,
+        )
+        return self.start(step, [component])
+
+    def container_exited(self, target: str) -> None:
+        """The container ``target`` exited: what it had loaded is gone with it."""
+        with self._lock:
+            for component in self.components:
+                if component.step.target == target and component.state in ("loaded", "unloading"):
+                    component.state = "gone"
 
     def _stopping(self) -> bool:
         return self.stop.is_set() or not self.context.ok()
@@ -270,6 +416,16 @@ class ComponentLoader:
         return result
 
 
+def _note(component: Component, result: LoadResult) -> None:
+    """What the container answered, on the component (the loader's lock held)."""
+    if result.success:
+        component.state, component.error = "loaded", ""
+        component.name = result.full_node_name or component.name
+        component.unique_id = result.unique_id
+    else:
+        component.state, component.error = "failed", result.error_message
+
+
 # --- attached to a run ---------------------------------------------------------------------
 
 
@@ -304,6 +460,8 @@ class ComponentDriver(Part):
         self.loader = ComponentLoader(
             context, self._log, self._finished, self._loaded, self._failed, self._refused
         )
+        # Who waits for a load thread to end (a ``load`` asked through runtime control).
+        self.waiting: list[Callable[[threading.Thread], None]] = []
         supervisor.events.subscribe(self.on_event)
 
     def on_event(self, event: Event) -> None:
@@ -319,6 +477,8 @@ class ComponentDriver(Part):
     def _exited(self, event: Exited) -> None:
         node = event.process.spec.node
         target = node.fully_qualified_name if node is not None else None
+        if target is not None:
+            self.loader.container_exited(target)
         if target is None or self.supervisor.shutting_down:
             return
         pending = self.loader.pending(target)
@@ -364,8 +524,56 @@ class ComponentDriver(Part):
         event = LoadRefused(step.target, node, request.plugin_name, result.error_message)
         self.loop.call_soon(lambda: self.supervisor.events.emit(event))
 
+    # --- runtime control (mlaunch.parts.control, loop thread) ----------------------------------
+
+    def unload(self, name: str, done: Callable[[dict[str, object]], None]) -> None:
+        """Unload the composable node ``name``; ``done(its state)`` on the loop thread."""
+        from mlaunch.parts.control import ControlError
+
+        component = self._component(name)
+        try:
+            self.loader.unload(component, lambda c: self.loop.call_soon(lambda: done(c.as_dict())))
+        except ValueError as e:
+            raise ControlError(f"cannot unload {name}: {e}") from None
+
+    def load(self, name: str, done: Callable[[dict[str, object]], None]) -> None:
+        """Load the composable node ``name`` again; ``done(its state)`` once its container
+        answered (on the loop thread)."""
+        from mlaunch.parts.control import ControlError
+
+        component = self._component(name)
+        try:
+            thread = self.loader.reload(component)
+        except ValueError as e:
+            raise ControlError(f"cannot load {name}: {e}") from None
+        self.supervisor.busy(thread)
+
+        def answered(finished: threading.Thread) -> None:
+            if finished is thread:
+                self.waiting.remove(answered)
+                done(component.as_dict())
+
+        self.waiting.append(answered)
+
+    def _component(self, name: str) -> Component:
+        from mlaunch.parts.control import UnknownNode
+
+        component = self.loader.find(name)
+        if component is None:
+            names = [str(c["name"]) for c in self.loader.listed() if c["name"]]
+            raise UnknownNode(
+                f"no composable node {name!r} in this run, or several (composable nodes:"
+                f" {', '.join(names) or 'none'})"
+            )
+        return component
+
     def _finished(self, thread: threading.Thread) -> None:
-        self.loop.call_soon(lambda: self.supervisor.done(thread))
+        def finished() -> None:
+            self.supervisor.done(thread)
+            for waiting in list(self.waiting):
+                waiting(thread)
+
+        self.loop.call_soon(finished)
 
     def _log(self, level: str, message: str) -> None:
         """A line from a load's thread, said from the loop thread."""

@@ -57,10 +57,13 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from mlaunch.engine.output import Printer
     from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.parts.components import ComponentDriver
     from mlaunch.plan.events import ProcessView
 
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
-OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs")
+OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs", "unload", "load")
+# Those that name a composable node rather than a process.
+COMPONENT_OPERATIONS = ("unload", "load")
 DEFAULT_LINES = 20
 # Labels an unknown-label error lists (a launch may have hundreds).
 LISTED = 20
@@ -105,6 +108,12 @@ class AmbiguousLabel(ControlError):
         super().__init__(f"{name!r} names several processes: {', '.join(labels)}; give one label")
 
 
+class UnknownNode(ControlError):
+    """A composable node name the run does not have (or several of its nodes share)."""
+
+    exit_code = EXIT_USAGE
+
+
 class ProcessInfo:
     """One label as the user sees it: what ``list`` shows and ``done`` callbacks receive.
 
@@ -144,6 +153,7 @@ class ProcessInfo:
 
 
 Done = Callable[[ProcessInfo], None]
+ComponentDone = Callable[[dict[str, object]], None]
 
 
 class Control(Part):
@@ -153,9 +163,16 @@ class Control(Part):
     names it.
     """
 
-    def __init__(self, supervisor: Supervisor, printer: Printer) -> None:
+    def __init__(
+        self,
+        supervisor: Supervisor,
+        printer: Printer,
+        components: Callable[[], ComponentDriver | None] = lambda: None,
+    ) -> None:
         self.supervisor = supervisor
         self.printer = printer
+        # The LoadNode driver, once the run has one (unload and load a composable node).
+        self.components = components
         # (process, what, callback): "exit" calls back when it exits, "restart" when its
         # label's next instance has started.
         self._waits: list[tuple[Process, str, Done]] = []
@@ -287,6 +304,33 @@ class Control(Part):
             self.printer.mute(label, False)
             self.supervisor.events.emit(Controlled(label, "unmute", by))
         return self.info(label)
+
+    # --- composable nodes ------------------------------------------------------------------
+
+    def composable_nodes(self) -> list[dict[str, object]]:
+        """Every composable node of the run: container, name, plugin, state (any thread)."""
+        driver = self.components()
+        return [] if driver is None else driver.loader.listed()
+
+    def unload(self, name: str, *, by: str = "", done: ComponentDone) -> None:
+        """Ask its container to unload the composable node ``name`` (its full name, or its
+        name when only one has it); ``done(its state)`` once the container answered."""
+        self._driver("unload").unload(name, done)
+        self.supervisor.events.emit(Controlled(name, "unload", by))
+
+    def load(self, name: str, *, by: str = "", done: ComponentDone) -> None:
+        """Load the composable node ``name`` into its container again (after an unload, or a
+        failed load); ``done(its state)`` once the container answered."""
+        self._driver("load").load(name, done)
+        self.supervisor.events.emit(Controlled(name, "load", by))
+
+    def _driver(self, action: str) -> ComponentDriver:
+        driver = self.components()
+        if driver is None:
+            raise ControlError(f"cannot {action}: this run has no composable nodes")
+        if self.supervisor.shutting_down:
+            raise ControlError(f"cannot {action}: the launch is shutting down")
+        return driver
 
     # --- the parts -------------------------------------------------------------------------
 

@@ -395,7 +395,7 @@ def answer_request(
     from mlaunch.parts.control import AmbiguousLabel, ControlError, UnknownLabel
 
     try:
-        carry_out(control(), request, by=by, answer=answer, accepted=accepted)
+        carry_out(control(), request, by=by, answer=answer, accepted=accepted, fail=fail)
     except UnknownLabel as e:
         fail(str(e), e.exit_code, labels=e.labels, close=e.close)
     except AmbiguousLabel as e:
@@ -415,9 +415,11 @@ def carry_out(
     by: str,
     answer: Reply,
     accepted: Reply | None = None,
+    fail: Callable[..., None] | None = None,
 ) -> None:
-    """What ``request`` asks of ``control`` (raises ControlError or BadRequest)."""
-    from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
+    """What ``request`` asks of ``control`` (raises ControlError or BadRequest); an unload or
+    load the container refused is ``fail``'s."""
+    from mlaunch.parts.control import COMPONENT_OPERATIONS, DEFAULT_LINES, OPERATIONS
 
     op, label = request.get("op"), request.get("label")
     if op not in OPERATIONS:
@@ -431,7 +433,19 @@ def carry_out(
     def done(info: ProcessInfo) -> None:
         answer({"process": info.as_dict()})
 
-    if op == "logs":
+    if op in COMPONENT_OPERATIONS:
+
+        def answered(component: dict[str, object]) -> None:
+            if component.get("error") and fail is not None:
+                fail(f"{op} {component.get('name')}: {component['error']}", EXIT_FAILURE)
+            else:
+                answer({"component": component})
+
+        if op == "unload":
+            control.unload(label, by=by, done=answered)
+        else:
+            control.load(label, by=by, done=answered)
+    elif op == "logs":
         lines = request.get("lines", DEFAULT_LINES)
         if not isinstance(lines, int) or isinstance(lines, bool):
             raise BadRequest(f"lines must be a whole number, not {lines!r}")

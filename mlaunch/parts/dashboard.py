@@ -138,11 +138,13 @@ class Dashboard(Part):
         metrics: Metrics,
         *,
         port: int | None,
+        composable: Callable[[], list[dict[str, object]]] = lambda: [],
     ) -> None:
         self.supervisor = supervisor
         self.control = control
         self.metrics = metrics
         self.port = port
+        self.composable = composable  # the composable nodes and their state (any thread)
         self.hub = Hub()
         self.token = secrets.token_urlsafe(24)
         self.servers: list[BaseServer] = []
@@ -201,7 +203,7 @@ class Dashboard(Part):
             entry["history"] = list(history)
             processes.append(entry)
         run = {"pid": os.getpid(), "run_id": self.supervisor.run_id, "elapsed": sample.elapsed}
-        message = {"run": run, "processes": processes}
+        message = {"run": run, "processes": processes, "components": self.composable()}
         hub.publish(json.dumps(message, separators=(",", ":")).encode())
 
     # --- asked by the browsers' threads -----------------------------------------------------
