@@ -117,6 +117,9 @@ class ReaderPace:
             self._taken = taken
         return unread
 
+    def blocked(self) -> None:
+        """The fd took less than it was given (the kernel's count says the rest)."""
+
     def _add(self, seconds: float, size: int) -> None:
         self._samples.append((seconds, size))
         self._span += seconds
@@ -135,6 +138,113 @@ class ReaderPace:
         rate = self.rate
         ahead = self.ahead if rate is None else max(MIN_AHEAD, int(rate * KERNEL_SECONDS))
         return ahead - unread
+
+
+# A pty (UNIX98 slaves: majors 136-143) says nothing of what it holds: TIOCOUTQ is always 0.
+PTY_MAJORS = range(136, 144)
+# While the reader's pace is measured from blocked writes: a window lasts at least this long...
+WINDOW = 0.6
+# ... and two blocked writes further apart than this are not one stretch of saturation.
+SATURATED_GAP = 0.5
+# A pace that held PROBE_AFTER seconds without the terminal blocking a write is raised by this
+# factor (the reader may have sped up); past MAX_PACE it is a reader that keeps up. A raise
+# that overshoots fills the terminal's buffer before it shows (a quiet line then waits ~0.7 s
+# at 30 KB/s), so it is rare; a terminal left idle IDLE_RESET seconds is measured afresh.
+PROBE_AFTER = 10.0
+IDLE_RESET = 2.0
+PROBE_FACTOR = 1.25
+MEASURED_SHARE = 0.8
+MAX_PACE = 4_000_000
+
+
+class WritePace(ReaderPace):
+    """The pace of a reader whose kernel buffer says nothing (a pty), from the time of writes.
+
+    While the terminal blocks the writes (EAGAIN, a partial write), its buffer is full and it
+    takes bytes exactly as fast as the reader reads them: the pace is the bytes it took between
+    two blocked writes at least WINDOW apart. Until that is known, the terminal gets what it
+    takes (its buffer fills once: ~20 KB, 0.7 s at 30 KB/s). Once it is known, what the buffer
+    holds is estimated (what was written, less the pace times the time since), and writes keep
+    it near KERNEL_SECONDS of the pace, as ReaderPace does with the kernel's own count. A pace
+    that held for PROBE_AFTER seconds is raised a little, so that a reader that sped up is
+    found: a write blocked after that raise goes back to the pace before it; one blocked
+    otherwise means the reader slowed down, and its pace is measured afresh.
+    """
+
+    def __init__(self, fd: int, mode: int, clock: Callable[[], float]) -> None:
+        super().__init__(fd, mode, clock)
+        self._pace: float | None = None
+        self._held = 0.0  # estimated bytes in the terminal's buffer, at ``_held_at``
+        self._held_at = clock()
+        self._window: tuple[float, int] | None = None  # (since, written then) while saturated
+        self._blocked_at = -math.inf
+        self._probed_at = -math.inf
+        self._probing = False  # the pace was raised on trust and not blocked since
+
+    @property
+    def rate(self) -> float | None:
+        return self._pace
+
+    def unread(self) -> int | None:
+        now = self.clock()
+        if self._pace is not None:
+            self._held = max(0.0, self._held - self._pace * (now - self._held_at))
+            if not self._held and now - self.progress_at >= IDLE_RESET:
+                self._pace = None  # idle: the next burst measures the reader again
+                self.ahead = UNKNOWN_AHEAD
+            elif now - max(self._blocked_at, self._probed_at) >= PROBE_AFTER:
+                self._probed_at = now
+                self._probing = True
+                self._pace *= PROBE_FACTOR
+                if self._pace > MAX_PACE:  # keeps up: no pacing
+                    self._pace = None
+                    self.ahead = MAX_AHEAD
+        self._held_at = now
+        return int(self._held)
+
+    def sample(self) -> int | None:
+        return self.unread()
+
+    def room(self, unread: int) -> int:
+        if self._pace is None:
+            return 1 << 30  # as much as the terminal takes: that measures it
+        return max(MIN_AHEAD, int(self._pace * KERNEL_SECONDS)) - unread
+
+    def wrote(self, n: int) -> None:
+        self.unread()  # the estimate up to now, before adding
+        self.written += n
+        self._held += n
+        self.progress_at = self.clock()
+
+    def blocked(self) -> None:
+        """The terminal took less than it was given: its buffer is full."""
+        now = self.clock()
+        if self._pace is not None and self._probing:
+            # The last raise overshot: back to the pace before it, and the buffer is full.
+            self._pace /= PROBE_FACTOR
+            self._held = self._pace * KERNEL_SECONDS * 4
+            self._held_at = self._blocked_at = now
+            self._probed_at = now
+            self._probing = False
+            return
+        if self._pace is not None:  # the reader slowed down: measure it again
+            self._pace = None
+            self._window = None
+        self.ahead = UNKNOWN_AHEAD  # not a reader that keeps up, whatever was thought
+        if self._window is None or now - self._blocked_at > SATURATED_GAP:
+            self._window = (now, self.written)
+        else:
+            since, written = self._window
+            if now - since >= WINDOW:
+                if self.written > written:
+                    # Measured as the kernel frees room, in its own steps: a window over-counts
+                    # by up to a fifth; a pace a little under the reader's keeps its buffer low.
+                    self._pace = MEASURED_SHARE * (self.written - written) / (now - since)
+                    self._held = self._pace * KERNEL_SECONDS * 4  # full: assume the worst
+                    self._held_at = now
+                    self._probed_at = now
+                self._window = None
+        self._blocked_at = now
 
 
 class Screen:
@@ -205,7 +315,13 @@ class Screen:
         except OSError:
             mode = 0
         self._regular = stat.S_ISREG(mode)
-        pace = None if self._regular or not mode else ReaderPace(fd, mode, clock)
+        pace: ReaderPace | None = None
+        if self._regular or not mode:
+            pace = None
+        elif stat.S_ISCHR(mode) and os.major(os.fstat(fd).st_rdev) in PTY_MAJORS:
+            pace = WritePace(fd, mode, clock)
+        else:
+            pace = ReaderPace(fd, mode, clock)
         if pace is not None and pace.unread() is None:
             # A sink that cannot say what it holds: /dev/null (`>/dev/null`, `>&-`, systemd's
             # StandardOutput=null) discards at once, the fastest reader there is. Paced as an
@@ -446,6 +562,8 @@ class Screen:
                 # A partial write keeps an offset into the head: the rest is never copied.
                 n = os.write(self.fd, view)
             except BlockingIOError:
+                if self.pace is not None:
+                    self.pace.blocked()
                 return
             except OSError:
                 self.gone = True
@@ -459,6 +577,8 @@ class Screen:
                 self._taken(n)
                 if self.pace is not None:
                     self.pace.wrote(n)
+                    if n < len(view):
+                        self.pace.blocked()
                 if room is not None:
                     room -= n
             self._size -= n
