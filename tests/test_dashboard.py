@@ -308,3 +308,25 @@ def test_bad_metrics_file_and_dashboard_port_are_clear_errors(tmp_path: Path) ->
     done = run_mlaunch(str(path), "--dashboard-port", "99999", env=env)
     assert done.returncode == 2
     assert "--dashboard-port is '99999'" in done.stderr
+
+
+@needs_chromium
+@pytest.mark.timeout(120)
+def test_the_page_shows_the_readiness_checks_as_ctl_wait_ready_has_them(
+    run: Run, tmp_path: Path
+) -> None:
+    with Browser(tmp_path / "profile") as browser:
+        page = browser.open(run.url)
+        page.wait("document.getElementById('ready').dataset.ready == 'true'", 30, "ready")
+        checks = page.eval(
+            "[...document.querySelectorAll('#checks tr')].map(r => [r.dataset.check,"
+            " r.dataset.state, r.cells[1].textContent])"
+        )
+        done = run_mlaunch("ctl", "wait-ready", "--json", env=run.env, timeout=30)
+        assert done.returncode == 0, done.stdout + done.stderr
+        answer = json.loads(done.stdout)
+        assert checks == [[c["check"], c["state"], c["description"]] for c in answer["checks"]]
+        assert [c[2] for c in checks] == [
+            "process ticker-1 starts and keeps running",
+            "process busy-2 starts and keeps running",
+        ]

@@ -338,10 +338,15 @@ def dashboard_part(run: Run) -> Dashboard:
         driver = run.components
         return [] if driver is None else driver.loader.listed()
 
+    def readiness() -> object:
+        return None if run.readiness is None else run.readiness()
+
+    metrics = run.metrics()
+    metrics.readers["readiness"] = readiness  # mlaunch test's checks, as ctl wait-ready has them
     return Dashboard(
         run.supervisor,
         run.control,
-        run.metrics(),
+        metrics,
         port=run.opts.dashboard_port,
         composable=composable,
     )

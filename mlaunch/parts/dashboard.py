@@ -203,7 +203,12 @@ class Dashboard(Part):
             entry["history"] = list(history)
             processes.append(entry)
         run = {"pid": os.getpid(), "run_id": self.supervisor.run_id, "elapsed": sample.elapsed}
-        message = {"run": run, "processes": processes, "components": self.composable()}
+        message = {
+            "run": run,
+            "processes": processes,
+            "components": self.composable(),
+            "readiness": sample.extra.get("readiness"),
+        }
         hub.publish(json.dumps(message, separators=(",", ":")).encode())
 
     # --- asked by the browsers' threads -----------------------------------------------------

@@ -48,16 +48,22 @@ COLUMNS = (
 
 
 class Sample:
-    """Every process at one moment: ``rows`` of (ProcessInfo, Usage or None when not running)."""
+    """Every process at one moment: ``rows`` of (ProcessInfo, Usage or None when not running);
+    ``extra`` what the ``readers`` said on the loop thread at that moment (by name)."""
 
-    __slots__ = ("elapsed", "rows", "time")
+    __slots__ = ("elapsed", "extra", "rows", "time")
 
     def __init__(
-        self, time: float, elapsed: float, rows: list[tuple[ProcessInfo, Usage | None]]
+        self,
+        time: float,
+        elapsed: float,
+        rows: list[tuple[ProcessInfo, Usage | None]],
+        extra: dict[str, object] | None = None,
     ) -> None:
         self.time = time
         self.elapsed = elapsed
         self.rows = rows
+        self.extra = {} if extra is None else extra
 
 
 Listener = Callable[[Sample], None]
@@ -82,10 +88,15 @@ class Metrics(Part):
         self.wall_clock = wall_clock
         self.csv_path = csv_path
         self.listeners: list[Listener] = []
+        # What else each sample carries, read on the loop thread (the run's readiness ...);
+        # a reader that raises gives None.
+        self.readers: dict[str, Callable[[], object]] = {}
         self.history: list[Sample] = []  # kept for the report when there is a CSV file
         self._csv: IO[str] | None = None
         self._start: float | None = None
-        self._queue: queue.Queue[tuple[float, list[ProcessInfo]] | None] = queue.Queue(maxsize=1)
+        self._queue: queue.Queue[tuple[float, list[ProcessInfo], dict[str, object]] | None] = (
+            queue.Queue(maxsize=1)
+        )
         self._sampler = GroupSampler()
         self._closed = False
         self._failure = ""  # what the sampling thread could not do, said by the loop
@@ -103,16 +114,28 @@ class Metrics(Part):
         if self._failure:
             self.supervisor.events.emit(Said("WARNING", "launch", self._failure))
             self._failure = ""
-        try:
-            self._queue.put_nowait((self.wall_clock(), self.control().processes()))
-        except queue.Full:
-            pass
+        if not self._queue.full():
+            item = (self.wall_clock(), self.control().processes(), self._read())
+            try:
+                self._queue.put_nowait(item)
+            except queue.Full:
+                pass
         # On the run's own beat (start + k periods), so a late turn of the loop does not drift.
         now = self.supervisor.clock()
         if self._beat is None:
             self._beat = now
         late = (now - self._beat) % self.period
         self.supervisor.schedule(self.period - late, self._tick, keeps_alive=False)
+
+    def _read(self) -> dict[str, object]:
+        extra: dict[str, object] = {}
+        for name, reader in self.readers.items():
+            try:
+                extra[name] = reader()
+            except Exception as e:  # what the panel shows, never a reason to stop sampling
+                extra[name] = None
+                self._failure = f"metrics: {name} could not be read: {type(e).__name__}: {e}"
+        return extra
 
     def _work(self) -> None:
         while True:
@@ -124,13 +147,13 @@ class Metrics(Part):
             except Exception as e:  # said by the loop's next tick; the next sample is tried
                 self._failure = f"metrics: a sample failed: {type(e).__name__}: {e}"
 
-    def _take(self, now: float, infos: list[ProcessInfo]) -> None:
+    def _take(self, now: float, infos: list[ProcessInfo], extra: dict[str, object]) -> None:
         if self._start is None:
             self._start = now
         running = {info.pid for info in infos if info.pid}
         usage = self._sampler.sample(group_members(running))
         rows = [(info, usage.get(info.pid) if info.pid else None) for info in infos]
-        sample = Sample(now, now - self._start, rows)
+        sample = Sample(now, now - self._start, rows, extra)
         if self._csv is not None:
             self.history.append(sample)
             _write_rows(self._csv, sample)
