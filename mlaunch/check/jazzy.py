@@ -161,3 +161,32 @@ BROKEN_SUBSTITUTIONS = {
 
 # on_exit: the only value Jazzy's frontends accept.
 ON_EXIT_WORDS = ("shutdown",)
+
+# Newer than Jazzy, and run by mlaunch on Jazzy (--check names the release that has each): a
+# Jazzy ros2 launch rejects the file. Tags, substitutions, and Python names and modules.
+_LAUNCH_3_8 = "launch 3.8 (Kilted, ros2/launch#802)"
+NEWER_TAGS = {"for_each": _LAUNCH_3_8, "for": _LAUNCH_3_8}
+NEWER_SUBSTITUTIONS = {
+    "for-var": _LAUNCH_3_8,
+    "index": _LAUNCH_3_8,
+    "string-join": "launch 3.9.5 (Rolling, ros2/launch#857)",
+}
+_STRING_JOIN = "launch 3.8.1 (Kilted, ros2/launch#843)"
+NEWER_PYTHON = {
+    "launch.actions.ForEach": _LAUNCH_3_8,
+    "launch.actions.ForLoop": _LAUNCH_3_8,
+    "launch.actions.for_loop": _LAUNCH_3_8,
+    "launch.substitutions.ForEachVar": _LAUNCH_3_8,
+    "launch.substitutions.ForLoopIndex": _LAUNCH_3_8,
+    "launch.substitutions.for_loop_var": _LAUNCH_3_8,
+    "launch.substitutions.StringJoinSubstitution": _STRING_JOIN,
+    "launch.substitutions.string_join_substitution": _STRING_JOIN,
+}
+
+
+def newer(what: str, release: str) -> str:
+    """The finding for syntax newer than Jazzy."""
+    return (
+        f"{what} is newer than Jazzy: {release} has it, ros2 launch (Jazzy) fails on it;"
+        " mlaunch runs it"
+    )

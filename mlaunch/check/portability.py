@@ -112,6 +112,16 @@ class _Walker:
 
     def action(self, e: Entity) -> None:
         table = jazzy.ACTIONS.get(e.tag)
+        if e.tag in jazzy.NEWER_TAGS:
+            self.add(e, jazzy.newer(f"the tag {e.tag!r}", jazzy.NEWER_TAGS[e.tag]))
+            for attr in e.attrs.values():
+                if isinstance(attr.value, str):
+                    self.substitutions(e, attr, attr.value)
+                elif isinstance(getattr(attr.value, "value", None), str):
+                    self.substitutions(e, attr, attr.value.value)
+            for child in e.children or []:
+                self.action(child)
+            return
         if table is None:
             if e.tag not in exposed()[0]:  # a package's tag is that package's to check
                 self.add(e, f"Jazzy has no tag {e.tag!r}: ros2 launch rejects the file")
@@ -200,7 +210,10 @@ class _Walker:
     def substitutions(self, e: Entity, attr: Attr, text: str) -> None:
         for match in _SUBSTITUTION.finditer(text):
             broken = jazzy.BROKEN_SUBSTITUTIONS.get(match.group(1))
-            if broken:
+            newer = jazzy.NEWER_SUBSTITUTIONS.get(match.group(1))
+            if newer:
+                self.add(e, jazzy.newer(f"$({match.group(1)} ...)", newer), attr)
+            elif broken:
                 self.add(e, f"Jazzy's $({match.group(1)} ...) is broken: {broken}", attr)
             elif match.group(1) not in jazzy.SUBSTITUTIONS and match.group(1) not in exposed()[1]:
                 self.add(

@@ -14,6 +14,7 @@ import ast
 import json
 import os
 
+from mlaunch.check import jazzy
 from mlaunch.check.portability import Finding, reads_as_bool
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -84,6 +85,9 @@ class _Visitor(ast.NodeVisitor):
         for alias in node.names:
             dotted = f"{module}.{alias.name}"
             missing = exports is not None and alias.name != "*" and alias.name not in exports
+            if missing and dotted in jazzy.NEWER_PYTHON:
+                self.add(node, jazzy.newer(dotted, jazzy.NEWER_PYTHON[dotted]))
+                continue
             if missing and dotted not in api()["modules"]:
                 self.add(
                     node,
@@ -106,6 +110,9 @@ class _Visitor(ast.NodeVisitor):
             self.add(node, f"imports {module!r}: mlaunch's own, not there under ros2 launch")
             return False
         if top not in _PACKAGES:
+            return False
+        if module in jazzy.NEWER_PYTHON:
+            self.add(node, jazzy.newer(f"the module {module}", jazzy.NEWER_PYTHON[module]))
             return False
         if module not in api()["modules"]:
             self.add(node, f"Jazzy has no module {module!r}: an ImportError under ros2 launch")

@@ -179,6 +179,27 @@ def _timer(e: Entity) -> Any:
     return core.TimerAction(period=period, actions=actions, **kwargs)
 
 
+def _for_each(e: Entity) -> Any:
+    """``<for_each values="...">``, newer than Jazzy: its children once per set of values."""
+    children = [build_action(child) for child in e.actions()]
+
+    def iteration(**values: Any) -> list[Any]:
+        return core.ForEach.iteration_entities(children, values)
+
+    return core.ForEach(required_text(e, "values"), function=iteration)
+
+
+def _for(e: Entity) -> Any:
+    """``<for len="..." name="...">``, newer than Jazzy: its children ``len`` times."""
+    name = required_literal(e, "name")
+    children = [build_action(child) for child in e.actions()]
+
+    def iteration(i: int) -> list[Any]:
+        return core.ForEach.iteration_entities(children, {name: i})
+
+    return core.ForLoop(required_text(e, "len"), function=iteration, name=name)
+
+
 def _set_env(e: Entity) -> Any:
     return core.SetEnvironmentVariable(required_text(e, "name"), required_text(e, "value"))
 
@@ -231,6 +252,8 @@ ACTIONS: dict[str, Builder] = {
     "reset_env": _reset_env,
     "log": _log,
     "timer": _timer,
+    "for_each": _for_each,
+    "for": _for,
     "shutdown": _shutdown,
     "reset": _reset,
     **PROCESS_TAGS,
@@ -239,7 +262,7 @@ ACTIONS: dict[str, Builder] = {
 }
 
 # The tags whose children are actions.
-TAKES_ACTIONS = ("group", "timer")
+TAKES_ACTIONS = ("group", "timer", "for_each", "for")
 
 # ROS 2 tags mlaunch knows but does not implement, with what to do instead.
 UNSUPPORTED: dict[str, str] = {

@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 
 from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
+from mlaunch.launch.actions.for_loop import ForEach, ForLoop
 from mlaunch.launch.actions.register_event_handler import (
     RegisterEventHandler,
     UnregisterEventHandler,
@@ -270,6 +271,8 @@ __all__ = [
     "EmitEvent",
     "ExecuteLocal",
     "ExecuteProcess",
+    "ForEach",
+    "ForLoop",
     "GroupAction",
     "IncludeLaunchDescription",
     "LaunchDescription",

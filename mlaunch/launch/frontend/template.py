@@ -126,6 +126,10 @@ def _command(a: list[Any]) -> Substitution:
     return core.Command(a[0])
 
 
+def _for_var(a: list[Any]) -> Substitution:
+    return core.ForEachVar(a[0], default_value=a[1] if len(a) > 1 else None)
+
+
 def _if(a: list[Any]) -> Substitution:
     return core.IfElseSubstitution(a[0], a[1], a[2] if len(a) > 2 else "")
 
@@ -158,6 +162,15 @@ SUBSTITUTIONS: dict[str, SubstitutionSpec] = {
         "$(not-equals a b)", 2, 2, lambda a: core.NotEqualsSubstitution(a[0], a[1])
     ),
     "if": SubstitutionSpec("$(if condition value [else-value])", 2, 3, _if),
+    # Newer than Jazzy (--check says so): launch 3.8 (Kilted), string-join 3.9.5 (Rolling).
+    "for-var": SubstitutionSpec("$(for-var name [default])", 1, 2, _for_var),
+    "index": SubstitutionSpec("$(index name)", 1, 1, lambda a: core.ForLoopIndex(a[0])),
+    "string-join": SubstitutionSpec(
+        "$(string-join delimiter a [b ...])",
+        2,
+        None,
+        lambda a: core.StringJoinSubstitution(a[1:], delimiter=a[0]),
+    ),
 }
 
 

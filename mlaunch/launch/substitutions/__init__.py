@@ -426,6 +426,12 @@ def _failure_of(error: Exception, message: str) -> SubstitutionFailure:
     return failure
 
 
+# Newer than Jazzy (launch 3.8, Kilted); --check says so where a file uses them.
+from mlaunch.launch.substitutions.for_loop_var import ForEachVar, ForLoopIndex  # noqa: E402
+from mlaunch.launch.substitutions.string_join_substitution import (  # noqa: E402
+    StringJoinSubstitution,
+)
+
 __all__ = [
     "AllSubstitution",
     "AndSubstitution",
@@ -436,6 +442,8 @@ __all__ = [
     "EqualsSubstitution",
     "FileContent",
     "FindExecutable",
+    "ForEachVar",
+    "ForLoopIndex",
     "IfElseSubstitution",
     "LaunchConfiguration",
     "LaunchLogDir",
@@ -449,6 +457,7 @@ __all__ = [
     "PythonExpression",
     "SomeSubstitutionsType",
     "SomeSubstitutionsType_types_tuple",
+    "StringJoinSubstitution",
     "Subs",
     "Substitution",
     "SubstitutionFailure",
