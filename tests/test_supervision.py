@@ -11,6 +11,7 @@ from __future__ import annotations
 import os
 import resource
 import signal
+import stat
 import sys
 import textwrap
 import time
@@ -638,16 +639,36 @@ def test_log_files_rotate_at_the_size_limit(tmp_path: Path) -> None:
 def test_a_log_file_that_cannot_be_written_is_reported_once_and_the_run_goes_on(
     tmp_path: Path,
 ) -> None:
-    (tmp_path / "full.log").symlink_to("/dev/full")
+    if os.geteuid() == 0:  # a full disk: the device /dev/full is, made in the log folder
+        os.mknod(tmp_path / "full.log", stat.S_IFCHR | 0o666, os.makedev(1, 7))
+        said = "No space left on device"
+    else:  # a folder it cannot write into
+        tmp_path.chmod(0o500)
+        said = "Permission denied"
     code = """
     for i in range(2000):
         print("line", i, flush=True)
     """
     h = Harness([make_spec("full", code)], log_dir=str(tmp_path))
-    assert h.run() == 0
+    try:
+        assert h.run() == 0
+    finally:
+        tmp_path.chmod(0o700)
     assert h.text.count("cannot write") == 1
-    assert "No space left on device" in h.text
+    assert said in h.text
     assert "[full] line 1999" in h.text
+
+
+def test_a_log_file_is_never_written_through_a_symlink(tmp_path: Path) -> None:
+    """Someone who could put a link at a log file's name (a log folder another user could
+    change) would have had a child's output appended to the file it names."""
+    target = tmp_path / "elsewhere.txt"
+    target.write_text("someone's file\n")
+    (tmp_path / "talker.log").symlink_to(target)
+    h = Harness([make_spec("talker", 'print("hello", flush=True)')], log_dir=str(tmp_path))
+    assert h.run() == 0
+    assert "cannot write" in h.text and "a symlink stands at its name" in h.text
+    assert target.read_text() == "someone's file\n"
 
 
 def test_logfile_keeps_lines_whole_across_rotation(tmp_path: Path) -> None:

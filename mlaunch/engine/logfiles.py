@@ -9,6 +9,7 @@ one, so nothing is ever dropped). What is kept is the user's choice (``--log-max
 
 from __future__ import annotations
 
+import errno
 import os
 import time
 from collections.abc import Callable, Mapping
@@ -65,7 +66,13 @@ class LogFile:
     def _open(self) -> None:
         # Never through a link someone put at the name: only a file of the run's own folder.
         flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC
-        self._file = open(os.open(self.path, flags, 0o666), "ab", buffering=LOG_BUFFER)  # noqa: SIM115
+        try:
+            fd = os.open(self.path, flags, 0o666)
+        except OSError as e:
+            if e.errno == errno.ELOOP:
+                raise OSError(e.errno, "a symlink stands at its name (never written through)")
+            raise
+        self._file = open(fd, "ab", buffering=LOG_BUFFER)  # noqa: SIM115
         self.size = self._file.tell()
 
     def write(self, data: bytes) -> None:
