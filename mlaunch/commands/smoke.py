@@ -57,6 +57,7 @@ def command(args: Sequence[str]) -> int:
         from mlaunch.commands.smoke_many import run_many
 
         return run_many(*many)
+    as_json = _take_json(args)
     mine, rest = split_arguments(args)
     try:
         settings = parse_settings(mine)
@@ -73,10 +74,27 @@ def command(args: Sequence[str]) -> int:
         return pipeline.launch(opts, standard_parts(opts))
     if settings.junit:
         junit.check_target(settings.junit)  # found now, not after the whole test ran
+    settings.json = as_json
     return run(opts, settings)
 
 
-def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None] | None:
+def _take_json(args: list[str]) -> bool:
+    """Take ``--format json`` out of ``args`` when it is for the verdict (not --print's or
+    --show-args's): the verdict is then JSON on stdout, and what the run says goes to stderr."""
+    views = {"-p", "--print", "--print-description", "-s", "--show-args", "--show-arguments"}
+    if views & set(args):
+        return False
+    for i, arg in enumerate(args):
+        if arg == "--format" and i + 1 < len(args) and args[i + 1] == "json":
+            del args[i : i + 2]
+            return True
+        if arg == "--format=json":
+            del args[i]
+            return True
+    return False
+
+
+def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None, int] | None:
     """``mlaunch test FILE... [-j N]``: (files, the arguments every run gets, N, --junit), or
     None for one launch. Several files are meant when -j is given, or when every positional
     word names a launch file that exists (``PKG FILE`` names a package first)."""
@@ -85,6 +103,7 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None] | Non
     from mlaunch.smoke.settings import VALUE_FLAGS
 
     jobs: int | None = None
+    repeat = 1
     junit_path: str | None = None
     files: list[str] = []
     shared: list[str] = []
@@ -96,6 +115,11 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None] | Non
             jobs = parse_jobs(arg.split("=", 1)[1])
         elif arg.startswith("-j") and arg[2:].isdigit():
             jobs = parse_jobs(arg[2:])
+        elif arg == "--repeat" or arg.startswith("--repeat="):
+            value = arg.split("=", 1)[1] if "=" in arg else next(words, "")
+            repeat = int(value) if value.isdigit() else 0
+            if repeat < 1:
+                raise UsageError(f"--repeat {value!r}: expected a number of runs >= 1")
         elif arg in ("--junit", "--junit-xml"):
             junit_path = next(words, None)
         elif arg.startswith(("--junit=", "--junit-xml=")):
@@ -107,11 +131,11 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None] | Non
         else:
             files.append(arg)
     several = len(files) > 1 and all(os.path.isfile(f) for f in files)
-    if jobs is None and not several:
+    if jobs is None and not several and repeat == 1:
         return None
     if not files:
         raise UsageError("mlaunch test FILE... -j N: name the launch files to test")
-    return files, shared, jobs or 1, junit_path
+    return files, shared, jobs or 1, junit_path, repeat
 
 
 # --- running --------------------------------------------------------------------------------------
@@ -123,6 +147,10 @@ def run(opts: Options, settings: Settings) -> int:
     from mlaunch.engine.logfiles import make_run_log_dir
     from mlaunch.ros import domain
 
+    if settings.json:  # stdout is the verdict's: what the run says goes to stderr meanwhile
+        sys.stdout.flush()
+        settings.stdout = os.dup(1)
+        os.dup2(2, 1)
     # A domain of its own (unless the user chose one): runs at the same time never meet.
     claimed = domain.isolate(os.environ)
     try:
@@ -139,6 +167,14 @@ def run(opts: Options, settings: Settings) -> int:
     finally:
         if claimed is not None:
             claimed.release()
+        _stdout_back(settings)
+
+
+def _stdout_back(settings: Settings) -> None:
+    if settings.stdout is not None:
+        os.dup2(settings.stdout, 1)
+        os.close(settings.stdout)
+        settings.stdout = None
 
 
 def print_plan(opts: Options, settings: Settings) -> int:
@@ -280,7 +316,7 @@ def _involve(expectation: Expectation, specs: list[ProcessSpec]) -> None:
             for s in specs
             if s.node is not None and s.node.fully_qualified_name == expectation.target
         ]
-    elif expectation.kind == "output":
+    elif expectation.kind in ("output", "forbid"):
         names = {s.label for s in specs} | {s.base_name for s in specs}
         head, sep, tail = expectation.target.partition(":")
         if sep and head in names:
@@ -293,7 +329,8 @@ def _involve(expectation: Expectation, specs: list[ProcessSpec]) -> None:
             expectation.regex = re.compile(expectation.target)
         except re.error as e:
             raise UsageError(
-                f"output expectation ({expectation.origin}): {expectation.target!r} is not a"
+                f"{expectation.kind} expectation ({expectation.origin}): {expectation.target!r}"
+                " is not a"
                 f" regular expression: {e}"
             )
 
@@ -351,7 +388,13 @@ def supervise(
         properties={"ros_domain_id": domain_id} if domain_id else {},
         notes=[f"ROS domain {words}"] if words else [],
     )
-    sys.stdout.write(report.table())
+    if settings.json:
+        sys.stderr.write(report.table())
+        sys.stderr.flush()
+        _stdout_back(settings)
+        sys.stdout.write(report.json())
+    else:
+        sys.stdout.write(report.table())
     sys.stdout.flush()
     if settings.junit:
         report.write_junit(settings.junit)

@@ -84,8 +84,16 @@ def parse_jobs(value: str) -> int:
     return jobs
 
 
-def run_many(files: Sequence[str], shared: Sequence[str], jobs: int, junit_path: str | None) -> int:
-    """Test ``files`` with ``shared`` arguments and options, ``jobs`` at a time."""
+def run_many(
+    files: Sequence[str],
+    shared: Sequence[str],
+    jobs: int,
+    junit_path: str | None,
+    repeat: int = 1,
+) -> int:
+    """Test ``files`` with ``shared`` arguments and options, ``jobs`` at a time, each
+    ``repeat`` times (then a table says how often each check held)."""
+    files = [path for path in files for _ in range(repeat)]
     from mlaunch.engine.logfiles import make_run_log_dir
 
     for path in files:
@@ -116,6 +124,8 @@ def run_many(files: Sequence[str], shared: Sequence[str], jobs: int, junit_path:
     stopped = _Runner(batch, shared, jobs).run()
     elapsed = time.monotonic() - started
     sys.stdout.write(summary(batch, elapsed, folder))
+    if repeat > 1:
+        sys.stdout.write(flakiness(batch))
     sys.stdout.flush()
     if junit_path:
         write_junit(junit_path, batch)
@@ -226,6 +236,31 @@ def summary(batch: list[Job], elapsed: float, folder: str) -> str:
             + (f"  (ROS domain {domain})" if domain else "")
             + "\n"
         )
+    return "".join(out)
+
+
+def flakiness(batch: list[Job]) -> str:
+    """Per file and check: in how many runs it held; a check that held in some runs and not
+    in others is flaky."""
+    out = []
+    for path in dict.fromkeys(j.path for j in batch):
+        jobs = [j for j in batch if j.path == path]
+        held: dict[str, int] = {}
+        for job in jobs:
+            suite = job.suite()
+            cases = [] if suite is None else suite.findall("testcase")
+            if suite is None:
+                cases = []
+                held.setdefault("the launch file runs", 0)
+            for case in cases:
+                name = case.get("name", "")
+                passed = case.find("failure") is None and case.find("skipped") is None
+                held[name] = held.get(name, 0) + int(passed)
+        runs = len(jobs)
+        out.append(f"\nflakiness over {runs} runs: {path}\n")
+        for name, count in held.items():
+            mark = "ok" if count == runs else "FAIL" if count == 0 else "FLAKY"
+            out.append(f"  {mark:<5}  {count:>3}/{runs}  {name}\n")
     return "".join(out)
 
 

@@ -386,6 +386,22 @@ class RosGraph:
         response = self._call(f"{fqn}/get_state", GetState, GetState.Request(), deadline, timeout)
         return str(response.current_state.label)
 
+    # -- parameters ----------------------------------------------------------------------------
+
+    def parameter(self, node: str, name: str, timeout: float) -> tuple[bool, Any]:
+        """(whether ``node`` has parameter ``name``, its value as Python) from the node's
+        ``get_parameters`` service; RosTimeout when it does not appear or answer in time."""
+        from rcl_interfaces.srv import GetParameters
+
+        fqn = node_fqn(node)
+        deadline = time.monotonic() + timeout
+        request = GetParameters.Request(names=[name])
+        service = f"{fqn}/get_parameters"
+        response = self._call(service, GetParameters, request, deadline, timeout)
+        if not response.values:
+            return False, None
+        return parameter_value(response.values[0])
+
     def change_state(self, node: str, transition: str, timeout: float) -> TransitionResult:
         """Ask managed node `node` for `transition` ('configure', 'activate', ...).
 
@@ -492,6 +508,26 @@ class RosGraph:
 
 
 # -- names, types and QoS ----------------------------------------------------------------------
+
+
+def parameter_value(value: Any) -> tuple[bool, Any]:
+    """(set, the Python value) of an rcl_interfaces ParameterValue (type 0: not set)."""
+    fields = {
+        1: "bool_value",
+        2: "integer_value",
+        3: "double_value",
+        4: "string_value",
+        5: "byte_array_value",
+        6: "bool_array_value",
+        7: "integer_array_value",
+        8: "double_array_value",
+        9: "string_array_value",
+    }
+    field = fields.get(int(value.type))
+    if field is None:
+        return False, None
+    found = getattr(value, field)
+    return True, list(found) if field.endswith("array_value") else found
 
 
 # The names the rest of mlaunch (and launch files' tests) import from the bridge.

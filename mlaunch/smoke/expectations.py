@@ -19,7 +19,20 @@ if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
 
 CONFIG_PREFIX = "mlaunch_expect"
-KINDS = ("topic", "service", "node", "lifecycle", "output", "clock")
+KINDS = (
+    "topic",
+    "service",
+    "node",
+    "lifecycle",
+    "output",
+    "clock",
+    "tf",
+    "param",
+    "action",
+    "forbid",
+)
+# --no-errors: a forbidden output of ROS log lines at ERROR or FATAL level.
+ERROR_LINES = r"\[(ERROR|FATAL)\]"
 LIFECYCLE_STATES = ("unconfigured", "inactive", "active", "finalized")
 _WITHIN = re.compile(r"^(?P<body>.*?)\s+within\s+(?P<seconds>[0-9]+(?:\.[0-9]*)?)\s*s?$")
 
@@ -38,6 +51,7 @@ class Expectation:
     state: str = "active"
     process: str | None = None  # output: only this process (label or base name)
     regex: re.Pattern[str] | None = None
+    value: str | None = None  # param: the value expected, as YAML reads it
     labels: list[str] = field(default_factory=list)  # processes whose output explains it
     status: str = "pending"  # pending, met, failed
     seen: str = "not checked yet"
@@ -61,6 +75,19 @@ class Expectation:
             return f"output of {where or 'any process '}matches /{self.target}/"
         if self.kind == "clock":
             return "/clock advances (use_sim_time)"
+        if self.kind == "tf":
+            parent, _, child = self.target.partition(":")
+            return f"TF links frame {parent} to {child}"
+        if self.kind == "param":
+            node, _, name = self.target.rpartition(":")
+            return f"parameter {name} of {node} is {self.value}"
+        if self.kind == "action":
+            return f"action server {self.target} is offered"
+        if self.kind == "forbid":
+            if self.target == ERROR_LINES:
+                return "no ERROR or FATAL line in any output"
+            where = f"{self.process} " if self.process else "any process "
+            return f"no line of {where}matches /{self.target}/"
         return "every process stops within its stop ladder (no SIGKILL)"
 
     def key(self) -> tuple[str, str]:
@@ -109,7 +136,35 @@ def parse_target(kind: str, target: str, origin: str) -> Expectation:
         return Expectation("output", target, origin)
     if kind == "clock":
         return Expectation("clock", _absolute(target, "topic", origin), origin)
+    if kind == "tf":
+        parent, sep, child = target.partition(":")
+        parent, child = parent.strip().lstrip("/"), child.strip().lstrip("/")
+        if not sep or not parent or not child or any(c.isspace() for c in parent + child):
+            raise UsageError(
+                f"tf expectation {target!r} ({origin}) is not PARENT:CHILD (two frame names,"
+                " e.g. odom:base_link)"
+            )
+        return Expectation("tf", f"{parent}:{child}", origin)
+    if kind == "param":
+        return _param(target, origin)
+    if kind == "action":
+        return Expectation("action", _absolute(target, "action", origin), origin)
+    if kind == "forbid":
+        return Expectation("forbid", target, origin, status="met", seen="no line matched")
     raise UsageError(f"unknown expectation kind {kind!r}; valid: {', '.join(KINDS)}")
+
+
+def _param(target: str, origin: str) -> Expectation:
+    """``/node:name=value``: the node's parameter ``name`` reads ``value`` (as YAML)."""
+    head, sep, value = target.partition("=")
+    node, colon, name = head.rpartition(":")
+    if not sep or not colon or not name.strip() or not node.strip():
+        raise UsageError(
+            f"param expectation {target!r} ({origin}) is not /NODE:NAME=VALUE"
+            " (e.g. /robot_state_publisher:publish_frequency=20.0)"
+        )
+    full = f"{_absolute(node, 'node', origin)}:{name.strip()}"
+    return Expectation("param", full, origin, value=value.strip())
 
 
 def _absolute(name: str, what: str, origin: str) -> str:
@@ -162,6 +217,7 @@ def expectation_data(e: Expectation) -> dict[str, Any]:
         "rate": e.rate,
         "state": e.state if e.kind == "lifecycle" else None,
         "process": e.process,
+        "value": e.value,
         "regex": None if e.regex is None else e.regex.pattern,
         "source": e.origin,
     }
@@ -187,6 +243,10 @@ class Expect(Action):
         output: Any = None,
         process: Any = None,
         within: float | None = None,
+        tf: Any = None,
+        param: Any = None,
+        action: Any = None,
+        forbid: Any = None,
         **kwargs: Any,
     ) -> None:
         super().__init__(**kwargs)
@@ -198,12 +258,17 @@ class Expect(Action):
                 ("node", node),
                 ("lifecycle", lifecycle),
                 ("output", output),
+                ("tf", tf),
+                ("param", param),
+                ("action", action),
+                ("forbid", forbid),
             )
             if v is not None
         }
         if len(given) != 1:
             raise LaunchFileError(
-                "Expect takes exactly one of topic=, service=, node=, lifecycle=, output="
+                "Expect takes exactly one of topic=, service=, node=, lifecycle=, output=, tf=,"
+                " param=, action=, forbid="
                 f" (got {', '.join(given) or 'none'})",
                 where=self.origin,
             )
@@ -218,7 +283,7 @@ class Expect(Action):
             target = f"{target}:{self.rate}"
         elif self.kind == "lifecycle":
             target = f"{target}:{self.state}"
-        elif self.kind == "output" and self.process is not None:
+        elif self.kind in ("output", "forbid") and self.process is not None:
             target = f"{perform(context, self.process)}:{target}"
         try:
             expectation = parse_target(self.kind, target, where)

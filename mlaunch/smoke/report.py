@@ -135,6 +135,37 @@ class Report:
             parts.append(f"--- last output of {label} ---\n" + "\n".join(lines or ["(no output)"]))
         return "\n".join(parts)
 
+    def data(self) -> dict[str, object]:
+        """The verdict as data (``mlaunch test --format json``, the artifacts' verdict.json)."""
+        from mlaunch.smoke.expectations import expectation_data
+
+        checks = []
+        for e in self.expectations:
+            item = expectation_data(e)
+            item.update(status=e.status, seen=e.seen, at=e.at, labels=list(e.labels))
+            checks.append(item)
+        window = self.window
+        return {
+            "file": self.path,
+            "passed": self.passed,
+            "duration": round(self.duration, 3),
+            "window": None
+            if window is None
+            else {
+                "ready_after": window.ready_at,
+                "hold": window.hold,
+                "watched_after_ready": round(window.watched, 3),
+            },
+            **self.properties,
+            "checks": checks,
+            "output": {label: list(lines) for label, lines in self.rings.items()},
+        }
+
+    def json(self) -> str:
+        import json
+
+        return json.dumps(self.data(), indent=2) + "\n"
+
     def write_junit(self, path: str) -> None:
         from mlaunch.smoke import junit
 

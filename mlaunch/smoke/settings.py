@@ -40,8 +40,13 @@ More expectations, from the command line (each has the overall ``--timeout`` as 
   --expect-output 'LABEL:REGEX' | 'REGEX'   a line of output (LABEL: a process label like
                                      talker-1 or its base name talker) matches REGEX
   --expect-clock /clock              simulated time advances (also without use_sim_time)
+  --expect-tf odom:base_link         /tf or /tf_static link the two frames
+  --expect-param /rsp:publish_frequency=20.0   the node's parameter reads that value
+  --expect-action /navigate_to_pose  an action server is offered
+  --forbid-output '[LABEL:]REGEX'    no line of output matches REGEX, at any time of the run
+  --no-errors                        no process logs an ERROR or FATAL line (off by default)
   --expect 'KIND TARGET [within S]'  the same in one string (KIND: topic, service, node,
-                                     lifecycle, output, clock)
+                                     lifecycle, output, clock, tf, param, action, forbid)
 or from the launch file:
   - any launch configuration whose name starts with ``mlaunch_expect`` holds one expectation
     as 'KIND TARGET [within S]', e.g. in YAML
@@ -49,7 +54,8 @@ or from the launch file:
     ``<let name="mlaunch_expect_scan" value="topic /scan:10"/>`` (it must be set where the
     top level of the launch sees it: at the top level, or in an included file, not in a group);
   - in Python, ``mlaunch.commands.smoke.Expect(topic="/scan", rate=10.0, within=15)`` (or
-    ``service=``, ``node=``, ``lifecycle=`` with ``state=``, ``output=`` with ``process=``).
+    ``service=``, ``node=``, ``lifecycle=`` with ``state=``, ``output=`` or ``forbid=`` with
+    ``process=``, ``tf=``, ``param=``, ``action=``).
 A normal ``mlaunch FILE`` run ignores both.
 
 Each run gets a ROS domain of its own when ROS_DOMAIN_ID is not set: a free id, claimed with a
@@ -71,7 +77,7 @@ from typing import Any
 
 from mlaunch.plan.argparser import ArgumentParser
 from mlaunch.plan.errors import UsageError
-from mlaunch.smoke.expectations import KINDS, Expectation, parse_spec, parse_target
+from mlaunch.smoke.expectations import ERROR_LINES, KINDS, Expectation, parse_spec, parse_target
 
 _HELP = __doc__ or ""
 DEFAULT_TIMEOUT = 30.0
@@ -84,6 +90,9 @@ HELP = {
     "lifecycle": "/ns/name[:STATE]: the managed node is in STATE (active)",
     "output": "'LABEL:REGEX' or 'REGEX': a line of output matches",
     "clock": "/clock: simulated time advances (implied by use_sim_time)",
+    "tf": "PARENT:CHILD: /tf or /tf_static link the two frames (odom:base_link)",
+    "param": "/NODE:NAME=VALUE: the node's parameter reads VALUE (as YAML reads it)",
+    "action": "/name: an action server is offered",
 }
 
 # --- the command line -----------------------------------------------------------------------------
@@ -98,6 +107,9 @@ class Settings:
     hold: float = DEFAULT_HOLD
     junit: str | None = None
     allow_exit: list[str] = field(default_factory=list)
+    repeat: int = 1
+    json: bool = False  # --format json: the verdict as JSON on stdout
+    stdout: int | None = None  # the verdict's stdout, while the run's output goes to stderr
 
 
 VALUE_FLAGS = (
@@ -107,6 +119,11 @@ VALUE_FLAGS = (
     "--expect-node",
     "--expect-lifecycle",
     "--expect-output",
+    "--expect-tf",
+    "--expect-param",
+    "--expect-action",
+    "--forbid-output",
+    "--repeat",
     "--within",
     "--timeout",
     "--hold",
@@ -129,6 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     group = parser.add_argument_group("expectations")
     for kind in KINDS:
+        if kind == "forbid":
+            continue
         group.add_argument(
             f"--expect-{kind}",
             metavar=kind.upper(),
@@ -136,6 +155,18 @@ def build_parser() -> argparse.ArgumentParser:
             const=kind,
             help=HELP[kind],
         )
+    group.add_argument(
+        "--forbid-output",
+        metavar="'[LABEL:]REGEX'",
+        action=_ExpectAction,
+        const="forbid",
+        help="fails when a line of output (of LABEL) matches REGEX, at any time of the run",
+    )
+    group.add_argument(
+        "--no-errors",
+        action="store_true",
+        help="fails when any process logs an ERROR or FATAL line (off by default)",
+    )
     group.add_argument(
         "--expect",
         metavar="'KIND TARGET [within S]'",
@@ -170,6 +201,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE",
         dest="junit",
         help="write a JUnit XML report",
+    )
+    parser.add_argument(
+        "--repeat",
+        type=int,
+        default=1,
+        metavar="N",
+        help="run the test N times and say, per check, how often it held (flakiness)",
     )
     parser.add_argument(
         "-j",
@@ -225,7 +263,7 @@ def split_arguments(args: Sequence[str]) -> tuple[list[str], list[str]]:
                     raise UsageError(f"{arg} needs a value")
                 mine.append(args[i + 1])
                 i += 1
-        elif arg in ("-h", "--help"):
+        elif arg in ("-h", "--help", "--no-errors"):
             mine.append(arg)
         else:
             rest.append(arg)
@@ -242,8 +280,14 @@ def parse_settings(args: Sequence[str]) -> Settings:
         raise UsageError("--timeout 0: the deadline must be > 0 seconds")
     for value in ns.allow_exit:
         parse_allow_exit(value)  # a bad CODES is a usage error before anything starts
+    if ns.repeat < 1:
+        raise UsageError(f"--repeat {ns.repeat!r}: expected a number of runs >= 1")
+    expectations = list(getattr(ns, "expectations", None) or [])
+    if ns.no_errors:
+        expectations.append(parse_target("forbid", ERROR_LINES, "--no-errors"))
     return Settings(
-        expectations=list(getattr(ns, "expectations", None) or []),
+        repeat=ns.repeat,
+        expectations=expectations,
         timeout=ns.timeout,
         hold=ns.hold,
         junit=ns.junit,

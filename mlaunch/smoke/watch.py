@@ -47,7 +47,7 @@ _PHASES = {
     "holding": "during the hold",
     "done": "in the shutdown",
 }
-GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock"})
+GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock", "tf", "param", "action"})
 _ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
 # --- watching the run -----------------------------------------------------------------------------
@@ -127,6 +127,7 @@ class SmokeRun(Part):
         if ring is None:
             ring = self.rings[label] = deque(maxlen=RING_LINES)
         ring.extend(lines)
+        self._forbidden(label, lines)
         if self.phase == "done":
             return
         for e in self.expectations:
@@ -139,6 +140,25 @@ class SmokeRun(Part):
                     self._met(e, f"{label}: {line.strip()[:160]}")
                     break
         self._maybe_ready()
+
+    def _forbidden(self, label: str, lines: list[str]) -> None:
+        """--forbid-output, --no-errors: a matching line fails the test whenever it comes (in
+        the shutdown too: an error logged while stopping is an error)."""
+        for e in self.expectations:
+            if e.kind != "forbid" or e.status == "failed" or e.regex is None:
+                continue
+            if e.process and e.process not in (label, label.rsplit("-", 1)[0]):
+                continue
+            line = next((x for x in lines if e.regex.search(x)), None)
+            if line is None:
+                continue
+            seen = f"{label}: {line.strip()[:160]}"
+            if e.labels == []:
+                e.labels = [label]
+            if self.phase == "done":
+                self._mark(e, "failed", seen)
+            else:
+                self._fail(e, seen)
 
     def _on_process(self, exited: bool, process: ProcessView) -> None:
         label = process.label
@@ -488,13 +508,13 @@ class GraphProbe:
         self.graph = graph
         self.watches: dict[str, Any] = {}
         self.clock_first: float | None = None
+        self.tf: TfLinks | None = None
 
     def check(self, expectations: list[Expectation]) -> list[tuple[Expectation, bool, str]]:
         nodes = self.graph.node_names()
         topics = self.graph.topic_types()
-        services = (
-            self.graph.service_names() if any(e.kind == "service" for e in expectations) else set()
-        )
+        wants = {e.kind for e in expectations}
+        services = self.graph.service_names() if wants & {"service", "action"} else set()
         out: list[tuple[Expectation, bool, str]] = []
         for e in expectations:
             check: Callable[..., tuple[bool, str]] = getattr(self, f"_{e.kind}")
@@ -560,6 +580,50 @@ class GraphProbe:
             return True, seen
         return False, f"too slow: {seen}, wanted >= {wanted:.1f} Hz"
 
+    def _action(self, e: Expectation, *, services: set[str], **_: Any) -> tuple[bool, str]:
+        # An action server offers <name>/_action/send_goal (and its other services).
+        if f"{e.target}/_action/send_goal" in services:
+            return True, "offered"
+        actions = sorted(
+            n[: -len("/_action/send_goal")] for n in services if n.endswith("/_action/send_goal")
+        )
+        from mlaunch.plan.errors import did_you_mean
+
+        return False, f"not offered ({len(actions)} action servers in the graph)" + did_you_mean(
+            e.target, actions
+        )
+
+    def _param(self, e: Expectation, *, nodes: set[str], **_: Any) -> tuple[bool, str]:
+        import yaml
+
+        from mlaunch.parts.graph_types import RosTimeout
+
+        node, _sep, name = e.target.rpartition(":")
+        if node not in nodes:
+            return False, f"node {node} is not in the graph"
+        try:
+            found, value = self.graph.parameter(node, name, STATE_QUERY_TIMEOUT)
+        except RosTimeout as exc:
+            return False, f"no answer: {exc}"
+        if not found:
+            return False, f"{node} has no parameter {name!r} set"
+        try:
+            wanted = yaml.safe_load(e.value or "")
+        except yaml.YAMLError:
+            wanted = e.value
+        same = value == wanted or str(value) == str(e.value)
+        return same, f"{name} = {value!r}"
+
+    def _tf(self, e: Expectation, **_: Any) -> tuple[bool, str]:
+        if self.tf is None:
+            self.tf = TfLinks(self.graph)
+        parent, _sep, child = e.target.partition(":")
+        if self.tf.linked(parent, child):
+            return True, f"{parent} -> {child} through {' -> '.join(self.tf.path(parent, child))}"
+        frames = sorted(self.tf.frames())
+        shown = ", ".join(frames[:10]) + (" ..." if len(frames) > 10 else "")
+        return False, self.tf.error or f"not linked (frames seen: {shown or 'none'})"
+
     def _clock(self, e: Expectation, **_: Any) -> tuple[bool, str]:
         watch = self.watches.get("/clock")
         if watch is None:
@@ -573,3 +637,55 @@ class GraphProbe:
         if now > self.clock_first:
             return True, f"advanced from {self.clock_first:.2f} s to {now:.2f} s"
         return False, f"stuck at {now:.2f} s ({_messages(watch.count)})"
+
+
+class TfLinks:
+    """The frames /tf and /tf_static link (parent -> child), from the graph's messages."""
+
+    TYPE = "tf2_msgs/msg/TFMessage"
+
+    def __init__(self, graph: Any) -> None:
+        self.edges: dict[str, set[str]] = {}
+        self.lock = threading.Lock()
+        self.error = ""
+        for topic in ("/tf", "/tf_static"):
+            watch = graph.watch_topic(topic, self.TYPE)
+            watch.listen(functools.partial(self._message, watch))
+            self.error = self.error or (watch.error or "")
+
+    def _message(self, watch: Any) -> None:
+        message = watch.last_message()
+        if message is None:
+            return
+        with self.lock:
+            for transform in message.transforms:
+                parent = transform.header.frame_id.lstrip("/")
+                child = transform.child_frame_id.lstrip("/")
+                self.edges.setdefault(parent, set()).add(child)
+                self.edges.setdefault(child, set()).add(parent)
+
+    def frames(self) -> set[str]:
+        with self.lock:
+            return set(self.edges)
+
+    def path(self, start: str, end: str) -> list[str]:
+        """The frames from ``start`` to ``end`` through the tree (either way), or []."""
+        with self.lock:
+            edges = {k: set(v) for k, v in self.edges.items()}
+        came: dict[str, str] = {start: start}
+        todo = [start]
+        while todo:
+            frame = todo.pop(0)
+            if frame == end:
+                out = [end]
+                while out[-1] != start:
+                    out.append(came[out[-1]])
+                return out[::-1]
+            for near in edges.get(frame, ()):
+                if near not in came:
+                    came[near] = frame
+                    todo.append(near)
+        return []
+
+    def linked(self, start: str, end: str) -> bool:
+        return bool(self.path(start, end))
