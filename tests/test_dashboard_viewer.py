@@ -143,3 +143,54 @@ def test_a_composable_node_unloaded_from_the_page_is_gone_from_its_container(
     finally:
         if run.proc.poll() is None:
             run.kill()
+
+
+LIFECYCLE = f"""import sys
+from launch import LaunchDescription
+from launch_ros.actions import LifecycleNode
+NODE = {str(REPO / "tests" / "nodes" / "lifecycle_node.py")!r}
+def generate_launch_description():
+    return LaunchDescription([
+        LifecycleNode(executable=sys.executable, arguments=[NODE], name="camera",
+                      namespace="robot", exec_name="camera", output="screen", autostart=True),
+    ])
+"""
+
+
+@requires_rclpy
+@pytest.mark.timeout(150)
+@pytest.mark.skipif(not available(), reason="chromium not installed (apt chromium)")
+def test_a_lifecycle_transition_asked_from_the_page_reaches_the_node(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    path = tmp_path / "camera.launch.py"
+    path.write_text(LIFECYCLE)
+    env = {**ros_env, "ROS_LOG_DIR": str(tmp_path / "logs"), "NO_COLOR": "1"}
+    run = Running(mlaunch(str(path), "--dashboard"), env=env, cwd=str(tmp_path))
+    node = 'tr[data-lifecycle="/robot/camera"]'
+    state = f"document.querySelector('{node}')?.dataset.state"
+    try:
+        url = run.wait_for(r"dashboard: open (http://127\.0\.0\.1:\d+/launch/)", 60).group(1)
+        run.wait_for(r"activate of /robot/camera succeeded", 60)
+        with Browser(tmp_path / "profile") as browser:
+            page = browser.open(url)
+            page.wait(f"{state} == 'active'", 30, "the node active in the panel")
+            page.click(f'{node} button[data-op="deactivate"]')
+            answer = json.loads(page.wait("document.body.dataset.lastControl", 30, "deactivate"))
+            assert answer["ok"] and answer["op"] == "deactivate", answer
+            # the node itself says it went through the transition (it prints each one)
+            run.wait_for(r"\[camera-1\] transition deactivate: success", 15)
+            run.wait_for(r"deactivate asked by the user \(the launch panel\)", 5)
+            page.wait(f"{state} == 'inactive'", 15, "the node inactive in the panel")
+            page.eval("delete document.body.dataset.lastControl")
+            page.click(f'{node} button[data-op="activate"]')
+            answer = json.loads(page.wait("document.body.dataset.lastControl", 30, "activate"))
+            assert answer["ok"], answer
+            page.wait(f"{state} == 'active'", 15, "the node active again")
+        assert run.text.count("[camera-1] transition activate: success") >= 1
+        run.wait_for(r"(?s)deactivate: success.*\[camera-1\] transition activate: success", 15)
+        run.signal(signal.SIGINT)
+        assert run.finish(60) == 130
+    finally:
+        if run.proc.poll() is None:
+            run.kill()

@@ -110,7 +110,8 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         description="Run a ROS 2 launch file (Python, YAML, XML or ROS 1 XML) and supervise it.",
         epilog="Subcommands: 'mlaunch test FILE ...' (CI smoke run), 'mlaunch convert FILE' "
         "(ROS 1 -> ROS 2), 'mlaunch export FILE' (systemd units), 'mlaunch ctl [RUN] list|stop|"
-        "start|restart|mute|unmute|logs LABEL|unload|load NODE' (control a running launch). "
+        "start|restart|mute|unmute|logs LABEL|unload|load|activate|... NODE' (control a running"
+        " launch). "
         "Exit status: 0 ok, 1 a required process failed, 2 bad input, "
         "70 an internal error of mlaunch, 74 stdout cannot be written, 128+N stopped by signal N"
         " (130 Ctrl-C).",

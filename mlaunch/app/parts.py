@@ -86,7 +86,7 @@ class Run:
 
             # A part of its own, whichever part first asks for it (the socket, the keys).
             make = lambda: Control(  # noqa: E731
-                self.supervisor, self.printer, lambda: self.components
+                self.supervisor, self.printer, lambda: self.components, lambda: self.lifecycle
             )
             control = self.supervisor.reactor.attach("runtime control", make)
             if not isinstance(control, Control):
@@ -343,6 +343,7 @@ def dashboard_part(run: Run) -> Dashboard:
 
     metrics = run.metrics()
     metrics.readers["readiness"] = readiness  # mlaunch test's checks, as ctl wait-ready has them
+    metrics.readers["lifecycle"] = lambda: run.lifecycle.listed() if run.lifecycle else []
     return Dashboard(
         run.supervisor,
         run.control,

@@ -55,6 +55,8 @@ operations:
   unload NODE     ask its container to unload the composable node NODE (its full name, or
                   its name when only one has it)
   load NODE       load it into its container again (after an unload, or a failed load)
+  configure|activate|deactivate|cleanup NODE
+                  ask the lifecycle node NODE for that transition
   wait-ready      wait until the launch is ready by mlaunch test's checks (processes up, nodes
                   in the graph, lifecycle nodes active, /clock under sim time, the file's own
                   expectations); a run that is not there yet is waited for (--timeout)
@@ -534,6 +536,9 @@ def say(op: str, answer: dict[str, object]) -> str:
     if op in ("unload", "load"):
         node: dict[str, object] = answer.get("component") or {}  # type: ignore[assignment]
         return f"{node.get('name')}: {node.get('state')} (container {node.get('container')})\n"
+    if "lifecycle" in answer:
+        managed: dict[str, object] = answer["lifecycle"]  # type: ignore[assignment]
+        return f"{managed.get('name')}: {op} done, now {managed.get('state')}\n"
     info: dict[str, object] = answer.get("process") or {}  # type: ignore[assignment]
     label, state = info.get("label"), info.get("state")
     if op in ("mute", "unmute"):

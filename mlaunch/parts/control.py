@@ -58,12 +58,29 @@ if TYPE_CHECKING:
     from mlaunch.engine.output import Printer
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.components import ComponentDriver
+    from mlaunch.parts.lifecycle import LifecycleManager
     from mlaunch.plan.events import ProcessView
 
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
-OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs", "unload", "load")
+OPERATIONS = (
+    "list",
+    "stop",
+    "start",
+    "restart",
+    "mute",
+    "unmute",
+    "logs",
+    "unload",
+    "load",
+    "configure",
+    "activate",
+    "deactivate",
+    "cleanup",
+)
 # Those that name a composable node rather than a process.
 COMPONENT_OPERATIONS = ("unload", "load")
+# The lifecycle transitions a user can ask of a managed node.
+TRANSITIONS = ("configure", "activate", "deactivate", "cleanup")
 DEFAULT_LINES = 20
 # Labels an unknown-label error lists (a launch may have hundreds).
 LISTED = 20
@@ -168,11 +185,14 @@ class Control(Part):
         supervisor: Supervisor,
         printer: Printer,
         components: Callable[[], ComponentDriver | None] = lambda: None,
+        lifecycle: Callable[[], LifecycleManager | None] = lambda: None,
     ) -> None:
         self.supervisor = supervisor
         self.printer = printer
         # The LoadNode driver, once the run has one (unload and load a composable node).
         self.components = components
+        # Lifecycle driving, once the run has it (a transition asked by the user).
+        self.lifecycle = lifecycle
         # (process, what, callback): "exit" calls back when it exits, "restart" when its
         # label's next instance has started.
         self._waits: list[tuple[Process, str, Done]] = []
@@ -331,6 +351,32 @@ class Control(Part):
         if self.supervisor.shutting_down:
             raise ControlError(f"cannot {action}: the launch is shutting down")
         return driver
+
+    # --- lifecycle nodes -------------------------------------------------------------------
+
+    def lifecycle_nodes(self) -> list[dict[str, object]]:
+        """Every lifecycle node of the run and its state (loop thread)."""
+        manager = self.lifecycle()
+        return [] if manager is None else manager.listed()
+
+    def transition(self, name: str, label: str, *, by: str = "", done: ComponentDone) -> None:
+        """Ask the lifecycle node ``name`` for the transition ``label`` (configure, activate,
+        deactivate, cleanup); ``done(result)`` once it answered."""
+        manager = self.lifecycle()
+        if manager is None:
+            raise ControlError(f"cannot {label}: this run has no lifecycle nodes")
+        if self.supervisor.shutting_down:
+            raise ControlError(f"cannot {label}: the launch is shutting down")
+        managed = manager.find(name)
+        if managed is None:
+            names = ", ".join(str(n["name"]) for n in manager.listed())
+            raise UnknownNode(
+                f"no lifecycle node {name!r} in this run, or several (lifecycle nodes: {names})"
+            )
+        if managed.process is None:
+            raise ControlError(f"cannot {label} {managed.fqn}: its process is not running")
+        manager.request(managed, label, done)
+        self.supervisor.events.emit(Controlled(managed.fqn, label, by))
 
     # --- the parts -------------------------------------------------------------------------
 

@@ -419,7 +419,12 @@ def carry_out(
 ) -> None:
     """What ``request`` asks of ``control`` (raises ControlError or BadRequest); an unload or
     load the container refused is ``fail``'s."""
-    from mlaunch.parts.control import COMPONENT_OPERATIONS, DEFAULT_LINES, OPERATIONS
+    from mlaunch.parts.control import (
+        COMPONENT_OPERATIONS,
+        DEFAULT_LINES,
+        OPERATIONS,
+        TRANSITIONS,
+    )
 
     op, label = request.get("op"), request.get("label")
     if op not in OPERATIONS:
@@ -433,18 +438,21 @@ def carry_out(
     def done(info: ProcessInfo) -> None:
         answer({"process": info.as_dict()})
 
-    if op in COMPONENT_OPERATIONS:
+    if op in COMPONENT_OPERATIONS or op in TRANSITIONS:
+        key = "component" if op in COMPONENT_OPERATIONS else "lifecycle"
 
-        def answered(component: dict[str, object]) -> None:
-            if component.get("error") and fail is not None:
-                fail(f"{op} {component.get('name')}: {component['error']}", EXIT_FAILURE)
+        def answered(result: dict[str, object]) -> None:
+            if result.get("error") and fail is not None:
+                fail(f"{op} {result.get('name')}: {result['error']}", EXIT_FAILURE)
             else:
-                answer({"component": component})
+                answer({key: result})
 
         if op == "unload":
             control.unload(label, by=by, done=answered)
-        else:
+        elif op == "load":
             control.load(label, by=by, done=answered)
+        else:
+            control.transition(label, op, by=by, done=answered)
     elif op == "logs":
         lines = request.get("lines", DEFAULT_LINES)
         if not isinstance(lines, int) or isinstance(lines, bool):

@@ -208,6 +208,7 @@ class Dashboard(Part):
             "processes": processes,
             "components": self.composable(),
             "readiness": sample.extra.get("readiness"),
+            "lifecycle": sample.extra.get("lifecycle") or [],
         }
         hub.publish(json.dumps(message, separators=(",", ":")).encode())
 

@@ -47,7 +47,21 @@ FOLLOW_PERIOD = 0.2  # how often a log view looks for new lines
 MAX_BODY = 1024
 MAX_LINES = 5000  # lines a log view starts with, at most
 # What the page may ask of the control layer (``mlaunch ctl``'s operations).
-PAGE_OPERATIONS = ("list", "stop", "start", "restart", "mute", "unmute", "logs", "unload", "load")
+PAGE_OPERATIONS = (
+    "list",
+    "stop",
+    "start",
+    "restart",
+    "mute",
+    "unmute",
+    "logs",
+    "unload",
+    "load",
+    "configure",
+    "activate",
+    "deactivate",
+    "cleanup",
+)
 CONTROL_TIMEOUT = 120.0  # a stop waits for the process's whole stop ladder
 
 

@@ -401,6 +401,68 @@ class LifecycleManager(Part):
         for managed in matched:
             self._spawn(self._change, managed, label)
 
+    # --- runtime control (mlaunch.parts.control, loop thread) ----------------------------------
+
+    def listed(self) -> list[dict[str, object]]:
+        """Every lifecycle node of the run: name, label of its process, state (loop thread)."""
+        return [
+            {
+                "name": m.fqn,
+                "label": m.spec.label,
+                "state": m.state if m.process is not None else "not running",
+            }
+            for m in self.nodes.values()
+        ]
+
+    def find(self, name: str) -> Managed | None:
+        """The lifecycle node ``name`` (its full name, its name alone, or its process's label)."""
+        named = [m for m in self.nodes.values() if name in (m.fqn, m.spec.label)] or [
+            m for m in self.nodes.values() if m.fqn.rsplit("/", 1)[-1] == name
+        ]
+        return named[0] if len(named) == 1 else None
+
+    def request(
+        self, managed: Managed, label: str, done: Callable[[dict[str, object]], None]
+    ) -> None:
+        """Ask ``managed`` for the transition ``label`` (a user's request: a failure is said,
+        it ends nothing); ``done(result)`` on the loop thread once the node answered."""
+
+        def change() -> None:
+            from mlaunch.parts.bridge import GraphNotRunning
+
+            graph = self._graph_or_report(managed.fqn)
+            result: TransitionResult | None = None
+            if graph is not None:
+                try:
+                    result = graph.change_state(managed.fqn, label, self.timeout)
+                except GraphNotRunning:
+                    result = None
+            self.loop.call_soon(lambda: answered(result))
+
+        def answered(result: TransitionResult | None) -> None:
+            if result is None:
+                done(
+                    {
+                        "name": managed.fqn,
+                        "transition": label,
+                        "ok": False,
+                        "error": "the run's ROS graph is not running",
+                    }
+                )
+                return
+            self._record(Outcome(result, "user"))
+            done(
+                {
+                    "name": managed.fqn,
+                    "transition": label,
+                    "ok": result.ok,
+                    "state": managed.state,
+                    "error": "" if result.ok else result.detail,
+                }
+            )
+
+        self._spawn(change)
+
     def _change(self, managed: Managed, label: str) -> None:
         from mlaunch.parts.bridge import GraphNotRunning
 
