@@ -101,6 +101,17 @@ def test_a_folder_others_can_write_is_refused(tmp_path: Path) -> None:
     assert list(open_to_all.iterdir()) == []
 
 
+def test_a_folder_inside_one_others_can_write_is_refused(tmp_path: Path) -> None:
+    """Whoever can write the folder above can rename the units' folder and put their own."""
+    above = tmp_path / "open"
+    above.mkdir()
+    above.chmod(0o777)
+    code, out = export(tmp_path, above / "units")
+    assert code == 2, out
+    assert f"is in a folder others could change: {above} has mode 777" in out
+    assert list(above.iterdir()) == []
+
+
 def test_a_symlinked_folder_is_not_followed(tmp_path: Path) -> None:
     real = tmp_path / "real"
     real.mkdir()
@@ -113,9 +124,10 @@ def test_a_symlinked_folder_is_not_followed(tmp_path: Path) -> None:
 
 
 def test_modes_are_explicit_under_umask_000(tmp_path: Path) -> None:
-    out_dir = tmp_path / "units"
+    out_dir = tmp_path / "robot" / "units"  # the folder above is made too
     code, out = export(tmp_path, out_dir, umask=0)
     assert code == 0, out
+    assert stat.S_IMODE(out_dir.parent.stat().st_mode) == 0o755
     assert stat.S_IMODE(out_dir.stat().st_mode) == 0o755
     assert stat.S_IMODE((out_dir / "demo-worker-1.service").stat().st_mode) == 0o644
     assert stat.S_IMODE((out_dir / "demo.target").stat().st_mode) == 0o644

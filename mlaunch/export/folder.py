@@ -14,7 +14,7 @@ import errno
 import os
 import stat
 
-from mlaunch.engine.ownership import others_can_write
+from mlaunch.engine.ownership import others_can_write, unsafe_base
 from mlaunch.engine.ownership import user_name as _user
 from mlaunch.plan.errors import UsageError
 
@@ -33,6 +33,15 @@ class Folder:
     def open(cls, path: str, *, force: bool) -> Folder:
         """Open (or make) ``path``; UsageError when it is not the user's alone, is a link, or
         holds files without ``force``."""
+        existing = os.path.dirname(os.path.abspath(path))
+        while not os.path.isdir(existing):
+            existing = os.path.dirname(existing)
+        above = unsafe_base(existing)  # before anything is made in it
+        if above:
+            raise UsageError(
+                f"{path!r} is in a folder others could change: {above}; they could swap the"
+                " units before they are installed; export into a folder of your own"
+            )
         made = False
         try:
             os.mkdir(path, FOLDER_MODE)
@@ -40,7 +49,8 @@ class Folder:
         except FileExistsError:
             pass
         except FileNotFoundError:
-            os.makedirs(path, FOLDER_MODE)
+            _make_parents(os.path.dirname(os.path.abspath(path)))
+            os.mkdir(path, FOLDER_MODE)
             made = True
         try:
             fd = os.open(path, os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC)
@@ -123,3 +133,16 @@ class Folder:
         if self.fd >= 0:
             os.close(self.fd)
             self.fd = -1
+
+
+def _make_parents(folder: str) -> None:
+    """Make ``folder`` and what is missing above it 0755 whatever the umask (os.makedirs
+    gives the folders above the umask's mode: 0777 under umask 000)."""
+    if os.path.isdir(folder):
+        return
+    _make_parents(os.path.dirname(folder))
+    try:
+        os.mkdir(folder, FOLDER_MODE)
+    except FileExistsError:
+        return
+    os.chmod(folder, FOLDER_MODE)
