@@ -62,6 +62,7 @@ def test_one_service_per_process_with_argv_env_restart_and_stop(tmp_path: Path) 
         "demo-server-2.service",
         "demo-setup-1.service",
         "demo-talker-3.service",
+        "demo.service",  # the whole launch under mlaunch (Type=notify)
     ]
     server = unit(out, "demo-server-2.service")
     assert "ExecStart=/usr/bin/sleep 1000" in server or "ExecStart=/bin/sleep 1000" in server
@@ -168,3 +169,41 @@ def test_what_systemd_cannot_do_is_a_warning(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert "lifecycle node with autostart: nothing drives it to active" in done.stderr
     assert "nothing drives it to active" in (out / "README.md").read_text()
+
+
+def test_the_whole_launch_as_one_notify_service(tmp_path: Path) -> None:
+    done, out = export(tmp_path, "extra:=a b")
+    assert done.returncode == 0, done.stderr
+    service = unit(out, "demo.service")
+    assert {"Type=notify", "NotifyAccess=main", "Conflicts=demo.target"} <= set(service)
+    # 90 s to be ready, plus the longest timer before a process starts (3 s)
+    assert "TimeoutStartSec=93" in service
+    assert "KillMode=mixed" in service and "KillSignal=SIGINT" in service
+    start = next(line for line in service if line.startswith("ExecStart="))
+    assert start.endswith(f'{out}/launch/demo.launch.py "extra:=a b"'), start
+    assert (out / "launch" / "demo.launch.py").read_text() == LAUNCH
+    assert not (out / "launch" / "units").exists()  # the export is not copied into itself
+
+
+def test_stand_ins_are_named_and_refused_unless_allowed(tmp_path: Path) -> None:
+    launch = tmp_path / "standin.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([Node(package='tf2_ros', executable='static_transform_publisher', arguments=['0','0','0','0','0','0','a','b'])])\n"
+    )
+    out = tmp_path / "units"
+    env = clean_env()
+    refused = run_mlaunch("export", str(launch), "--to", "systemd", str(out), env=env)
+    assert refused.returncode == 2, refused.stderr
+    assert "static_transform_publisher-1: runs mlaunch's stand-in" in refused.stderr, refused.stderr
+    assert "tf2_ros/static_transform_publisher is not installed here" in refused.stderr
+    assert not out.exists()
+    allowed = run_mlaunch(
+        "export", str(launch), "--to", "systemd", str(out), "--allow-standins", env=env
+    )
+    assert allowed.returncode == 0, allowed.stderr
+    assert (
+        "static_transform_publisher-1: runs mlaunch's stand-in" in (out / "README.md").read_text()
+    )

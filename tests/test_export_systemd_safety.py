@@ -32,7 +32,7 @@ KEYS = {
     "Description", "PartOf", "After", "Requires", "StartLimitIntervalSec", "Type",
     "RemainAfterExit", "User", "ExecStart", "WorkingDirectory", "EnvironmentFile", "Environment",
     "UnsetEnvironment", "Restart", "RestartSec", "KillMode", "KillSignal", "TimeoutStopSec",
-    "TimeoutStartSec",
+    "TimeoutStartSec", "NotifyAccess", "WatchdogSec", "Conflicts",
     "SyslogIdentifier", "Wants", "BindsTo", "WantedBy",
 }  # fmt: skip
 verify_needed = pytest.mark.skipif(

@@ -69,7 +69,7 @@ class Convert(Subcommand):
 
 class Export(Subcommand):
     name = "export"
-    help = "one systemd service per process, under one target"
+    help = "hand a launch to systemd (units) or to Ansible (a playbook for a fleet)"
 
     def parser(self) -> argparse.ArgumentParser:
         from mlaunch.app.options import build_parser
@@ -85,7 +85,7 @@ class Export(Subcommand):
 
 class Ctl(Subcommand):
     name = "ctl"
-    help = "control a running launch: list, stop, start, restart, mute, unmute, logs"
+    help = "control a running launch: list, stop, start, restart, mute, unmute, logs, wait-ready"
 
     def parser(self) -> argparse.ArgumentParser:
         from mlaunch.commands.ctl import parser

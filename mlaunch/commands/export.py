@@ -12,6 +12,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from mlaunch.export.bundle import check_portable, stem
 from mlaunch.plan.argparser import ArgumentParser
 from mlaunch.plan.errors import MlaunchError, UsageError
 
@@ -21,10 +22,10 @@ if TYPE_CHECKING:
     from mlaunch.export.systemd import Export, Unit
     from mlaunch.plan.steps import Deferred, Plan
 
-FORMATS = ("systemd",)
+FORMATS = ("systemd", "ansible")
 USAGE = (
-    "mlaunch export FILE [name:=value ...] --to systemd DIR [--name NAME] [--user USER]"
-    " [--env NAME[=VALUE]]..."
+    "mlaunch export FILE [name:=value ...] --to systemd|ansible DIR [--name NAME] [--user USER]"
+    " [--env NAME[=VALUE]]... [--allow-standins]"
 )
 
 
@@ -41,7 +42,8 @@ def build_parser() -> argparse.ArgumentParser:
         nargs=2,
         metavar=("FORMAT", "DIR"),
         required=True,
-        help="what to write and where: 'systemd DIR' writes units, params files and a README",
+        help="what to write and where: 'systemd DIR' writes units, params files and a README;"
+        " 'ansible DIR' a playbook folder (deploy.yml, teardown.yml, an example inventory.yml)",
     )
     parser.add_argument("--name", help="the target's name and the units' prefix (default: FILE)")
     parser.add_argument("--user", help="the user the services run as (User=; default: root)")
@@ -58,6 +60,12 @@ def build_parser() -> argparse.ArgumentParser:
         " NAME=VALUE, into NAME.env for every unit; nothing else of this environment is exported",
     )
     parser.add_argument("--force", action="store_true", help="write into a non-empty DIR")
+    parser.add_argument(
+        "--allow-standins",
+        action="store_true",
+        help="export even when processes run mlaunch's stand-ins or programs of this computer's"
+        " virtual environment (each is named; without this the export is refused)",
+    )
     return parser
 
 
@@ -78,6 +86,10 @@ def command(args: Sequence[str]) -> int:
         opts = parse_options(rest)
     except SystemExit as e:
         return int(e.code or 0)
+    if fmt == "ansible":
+        from mlaunch.export.ansible import export_ansible
+
+        return export_ansible(opts, settings, out_dir)
     return export_systemd(opts, settings, out_dir)
 
 
@@ -91,7 +103,7 @@ def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) ->
     if os.path.lexists(out_dir):  # refused now, before loading the file
         Folder.open(out_dir, force=settings.force).close()
     path, description = pipeline.load_target(opts)
-    prefix = systemd.unit_name(settings.name or _stem(path))
+    prefix = systemd.unit_name(settings.name or stem(path))
     temp_dir = private_temp_dir()
     try:
         plan, options, labels = pipeline.resolve_for_run(
@@ -111,14 +123,18 @@ def export_systemd(opts: Options, settings: argparse.Namespace, out_dir: str) ->
         units = export.build()
         if not units:
             raise MlaunchError(f"{path}: the launch starts no process; nothing to export")
-        write_units(export, units, out_dir, settings, path, prefix)
+        check_portable([u.spec for u in units], settings.allow_standins, export.warnings)
+        write_units(export, units, out_dir, settings, path, prefix, opts.arguments)
     finally:
         remove_private_dir(temp_dir)
     for warning in export.warnings:
         print(f"mlaunch export: warning: {warning}", file=sys.stderr)
     from mlaunch.engine.lifeline import write_stdout
 
-    write_stdout(f"wrote {len(units)} services and {prefix}.target to {out_dir} (see README.md)\n")
+    write_stdout(
+        f"wrote {len(units)} services, {prefix}.target and {prefix}.service (the whole launch"
+        f" under mlaunch) to {out_dir} (see README.md)\n"
+    )
     return 0
 
 
@@ -129,8 +145,10 @@ def write_units(
     settings: argparse.Namespace,
     source: str,
     prefix: str,
+    arguments: dict[str, str],
 ) -> None:
     from mlaunch.export import systemd
+    from mlaunch.export.bundle import copy_launch_tree, mlaunch_command
 
     install_dir = os.path.abspath(settings.install_dir or out_dir)
     copies = systemd.install_params(units, install_dir)
@@ -152,6 +170,18 @@ def write_units(
         for unit in units
     }  # every unit is checked before any file is written
     target = systemd.target_text(units, os.path.basename(source))
+    launch = os.path.join(install_dir, "launch", os.path.basename(source))
+    command = [*mlaunch_command(os.environ.get("PATH", os.defpath)), launch]
+    command += [f"{name}:={value}" for name, value in arguments.items()]
+    launch_service = systemd.launch_service_text(
+        units,
+        command,
+        target=f"{prefix}.target",
+        env_file=env_file,
+        cwd=cwd,
+        user=settings.user,
+        description=os.path.basename(source),
+    )
     environment = systemd.environment_file(chosen).encode()
     from mlaunch.export.folder import Folder
 
@@ -168,15 +198,9 @@ def write_units(
         for name, text in texts.items():
             folder.write(name, text.encode("utf-8"), 0o644)
         folder.write(f"{prefix}.target", target.encode("utf-8"), 0o644)
+        folder.write(f"{prefix}.service", launch_service.encode("utf-8"), 0o644)
+        copy_launch_tree(source, folder, "launch")
         readme = systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings)
         folder.write("README.md", readme.encode("utf-8"), 0o644)
     finally:
         folder.close()
-
-
-def _stem(path: str) -> str:
-    name = os.path.basename(path)
-    for suffix in (".launch.py", ".launch.yaml", ".launch.xml", ".launch", ".py", ".yaml", ".xml"):
-        if name.endswith(suffix):
-            return name[: -len(suffix)]
-    return name

@@ -329,6 +329,60 @@ def service_text(unit: Unit, *, target: str, env_file: str, cwd: str, user: str 
     return "\n".join(lines) + "\n"
 
 
+# The launch service's start timeout: readiness (graph discovery, lifecycle bring-up) plus the
+# longest timer delay before a process starts.
+READY_MARGIN = 90.0
+# Its stop: mlaunch's own ladder per process runs in parallel; this is on top of the longest.
+STOP_MARGIN = 10.0
+
+
+def launch_service_text(
+    units: list[Unit],
+    command: list[str],
+    *,
+    target: str,
+    env_file: str,
+    cwd: str,
+    user: str | None,
+    description: str,
+) -> str:
+    """The ``Type=notify`` service that runs the whole launch under mlaunch (``command``): it is
+    started once mlaunch says READY=1 (mlaunch test's checks), watched by WATCHDOG=1, and
+    conflicts with the per-process target (one or the other runs the launch)."""
+    delay = max((u.delay for u in units), default=0.0)
+    ladder = max((u.spec.sigterm_timeout + u.spec.sigkill_timeout for u in units), default=10.0)
+    lines = [
+        "[Unit]",
+        "Description=" + setting("launch file name", f"{description} under mlaunch"),
+        f"Conflicts={target}",
+        "After=network-online.target",
+        "Wants=network-online.target",
+        "",
+        "[Service]",
+        "Type=notify",
+        "NotifyAccess=main",
+        f"TimeoutStartSec={timespan(READY_MARGIN + delay)}",
+        "WatchdogSec=30",
+    ]
+    if user:
+        lines.append("User=" + user_setting(user))
+    lines += [
+        "ExecStart=" + " ".join(quote_exec(w) for w in command),
+        "WorkingDirectory=" + setting("working directory", cwd),
+        "EnvironmentFile=" + setting("environment file path", env_file),
+        "Restart=on-failure",
+        "RestartSec=2",
+        # SIGINT to mlaunch alone: its stop ladder stops the processes, then systemd's SIGKILL
+        "KillMode=mixed",
+        "KillSignal=SIGINT",
+        f"TimeoutStopSec={timespan(ladder + STOP_MARGIN, least=1e-6)}",
+        "",
+        "[Install]",
+        "WantedBy=multi-user.target",
+    ]
+    return "\n".join(lines) + "\n"
+
+
 def user_setting(user: str) -> str:
     """``User=``'s value: a user name or a numeric id, as systemd accepts them, else refused."""
     if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.-]{0,30}\$?|[0-9]{1,10}", user):
@@ -395,6 +449,16 @@ def readme_text(prefix: str, install_dir: str, source: str, warnings: list[str])
         "",
         f"Stop everything with `sudo systemctl stop {prefix}.target`; follow the output with"
         f" `journalctl -f -u '{prefix}-*'`.",
+        "",
+        f"Or run the whole launch under mlaunch: `{prefix}.service` (`Type=notify`) is started"
+        " once mlaunch says the launch is ready (its processes up, its nodes in the ROS graph,"
+        " lifecycle nodes active: the checks of `mlaunch test`), and restarted when a process"
+        " it watches dies (no more watchdog pings). It conflicts with the target: one or the"
+        " other runs the launch. It needs mlaunch on the robot (the path in its ExecStart=) and"
+        f" the launch file's folder, copied to {install_dir}/launch:",
+        "",
+        f"    sudo systemctl link {shlex.quote(install_dir)}/{prefix}.service"
+        f" && sudo systemctl enable --now {prefix}.service",
     ]
     if warnings:
         lines += ["", "## Warnings", ""] + [f"- {w}" for w in warnings]

@@ -1,0 +1,222 @@
+"""mlaunch export --to ansible, run by real Ansible against two "robots": two private sshd
+daemons on 127.0.0.1 (the same computer on two ports, as a simulated fleet on one computer is).
+
+Each host runs its part of the launch (its own robot:= argument) in a folder of its own, with a
+shared ROS domain: each host's readiness waits for the other's node, so wait-ready passing on both
+is the proof that they see each other. Then: a second deploy changes nothing, teardown leaves no
+process and no folder, and a host whose launch dies at once is reported failed.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import sshd
+from procutil import REPO, clean_env, run_mlaunch, wait_until
+
+PLAYBOOK = Path(sys.executable).parent / "ansible-playbook"
+MLAUNCH = Path(sys.executable).parent / "mlaunch"
+TALKER = REPO / "tests" / "nodes" / "talker.py"
+# ssh's control sockets: a short path (108 bytes at most), one per test process
+CONTROL = f"/tmp/mlaunch-ansible-{os.getpid()}-%C"
+
+pytestmark = pytest.mark.skipif(
+    not PLAYBOOK.exists() or sshd.SSHD is None or shutil.which("ssh") is None,
+    reason="needs ansible-core in the venv (scripts/setup installs it) and openssh-server",
+)
+
+LAUNCH = f"""\
+import sys
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, ExecuteProcess
+from launch.conditions import IfCondition, UnlessCondition
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+def generate_launch_description():
+    die = LaunchConfiguration("die")
+    return LaunchDescription([
+        DeclareLaunchArgument("robot", default_value="r0"),
+        DeclareLaunchArgument("die", default_value="false"),
+        Node(executable=sys.executable, arguments=[{str(TALKER)!r}], name="talker",
+             namespace=LaunchConfiguration("robot"), exec_name="talker",
+             condition=UnlessCondition(die)),
+        ExecuteProcess(cmd=[sys.executable, "-c", "exit(3)"], name="broken",
+                       condition=IfCondition(die)),
+    ])
+"""
+
+
+def recap(output: str) -> dict[str, dict[str, int]]:
+    """PLAY RECAP's counts per host."""
+    out = {}
+    for host, counts in re.findall(r"^(r\d)\s+:\s+(ok=.*)$", output, re.M):
+        out[host] = {k: int(v) for k, v in re.findall(r"(\w+)=(\d+)", counts)}
+    return out
+
+
+def talkers() -> list[str]:
+    """The test's talkers running anywhere on this computer: pid and command line."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        words = [w.decode(errors="replace") for w in argv if w]
+        if str(TALKER) in words:
+            found.append(f"{pid} {' '.join(words)}")
+    return found
+
+
+@pytest.fixture
+def robots(tmp_path: Path) -> object:
+    servers = []
+    try:
+        for name in ("r1", "r2"):
+            root = tmp_path / f"sshd-{name}"
+            root.mkdir()
+            servers.append(sshd.start(root, alias=name))
+        yield servers
+    finally:
+        for server in servers:
+            sshd.stop(server)
+
+
+def inventory(
+    path: Path, servers: list[sshd.Server], ros_env: dict[str, str], hosts: dict[str, dict]
+) -> Path:
+    """r1 and r2 on their own servers; r3 on r2's (one computer, two inventory names)."""
+    names = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMENTATION")
+    environment: dict[str, str] = {k: ros_env[k] for k in names if k in ros_env}
+    server_of = {"r1": servers[0], "r2": servers[1], "r3": servers[1]}
+    data = {
+        "all": {
+            "hosts": {
+                name: {
+                    "ansible_host": "r1" if name == "r1" else "r2",
+                    "ansible_ssh_common_args": f"-F {server_of[name].client_config}",
+                    "launch_arguments": arguments,
+                }
+                for name, arguments in hosts.items()
+            },
+            "vars": {
+                "mlaunch": str(MLAUNCH),
+                "install_root": str(path.parent / "robots"),
+                "ready_timeout": 90,
+                "launch_environment": environment,
+                "ansible_python_interpreter": "/usr/bin/python3",
+            },
+        }
+    }
+    path.write_text(json.dumps(data, indent=2))
+    return path
+
+
+def play(out: Path, inv: Path, book: str, *extra: str) -> subprocess.CompletedProcess[str]:
+    home = out.parent / "ansible-home"
+    env = clean_env(
+        ANSIBLE_HOME=str(home),
+        ANSIBLE_LOCAL_TEMP=str(home / "tmp"),
+        ANSIBLE_REMOTE_TEMP=str(home / "remote"),
+        ANSIBLE_NOCOLOR="1",
+        ANSIBLE_RETRY_FILES_ENABLED="0",
+        ANSIBLE_PIPELINING="1",  # one connection per task, not five
+        # Connections shared within a play; an idle master ends 2 s after the play's last use.
+        ANSIBLE_SSH_ARGS=f"-o ControlMaster=auto -o ControlPersist=2s -o ControlPath={CONTROL}",
+        ANSIBLE_SSH_TRANSFER_METHOD="piped",  # the test's sshd has no sftp subsystem
+    )
+    return subprocess.run(
+        [str(PLAYBOOK), "-i", str(inv), book, *extra],
+        cwd=out,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        stdin=subprocess.DEVNULL,
+    )
+
+
+def test_an_export_of_programs_only_this_computer_has_is_refused_unless_allowed(
+    tmp_path: Path,
+) -> None:
+    launch = tmp_path / "fleet.launch.py"
+    launch.write_text(LAUNCH)
+    refused = run_mlaunch("export", str(launch), "--to", "ansible", str(tmp_path / "out"),
+                          env=clean_env())  # fmt: skip
+    assert refused.returncode == 2, refused.stderr
+    assert f"talker-1: runs {sys.executable}, inside " in refused.stderr, refused.stderr
+    assert "--allow-standins" in refused.stderr
+    assert not (tmp_path / "out").exists()  # nothing written
+    done = run_mlaunch("export", str(launch), "--to", "ansible", str(tmp_path / "out"),
+                       "--allow-standins", env=clean_env())  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "warning: talker-1: runs " in done.stderr
+    assert "talker-1: runs " in (tmp_path / "out" / "README.md").read_text()
+
+
+@pytest.mark.timeout(600)  # four playbook runs: two minutes on a loaded 2-core machine
+def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
+    tmp_path: Path, ros_env: dict[str, str], robots: list[sshd.Server]
+) -> None:
+    launch = tmp_path / "launch" / "fleet.launch.py"
+    launch.parent.mkdir()
+    launch.write_text(LAUNCH)
+    out = tmp_path / "fleet"
+    done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), "--allow-standins",
+                       env=clean_env())  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    root = tmp_path / "robots" / "fleet"
+    # Each robot's readiness includes the other's node: both pass only in one shared graph.
+    # r3's launch dies at once.
+    hosts = {
+        "r1": {"robot": "r1", "mlaunch_expect_peer": "node /r2/talker"},
+        "r2": {"robot": "r2", "mlaunch_expect_peer": "node /r1/talker"},
+        "r3": {"robot": "r3", "die": "true"},
+    }
+    inv = inventory(tmp_path / "inventory.yml", robots, ros_env, hosts)
+
+    checked = play(out, inv, "deploy.yml", "--check")
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    assert all(c["changed"] > 0 for c in recap(checked.stdout).values()), checked.stdout
+    assert not talkers() and not root.exists()  # check mode starts and writes nothing
+
+    started = time.monotonic()
+    deployed = play(out, inv, "deploy.yml")
+    took = time.monotonic() - started
+    try:
+        assert deployed.returncode == 2, deployed.stdout + deployed.stderr  # a host failed
+        counts = recap(deployed.stdout)
+        assert counts["r1"]["failed"] == counts["r2"]["failed"] == 0, deployed.stdout
+        assert counts["r3"]["failed"] == 1, deployed.stdout
+        assert re.search(r'"msg": "r1: ready: 3 checks met', deployed.stdout), deployed.stdout
+        assert re.search(r'"msg": "r2: ready: 3 checks met', deployed.stdout), deployed.stdout
+        assert "ended before it was ready" in deployed.stdout, deployed.stdout
+        running = talkers()
+        assert len(running) == 2, running
+        assert any("__ns:=/r1" in t and "__node:=talker" in t for t in running), running
+        assert any("__ns:=/r2" in t and "__node:=talker" in t for t in running), running
+        for host in ("r1", "r2", "r3"):  # apart, by inventory name
+            assert (root / host / "files" / "launch" / "fleet.launch.py").is_file()
+            assert (root / host / "log").is_dir()
+        print(f"deploy to three hosts (two ready, one failed): {took:.1f} s")
+
+        again = play(out, inv, "deploy.yml")
+        counts = recap(again.stdout)
+        assert counts["r1"]["changed"] == counts["r2"]["changed"] == 0, again.stdout
+        assert counts["r1"]["failed"] == counts["r2"]["failed"] == 0, again.stdout
+        assert counts["r3"]["failed"] == 1, again.stdout  # started again, dead again
+        assert sorted(talkers()) == sorted(running)  # the same processes, untouched
+    finally:
+        down = play(out, inv, "teardown.yml")
+    assert down.returncode == 0, down.stdout + down.stderr
+    assert wait_until(lambda: not talkers(), 30), talkers()
+    assert not root.exists(), list(root.rglob("*"))
