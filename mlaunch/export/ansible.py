@@ -113,9 +113,8 @@ def export_ansible(opts: Options, settings: argparse.Namespace, out_dir: str) ->
     from mlaunch.app import pipeline
     from mlaunch.engine.lifeline import write_stdout
     from mlaunch.engine.privatedir import private_temp_dir, remove_private_dir
-    from mlaunch.export.systemd import unit_name
-
     from mlaunch.export.folder import Folder
+    from mlaunch.export.systemd import unit_name
 
     if os.path.lexists(out_dir):  # refused now, before loading the file
         Folder.open(out_dir, force=settings.force).close()
