@@ -20,6 +20,12 @@ from procutil import REPO, clean_env, mlaunch
 
 PREFIX = Path(VENV_PREFIX)
 TALKER_QOS = PREFIX / "lib" / "demo_nodes_py" / "talker_qos"
+LIFECYCLE_TALKER = PREFIX / "lib" / "lifecycle_py" / "lifecycle_talker"
+requires_lifecycle_py = pytest.mark.skipif(
+    not os.access(LIFECYCLE_TALKER, os.X_OK),
+    reason=f"lifecycle_py is not installed ({LIFECYCLE_TALKER} is missing): run scripts/setup"
+    " --real-nodes [DIR] with a demos archive that has lifecycle_py (CI does)",
+)
 requires_demo_nodes_py = pytest.mark.skipif(
     not os.access(TALKER_QOS, os.X_OK),
     reason=f"demo_nodes_py is not installed ({TALKER_QOS} is missing): run scripts/setup"
@@ -138,7 +144,41 @@ def test_the_packer_says_when_no_archive_has_the_package(tmp_path: Path) -> None
     manifest.write_text(manifest.read_text().replace("demo_nodes_py LICENSE", "LICENSE"))
     done = pack(sources, tmp_path / "cache")
     assert done.returncode == 2 and done.stdout == ""
-    assert f"no archive of {sources} has demo_nodes_py" in done.stderr, done.stderr
+    assert f"no archive of {sources} has demo_nodes_py or lifecycle_py" in done.stderr, done.stderr
+
+
+def test_the_packer_packs_lifecycle_py_beside_demo_nodes_py(tmp_path: Path) -> None:
+    """Both packages of one archive go into the one wheel; one an archive lacks is said."""
+    sources = make_sources(tmp_path / "src")
+    done = pack(sources, tmp_path / "cache")
+    assert done.returncode == 0 and "warning: no archive of" in done.stderr
+    assert "has lifecycle_py" in done.stderr, done.stderr
+    files = {
+        "setup.py": SETUP_PY.replace("'demo_nodes_py'", "'lifecycle_py'").replace(
+            "hello = demo_nodes_py.topics.hello:main", "lifecycle_talker = lifecycle_py.talker:main"
+        ),
+        "package.xml": "<package format='3'><name>lifecycle_py</name></package>",
+        "resource/lifecycle_py": "",
+        "lifecycle_py/__init__.py": "",
+        "lifecycle_py/talker.py": "def main():\n    return 0\n",
+    }
+    with tarfile.open(sources / "pylife.tar.gz", "w:gz") as archive:
+        for name, text in files.items():
+            info = tarfile.TarInfo(f"pylife/lifecycle_py/{name}")
+            info.size = len(text.encode())
+            archive.addfile(info, io.BytesIO(text.encode()))
+    with (sources / "MANIFEST.tsv").open("a") as manifest:
+        manifest.write("pylife.tar.gz\tros2/demos\tjazzy\tdef456\tlifecycle_py\t-\n")
+    done = pack(sources, tmp_path / "cache")
+    assert done.returncode == 0 and "warning" not in done.stderr, done.stderr
+    (wheel,) = Path(done.stdout.strip()).glob("*.whl")
+    data = "mlaunch_real_nodes_py-0.1.0.data/data/"
+    with zipfile.ZipFile(wheel) as archive:
+        names = set(archive.namelist())
+        metadata = archive.read("mlaunch_real_nodes_py-0.1.0.dist-info/METADATA").decode()
+    assert {data + "lib/demo_nodes_py/hello", data + "lib/lifecycle_py/lifecycle_talker"} <= names
+    assert "lifecycle_py/talker.py" in names
+    assert "Source: ros2/demos abc123" in metadata and "Source: ros2/demos def456" in metadata
 
 
 @requires_rclpy
@@ -166,3 +206,44 @@ def test_talker_qos_runs_under_mlaunch(ros_env: dict[str, str], tmp_path: Path) 
     assert "[qos_talker]: Reliable talker" in out, out[-3000:]
     assert '[qos_talker]: Publishing: "Hello World: 0"' in out, out[-3000:]
     assert "not installed" not in out, out[-3000:]
+
+
+LIFECYCLE_LAUNCH = """
+from launch import LaunchDescription
+from launch_ros.actions import LifecycleNode
+
+
+def generate_launch_description():
+    return LaunchDescription([
+        LifecycleNode(
+            package='lifecycle_py', executable='lifecycle_talker', name='lc_talker',
+            namespace='', autostart=True, output='screen',
+        ),
+    ])
+"""
+
+
+@requires_rclpy
+@requires_lifecycle_py
+@pytest.mark.timeout(150)
+def test_the_real_lifecycle_talker_autostarts_to_active(
+    ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """lifecycle_py's own talker (not a stand-in) under a LifecycleNode with autostart: mlaunch
+    configures and activates it, --expect-lifecycle sees it active, it publishes once active."""
+    launch = tmp_path / "lifecycle_talker.launch.py"
+    launch.write_text(LIFECYCLE_LAUNCH)
+    env = clean_env(**ros_env)
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    others = [e for e in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if e]
+    env["AMENT_PREFIX_PATH"] = os.pathsep.join([str(PREFIX), *others])
+    done = subprocess.run(
+        mlaunch("test", str(launch), "--expect-lifecycle", "/lc_talker", "--hold", "2"),
+        capture_output=True, text=True, env=env, timeout=140, cwd=tmp_path,
+    )  # fmt: skip
+    out = done.stdout + done.stderr
+    assert done.returncode == 0, out[-3000:]
+    assert "not installed" not in out, out[-3000:]  # the real program, no stand-in
+    assert "[lc_talker]: on_configure() is called." in out, out[-3000:]
+    assert "lifecycle node /lc_talker is active" in out and "state 'active'" in out, out[-3000:]
+    assert "Lifecycle publisher is active. Publishing: [Lifecycle HelloWorld #0]" in out

@@ -1,5 +1,5 @@
-"""Packs the pure Python ROS 2 demo package (demo_nodes_py, ament_python) into one wheel laid
-out as colcon installs it, for ``scripts/setup --real-nodes``.
+"""Packs the pure Python ROS 2 demo packages (demo_nodes_py and lifecycle_py, ament_python) into
+one wheel laid out as colcon installs them, for ``scripts/setup --real-nodes``.
 
 Nothing is compiled: the package's own ``setup.py`` is run only to read what it declares
 (``setuptools.setup`` is replaced by a recorder), and the wheel holds its Python modules in
@@ -10,12 +10,12 @@ no launcher for a prefix data file, so each program starts the Python of the pre
 (``<prefix>/bin/python3``: the venv's) through a two-line /bin/sh preamble that Python reads as
 a string.
 
-The source is the ``demo_nodes_py`` folder of the archive whose ``MANIFEST.tsv`` row lists it
-in its paths (ros2/demos has it beside demo_nodes_cpp). The wheel is cached beside the C++ one
-(``build.py``'s cache) under a key of that folder's files, this script, ``build.py`` (its wheel
+The source of each is its folder in the archive whose ``MANIFEST.tsv`` row lists it in its
+paths (ros2/demos has both beside demo_nodes_cpp). The wheel is cached beside the C++ one
+(``build.py``'s cache) under a key of those folders' files, this script, ``build.py`` (its wheel
 packer) and the interpreter, so it is packed again only when one of them changes, and a change
-here never rebuilds the C++ programs.
-Prints the wheel's folder; exit status 2 with one line when no archive has the package.
+here never rebuilds the C++ programs. A package no archive has is left out with a warning.
+Prints the wheel's folder; exit status 2 with one line when no archive has any of them.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-PACKAGE, DIST = "demo_nodes_py", "mlaunch_real_nodes_py"
+PACKAGES, DIST = ("demo_nodes_py", "lifecycle_py"), "mlaunch_real_nodes_py"
 
 # Run in the package's folder by the build's Python: prints what setup.py declares as JSON.
 READ_SETUP = """
@@ -70,25 +70,37 @@ def _load_build():  # type: ignore[no-untyped-def]
 build = _load_build()
 
 
-def find_archive(sources: Path) -> tuple[str, str, str]:
+def find_archive(sources: Path, package: str) -> tuple[str, str, str] | None:
     """The archive whose MANIFEST.tsv paths list the package: its stem, repository, commit."""
     with (sources / "MANIFEST.tsv").open(newline="") as handle:
         for row in csv.DictReader(handle, delimiter="\t"):
-            if PACKAGE in row["paths"].split():
+            if package in row["paths"].split():
                 return row["archive"].removesuffix(".tar.gz"), row["repo"], row["commit"]
-    raise build.BuildError(
-        f"no archive of {sources} has {PACKAGE} (MANIFEST.tsv lists it in no row's paths:"
-        f" ros2/demos has it beside demo_nodes_cpp): {PACKAGE} is not installed",
-        cannot_run=True,
-    )
+    return None
 
 
-def package_files(sources: Path) -> tuple[tuple[str, str, str], dict[str, bytes]]:
-    """The archive holding the package (find_archive) and its files (path below the package
-    folder -> bytes)."""
-    origin = find_archive(sources)
-    stem = origin[0]
-    archive, top = sources / f"{stem}.tar.gz", f"{stem}/{PACKAGE}/"
+Origin = tuple[str, str, str]  # archive stem, repository, commit
+
+
+def package_files(sources: Path) -> dict[str, tuple[Origin, dict[str, bytes]]]:
+    """Each package some archive has: where it is from (find_archive) and its files (path below
+    the package folder -> bytes)."""
+    found: dict[str, tuple[Origin, dict[str, bytes]]] = {}
+    for package in PACKAGES:
+        origin = find_archive(sources, package)
+        if origin is not None:
+            found[package] = (origin, _files(sources, origin[0], package))
+    if not found:
+        raise build.BuildError(
+            f"no archive of {sources} has {' or '.join(PACKAGES)} (MANIFEST.tsv lists them in no"
+            f" row's paths: ros2/demos has them beside demo_nodes_cpp): they are not installed",
+            cannot_run=True,
+        )
+    return found
+
+
+def _files(sources: Path, stem: str, package: str) -> dict[str, bytes]:
+    archive, top = sources / f"{stem}.tar.gz", f"{stem}/{package}/"
     found: dict[str, bytes] = {}
     with tarfile.open(archive) as tar:
         for member in tar:
@@ -98,16 +110,18 @@ def package_files(sources: Path) -> tuple[tuple[str, str, str], dict[str, bytes]
                 found[member.name[len(top) :]] = handle.read()
     if "setup.py" not in found:
         raise build.BuildError(f"{archive} has no {top}setup.py", cannot_run=True)
-    return origin, found
+    return found
 
 
-def build_key(files: dict[str, bytes]) -> str:
-    """The cache key: the package's files, this script, build.py and the interpreter."""
+def build_key(packages: dict[str, tuple[Origin, dict[str, bytes]]]) -> str:
+    """The cache key: the packages' files, this script, build.py and the interpreter."""
     parts = [build.ib._interpreter()]
     for path in (Path(__file__).resolve(), HERE / "build.py"):
         parts.append(path.read_bytes())
-    for name in sorted(files):
-        parts += [name.encode(), files[name]]
+    for package, (_, files) in sorted(packages.items()):
+        parts.append(package.encode())
+        for name in sorted(files):
+            parts += [name.encode(), files[name]]
     return str(build.ib._digest(parts))
 
 
@@ -122,7 +136,7 @@ def declared(source: Path) -> dict[str, object]:
     return result
 
 
-def install_tree(source: Path, prefix: Path) -> None:
+def install_tree(source: Path, prefix: Path, package_name: str) -> None:
     """Lays the package out in prefix as colcon's ament_python build installs it."""
     setup = declared(source)
     site = prefix / build.SITE
@@ -137,7 +151,7 @@ def install_tree(source: Path, prefix: Path) -> None:
         for name in names:
             shutil.copyfile(source / name, prefix / target / Path(name).name)
     scripts = (setup["entry_points"] or {}).get("console_scripts", [])  # type: ignore[attr-defined]
-    lib = prefix / "lib" / PACKAGE
+    lib = prefix / "lib" / package_name
     lib.mkdir(parents=True, exist_ok=True)
     for line in scripts:
         name, target = (part.strip() for part in line.split("=", 1))
@@ -145,7 +159,7 @@ def install_tree(source: Path, prefix: Path) -> None:
         program = lib / name
         program.write_text(
             PROGRAM.format(
-                package=PACKAGE, name=name, target=target, module=module, function=function
+                package=package_name, name=name, target=target, module=module, function=function
             )
         )
         program.chmod(0o755)
@@ -153,18 +167,27 @@ def install_tree(source: Path, prefix: Path) -> None:
 
 def build_all(sources: Path, root: Path) -> Path:
     """Returns the folder holding the wheel, packing it unless it is cached."""
-    (stem, repo, commit), files = package_files(sources)
-    done = root / f"python-{build_key(files)}"
+    packages = package_files(sources)
+    for missing in sorted(set(PACKAGES) - set(packages)):
+        print(
+            f"python_packages.py: warning: no archive of {sources} has {missing}", file=sys.stderr
+        )
+    done = root / f"python-{build_key(packages)}"
     if (done / ".complete").is_file():
         return done
     with tempfile.TemporaryDirectory(prefix="mlaunch-real-nodes-py-") as tmp:
-        source, prefix, wheels = Path(tmp) / "src", Path(tmp) / "install", Path(tmp) / "wheel"
-        for name, data in files.items():
-            (source / name).parent.mkdir(parents=True, exist_ok=True)
-            (source / name).write_bytes(data)
-        install_tree(source, prefix)
+        prefix, wheels = Path(tmp) / "install", Path(tmp) / "wheel"
+        origins: dict[str, tuple[str, str]] = {}
+        for package, ((stem, repo, commit), files) in sorted(packages.items()):
+            source = Path(tmp) / "src" / package
+            for name, data in files.items():
+                (source / name).parent.mkdir(parents=True, exist_ok=True)
+                (source / name).write_bytes(data)
+            install_tree(source, prefix, package)
+            origins[stem] = (repo, commit)
         wheels.mkdir()
-        build.pack_wheel(prefix, wheels, {stem: (repo, commit)}, dist=DIST, names=PACKAGE)
+        names = ", ".join(sorted(packages))
+        build.pack_wheel(prefix, wheels, origins, dist=DIST, names=names)
         return Path(build.publish(wheels, done))
 
 
@@ -176,7 +199,7 @@ def main(argv: list[str] | None = None) -> int:
     sources = args.sources.resolve()
     try:
         if args.key:
-            print(build_key(package_files(sources)[1]))
+            print(build_key(package_files(sources)))
         else:
             print(build_all(sources, build.cache_root()))
     except (build.BuildError, OSError, tarfile.TarError) as error:
