@@ -118,3 +118,17 @@ def test_a_for_length_that_is_no_number_is_a_located_error(
     assert done.returncode == 2
     assert f"{path}:2" in done.stderr
     assert "ForLoop's length is 'two'; it must be a whole number" in done.stderr, done.stderr
+
+
+def test_check_names_the_lifecycle_node_tag_as_newer(tmp_path: Path, env: dict[str, str]) -> None:
+    """It said "Jazzy has no tag 'lifecycle_node'", as for a misspelt tag."""
+    path = tmp_path / "lc.launch.xml"
+    path.write_text(
+        '<launch>\n<lifecycle_node pkg="p" exec="e" name="lc" namespace=""/>\n</launch>\n'
+    )
+    done = run_mlaunch(str(path), "--check", env=env)
+    assert done.returncode == 1
+    assert (
+        f"{path}:2:1: the tag 'lifecycle_node' is newer than Jazzy: launch_ros after 0.29.3"
+        " (Rolling, ros2/launch_ros#482) has it" in done.stdout
+    ), done.stdout

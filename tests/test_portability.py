@@ -69,7 +69,7 @@ BAD = {
     "yaml_unknown_tag": (
         "a.launch.yaml",
         "launch:\n- lifecycle_node: {pkg: p, exec: e, name: n, namespace: ''}\n",
-        "no tag 'lifecycle_node'",
+        "the tag 'lifecycle_node' is newer than Jazzy",
     ),
     "xml_broken_any": (
         "a.launch.xml",

@@ -152,7 +152,8 @@ SUBSTITUTIONS = (
 # Registered in Jazzy but failing there (observed under the reference): name -> what happens.
 BROKEN_ACTIONS = {
     "set_use_sim_time": "its frontend passes text where it wants a boolean, so it fails when run"
-    " (\"Type 'Type.BOOL' and value ... do not agree\"); use set_parameter use_sim_time",
+    " (\"Type 'Type.BOOL' and value ... do not agree\"; fixed in launch_ros 0.29.3, Rolling,"
+    " ros2/launch_ros#488); use set_parameter use_sim_time",
 }
 BROKEN_SUBSTITUTIONS = {
     "any": "its parser passes the arguments wrongly, so the file fails to load",
@@ -165,7 +166,11 @@ ON_EXIT_WORDS = ("shutdown",)
 # Newer than Jazzy, and run by mlaunch on Jazzy (--check names the release that has each): a
 # Jazzy ros2 launch rejects the file. Tags, substitutions, and Python names and modules.
 _LAUNCH_3_8 = "launch 3.8 (Kilted, ros2/launch#802)"
-NEWER_TAGS = {"for_each": _LAUNCH_3_8, "for": _LAUNCH_3_8}
+NEWER_TAGS = {
+    "for_each": _LAUNCH_3_8,
+    "for": _LAUNCH_3_8,
+    "lifecycle_node": "launch_ros after 0.29.3 (Rolling, ros2/launch_ros#482)",
+}
 NEWER_SUBSTITUTIONS = {
     "for-var": _LAUNCH_3_8,
     "index": _LAUNCH_3_8,
