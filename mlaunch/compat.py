@@ -30,8 +30,8 @@ ROOTS: dict[str, str] = {
     "launch_pytest": "mlaunch.launch_pytest",
 }
 
-# Upstream modules whose names mlaunch serves from a larger module (upstream splits one class per
-# module; ``launch.action`` holds ``Action``, which mlaunch keeps in ``launch.launch_description``).
+# Upstream modules that mlaunch serves from a module of another name: ``launch.launch_service``
+# runs the engine (an application), launch_xml's and launch_yaml's are mlaunch's readers'.
 SYNONYMS: dict[str, str] = {
     "launch.launch_service": "mlaunch.app.launch_service",
     "launch_xml.launch_description_sources": "mlaunch.launch.launch_description_sources",

@@ -210,3 +210,165 @@ def test_node_perform_substitutions_resolves_its_names_as_launch_ros() -> None:
     unnamed = Node(package="p", executable="e")
     unnamed._perform_substitutions(LaunchContext())
     assert unnamed.node_name == f"{Node.UNSPECIFIED_NODE_NAMESPACE}/{Node.UNSPECIFIED_NODE_NAME}"
+
+
+# Where upstream (launch 3.4.3, launch_ros 0.26.6) defines each class: the module that defines
+# it in mlaunch too (issue 31), so a new action is one module, as in ros2/launch.
+DEFINED_WHERE_UPSTREAM = {
+    "launch.action": ["Action"],
+    "launch.condition": ["Condition"],
+    "launch.event": ["Event"],
+    "launch.event_handler": ["EventHandler"],
+    "launch.launch_description": ["LaunchDescription"],
+    "launch.launch_description_entity": ["LaunchDescriptionEntity"],
+    "launch.launch_description_source": ["LaunchDescriptionSource"],
+    "launch.actions.append_environment_variable": ["AppendEnvironmentVariable"],
+    "launch.actions.declare_launch_argument": ["DeclareLaunchArgument"],
+    "launch.actions.emit_event": ["EmitEvent"],
+    "launch.actions.execute_local": ["ExecuteLocal"],
+    "launch.actions.execute_process": ["ExecuteProcess"],
+    "launch.actions.group_action": ["GroupAction"],
+    "launch.actions.include_launch_description": ["IncludeLaunchDescription"],
+    "launch.actions.log_info": ["LogInfo"],
+    "launch.actions.opaque_coroutine": ["OpaqueCoroutine"],
+    "launch.actions.opaque_function": ["OpaqueFunction"],
+    "launch.actions.pop_environment": ["PopEnvironment"],
+    "launch.actions.pop_launch_configurations": ["PopLaunchConfigurations"],
+    "launch.actions.push_environment": ["PushEnvironment"],
+    "launch.actions.push_launch_configurations": ["PushLaunchConfigurations"],
+    "launch.actions.register_event_handler": ["RegisterEventHandler"],
+    "launch.actions.reset_environment": ["ResetEnvironment"],
+    "launch.actions.reset_launch_configurations": ["ResetLaunchConfigurations"],
+    "launch.actions.set_environment_variable": ["SetEnvironmentVariable"],
+    "launch.actions.set_launch_configuration": ["SetLaunchConfiguration"],
+    "launch.actions.shutdown_action": ["Shutdown"],
+    "launch.actions.timer_action": ["TimerAction"],
+    "launch.actions.unregister_event_handler": ["UnregisterEventHandler"],
+    "launch.actions.unset_environment_variable": ["UnsetEnvironmentVariable"],
+    "launch.actions.unset_launch_configuration": ["UnsetLaunchConfiguration"],
+    "launch.conditions.if_condition": ["IfCondition"],
+    "launch.conditions.unless_condition": ["UnlessCondition"],
+    "launch.conditions.launch_configuration_equals": ["LaunchConfigurationEquals"],
+    "launch.conditions.launch_configuration_not_equals": ["LaunchConfigurationNotEquals"],
+    "launch.conditions.invalid_condition_expression_error": ["InvalidConditionExpressionError"],
+    "launch.conditions.evaluate_condition_expression_impl": ["evaluate_condition_expression"],
+    "launch.event_handlers.event_named": ["event_named"],
+    "launch.event_handlers.on_execution_complete": ["OnExecutionComplete"],
+    "launch.event_handlers.on_include_launch_description": ["OnIncludeLaunchDescription"],
+    "launch.event_handlers.on_process_exit": ["OnProcessExit"],
+    "launch.event_handlers.on_process_io": ["OnProcessIO"],
+    "launch.event_handlers.on_process_start": ["OnProcessStart"],
+    "launch.event_handlers.on_shutdown": ["OnShutdown"],
+    "launch.events.execution_complete": ["ExecutionComplete"],
+    "launch.events.include_launch_description": ["IncludeLaunchDescription"],
+    "launch.events.matchers": ["matches_action"],
+    "launch.events.shutdown": ["Shutdown"],
+    "launch.events.timer_event": ["TimerEvent"],
+    "launch.events.process.process_exited": ["ProcessExited"],
+    "launch.events.process.process_io": ["ProcessIO"],
+    "launch.events.process.process_started": ["ProcessStarted"],
+    "launch.events.process.process_stderr": ["ProcessStderr"],
+    "launch.events.process.process_stdin": ["ProcessStdin"],
+    "launch.events.process.process_stdout": ["ProcessStdout"],
+    "launch.events.process.process_targeted_event": ["ProcessTargetedEvent"],
+    "launch.events.process.running_process_event": ["RunningProcessEvent"],
+    "launch.events.process.shutdown_process": ["ShutdownProcess"],
+    "launch.events.process.signal_process": ["SignalProcess"],
+    "launch.events.process.process_matchers": ["matches_pid", "matches_name", "matches_executable"],
+    "launch.launch_description_sources.any_launch_description_source": [
+        "AnyLaunchDescriptionSource"
+    ],
+    "launch.launch_description_sources.frontend_launch_description_source": [
+        "FrontendLaunchDescriptionSource"
+    ],
+    "launch.launch_description_sources.python_launch_description_source": [
+        "PythonLaunchDescriptionSource"
+    ],
+    "launch.substitutions.anon_name": ["AnonName"],
+    "launch.substitutions.boolean_substitution": [
+        "NotSubstitution",
+        "AndSubstitution",
+        "OrSubstitution",
+        "AnySubstitution",
+        "AllSubstitution",
+    ],
+    "launch.substitutions.command": ["Command"],
+    "launch.substitutions.environment_variable": ["EnvironmentVariable"],
+    "launch.substitutions.equals_substitution": ["EqualsSubstitution"],
+    "launch.substitutions.file_content": ["FileContent"],
+    "launch.substitutions.find_executable": ["FindExecutable"],
+    "launch.substitutions.if_else_substitution": ["IfElseSubstitution"],
+    "launch.substitutions.launch_configuration": ["LaunchConfiguration"],
+    "launch.substitutions.launch_log_dir": ["LaunchLogDir"],
+    "launch.substitutions.local_substitution": ["LocalSubstitution"],
+    "launch.substitutions.not_equals_substitution": ["NotEqualsSubstitution"],
+    "launch.substitutions.path_join_substitution": ["PathJoinSubstitution"],
+    "launch.substitutions.python_expression": ["PythonExpression"],
+    "launch.substitutions.this_launch_file": ["ThisLaunchFile"],
+    "launch.substitutions.this_launch_file_dir": ["ThisLaunchFileDir"],
+    "launch_ros.actions.composable_node_container": ["ComposableNodeContainer"],
+    "launch_ros.actions.lifecycle_node": ["LifecycleNode"],
+    "launch_ros.actions.lifecycle_transition": ["LifecycleTransition"],
+    "launch_ros.actions.load_composable_nodes": ["LoadComposableNodes"],
+    "launch_ros.actions.node": ["Node"],
+    "launch_ros.actions.push_ros_namespace": ["PushROSNamespace"],
+    "launch_ros.actions.ros_timer": ["ROSTimer"],
+    "launch_ros.actions.set_parameter": ["SetParameter"],
+    "launch_ros.actions.set_parameters_from_file": ["SetParametersFromFile"],
+    "launch_ros.actions.set_remap": ["SetRemap"],
+    "launch_ros.actions.set_ros_log_dir": ["SetROSLogDir"],
+    "launch_ros.actions.set_use_sim_time": ["SetUseSimTime"],
+    "launch_ros.descriptions.composable_node": ["ComposableNode"],
+    "launch_ros.event_handlers.on_state_transition": ["OnStateTransition"],
+    "launch_ros.events.lifecycle.change_state": ["ChangeState"],
+    "launch_ros.events.lifecycle.state_transition": ["StateTransition"],
+    "launch_ros.substitutions.executable_in_package": ["ExecutableInPackage"],
+    "launch_ros.substitutions.find_package": [
+        "FindPackage",
+        "FindPackagePrefix",
+        "FindPackageShare",
+    ],
+    "launch_ros.substitutions.parameter": ["Parameter"],
+}
+
+
+@pytest.mark.parametrize("module", sorted(DEFINED_WHERE_UPSTREAM))
+def test_each_name_is_defined_in_the_module_upstream_defines_it_in(module: str) -> None:
+    loaded = importlib.import_module(module)
+    for name in DEFINED_WHERE_UPSTREAM[module]:
+        assert getattr(loaded, name).__module__ == f"mlaunch.{module}", (module, name)
+
+
+GATHERING_PACKAGES = [
+    "launch.actions",
+    "launch.conditions",
+    "launch.events",
+    "launch.events.process",
+    "launch.event_handlers",
+    "launch.launch_description_sources",
+    "launch.substitutions",
+    "launch_ros.actions",
+    "launch_ros.descriptions",
+    "launch_ros.event_handlers",
+    "launch_ros.events",
+    "launch_ros.events.lifecycle",
+    "launch_ros.substitutions",
+]
+
+
+@pytest.mark.parametrize("package", GATHERING_PACKAGES)
+def test_a_package_only_gathers_the_names_of_its_modules(package: str) -> None:
+    import ast
+    import inspect
+
+    loaded = importlib.import_module(package)
+    tree = ast.parse(inspect.getsource(loaded))
+    defined = [
+        node.name
+        for node in tree.body
+        if isinstance(node, (ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+    ]
+    assert defined == [], f"{package} defines {defined}: each belongs in a module of its own"
+    for name in loaded.__all__:
+        assert getattr(loaded, name) is not None  # each gathered name loads
+    assert set(loaded.__all__) <= set(dir(loaded))

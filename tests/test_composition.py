@@ -13,8 +13,8 @@ import pytest
 from mlaunch import readers
 from mlaunch.launch.actions import LaunchDescription
 from mlaunch.launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
-from mlaunch.launch_ros.composable import ComposableNode
 from mlaunch.launch_ros.composition import LoadComponents
+from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 from mlaunch.launch_ros.load_request import (
     BOOL,
     DOUBLE,
@@ -189,7 +189,7 @@ def test_bad_descriptions_are_clear_errors() -> None:
     with pytest.raises(LaunchFileError, match="must be a list of ComposableNode"):
         LoadComposableNodes(
             target_container="c",
-            composable_node_descriptions=ComposableNode(package="p", plugin="p::P"),
+            composable_node_descriptions=ComposableNode(package="p", plugin="p::P"),  # type: ignore[arg-type]
         )
     with pytest.raises(LaunchFileError, match="target_container must be"):
         LoadComposableNodes(target_container=3, composable_node_descriptions=[])

@@ -304,7 +304,7 @@ def test_a_launch_service_loads_components_of_a_description_included_while_runni
     from mlaunch.app.launch_service import LaunchService
     from mlaunch.launch.actions import ExecuteProcess, LaunchDescription
     from mlaunch.launch_ros.actions import LoadComposableNodes
-    from mlaunch.launch_ros.composable import ComposableNode
+    from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 
     screen = Screen()
     service = LaunchService(screen=screen)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 
+from mlaunch.launch.action import Action
 from mlaunch.launch.actions import (
     DeclareLaunchArgument,
     ExecuteProcess,
@@ -13,7 +14,7 @@ from mlaunch.launch.actions import (
     TimerAction,
 )
 from mlaunch.launch.launch_context import LaunchContext
-from mlaunch.launch.launch_description import Action, LaunchDescription
+from mlaunch.launch.launch_description import LaunchDescription
 from mlaunch.launch.planning import StandalonePlanner
 from mlaunch.launch.substitutions import LaunchConfiguration
 from mlaunch.plan.steps import Spawn, StartTimer

@@ -20,7 +20,8 @@ import xacro
 
 from mlaunch import readers
 from mlaunch.launch.launch_context import LaunchContext
-from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS, Command, perform
+from mlaunch.launch.substitutions import Command, perform
+from mlaunch.launch.substitutions.command import IN_PROCESS_COMMANDS
 from mlaunch.launch_ros import xacro as in_process
 from mlaunch.plan.errors import SubstitutionFailure
 from mlaunch.plan.steps import Log

@@ -27,8 +27,8 @@ import sys
 import threading
 from collections import deque
 
-from mlaunch.launch.actions import LaunchDescription
 from mlaunch.launch.launch_context import LaunchContext
+from mlaunch.launch.launch_description import LaunchDescription
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.events import Said
 
@@ -109,12 +109,12 @@ class LaunchService:
 
         ``launch.events.IncludeLaunchDescription`` includes its description.
         """
-        from mlaunch.launch.events import IncludeLaunchDescription
+        from mlaunch.launch.events.include_launch_description import IncludeLaunchDescription
 
         if isinstance(event, IncludeLaunchDescription):
             self.include_launch_description(event.launch_description)
             return
-        from mlaunch.launch.actions import EmitEvent
+        from mlaunch.launch.actions.emit_event import EmitEvent
 
         self.include_launch_description(LaunchDescription([EmitEvent(event=event)]))
 
@@ -385,8 +385,9 @@ class LaunchService:
         handler sees only the processes started after it), so a launch file's own handler of
         the same start runs first and may not see process_details filled in yet.
         """
-        from mlaunch.launch.actions import RegisterEventHandler
-        from mlaunch.launch.event_handlers import OnProcessExit, OnProcessStart
+        from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+        from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
+        from mlaunch.launch.event_handlers.on_process_start import OnProcessStart
 
         def started(event: Any, context: Any) -> None:
             if event.action is not None:

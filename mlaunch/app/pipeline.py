@@ -23,7 +23,8 @@ from mlaunch.plan.steps import Plan
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from mlaunch.engine.lifeline import Lifeline
-    from mlaunch.launch.launch_description import LaunchDescription, LaunchDescriptionEntity
+    from mlaunch.launch.launch_description import LaunchDescription
+    from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
     from mlaunch.parts.remote import Spawner
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
     from mlaunch.ros.search import PackageSearch
@@ -127,7 +128,7 @@ def resolve_for_run(
         dry_run=opts.print_plan,
     )
     if opts.use_sim_time is not None:
-        from mlaunch.launch_ros.actions import with_use_sim_time
+        from mlaunch.launch_ros.actions.set_parameter import with_use_sim_time
 
         description = with_use_sim_time(description, opts.use_sim_time)
     labels = LabelCounter()

@@ -60,7 +60,7 @@ def check_run(opts: Options, path: str) -> list[Finding]:
             collect=errors,
         )
         if opts.use_sim_time is not None:
-            from mlaunch.launch_ros.actions import with_use_sim_time
+            from mlaunch.launch_ros.actions.set_parameter import with_use_sim_time
 
             description = with_use_sim_time(description, opts.use_sim_time)
         warnings: list[str] = []

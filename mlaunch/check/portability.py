@@ -226,7 +226,8 @@ class _Walker:
         """Jazzy shlex-splits each text piece between substitutions on its own."""
         import shlex
 
-        from mlaunch.launch_ros.subst import TemplateError, parse_template
+        from mlaunch.launch.frontend.template import TemplateError
+        from mlaunch.launch_ros.subst import parse_template
 
         try:
             parts = parse_template(text)

@@ -201,7 +201,7 @@ def prepare(
     (path, plan, resolve options, labels, the expectations of the run, the native ROS 1 run
     it is, if it is one)."""
     from mlaunch.app import pipeline
-    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch.launch_description import LaunchDescription
 
     path, description = pipeline.load_target(opts, temp_dir=life.temp_dir)
     collector = _CollectConfigurations()

@@ -16,7 +16,8 @@ from collections.abc import Callable
 
 from mlaunch.engine.process import Process
 from mlaunch.launch import events as ev
-from mlaunch.launch.event_handlers import MATCHER_KIND, returned_entities
+from mlaunch.launch.event_handler import MATCHER_KIND, returned_entities
+from mlaunch.launch.events.matchers import SEES_PROCESS
 from mlaunch.plan.events import (
     Completed,
     Event,
@@ -240,7 +241,7 @@ class LaunchHandlers:
 def _selects(matcher: Callable[[Any], bool], process: Process) -> bool:
     """Whether a ShutdownProcess's or SignalProcess's matcher selects ``process``: launch's
     matchers are given the process's action, mlaunch's own (matches_pid ...) the process."""
-    sees_process = getattr(matcher, ev.SEES_PROCESS, False)
+    sees_process = getattr(matcher, SEES_PROCESS, False)
     return bool(matcher(process if sees_process else process.spec.action))
 
 

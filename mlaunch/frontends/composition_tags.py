@@ -15,7 +15,8 @@ from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item
 from mlaunch.frontends.process_tags import node_kwargs
-from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.launch.conditions.if_condition import IfCondition
+from mlaunch.launch.conditions.unless_condition import UnlessCondition
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -23,7 +24,7 @@ if TYPE_CHECKING:
 
 
 def _composable_node(e: Entity) -> Any:
-    from mlaunch.launch_ros.composable import ComposableNode
+    from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 
     kwargs: dict[str, Any] = {
         "package": required_text(e, "pkg"),
@@ -58,7 +59,7 @@ def _composable_node(e: Entity) -> Any:
 
 def _extra_argument(x: Entity) -> dict[Any, Any]:
     """``{name: value}``; the value is a substitution, so it is typed as YAML (as launch_ros)."""
-    from mlaunch.launch.substitutions import TextSubstitution
+    from mlaunch.launch.substitution import TextSubstitution
 
     name = required_text(x, "name")
     value = required_text(x, "value")
@@ -71,7 +72,7 @@ def _descriptions(e: Entity) -> list[Any]:
 
 
 def _node_container(e: Entity) -> Any:
-    from mlaunch.launch_ros.composition import ComposableNodeContainer
+    from mlaunch.launch_ros.actions.composable_node_container import ComposableNodeContainer
 
     kwargs = node_kwargs(e)
     for required in ("name", "namespace"):
@@ -84,7 +85,7 @@ def _node_container(e: Entity) -> Any:
 
 
 def _load_composable_node(e: Entity) -> Any:
-    from mlaunch.launch_ros.composition import LoadComposableNodes
+    from mlaunch.launch_ros.actions.load_composable_nodes import LoadComposableNodes
 
     target = required_text(e, "target")
     return LoadComposableNodes(

@@ -16,8 +16,9 @@ from __future__ import annotations
 import difflib
 from collections.abc import Callable
 
-from mlaunch.launch.substitutions import to_bool
-from mlaunch.launch_ros.subst import Parts, TemplateError, parse_template
+from mlaunch.launch.frontend.template import Parts, TemplateError
+from mlaunch.launch.substitutions.boolean_substitution import to_bool
+from mlaunch.launch_ros.subst import parse_template
 from mlaunch.plan.errors import LaunchFileError, SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms to import

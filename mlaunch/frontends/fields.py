@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from mlaunch.frontends.entity import Entity
-from mlaunch.launch_ros.subst import Parts
+from mlaunch.launch.frontend.template import Parts
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

@@ -33,7 +33,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any, TextIO
 
-    from mlaunch.launch.launch_description import Action, LaunchDescription
+    from mlaunch.launch.action import Action
+    from mlaunch.launch.launch_description import LaunchDescription
     from mlaunch.launch.substitution import Substitution
 
 # The exceptions a parse method written against upstream raises for bad input.

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.fields import Value, as_key, required_text
-from mlaunch.launch.substitutions import Substitution, TextSubstitution, to_bool
+from mlaunch.launch.substitution import Substitution, TextSubstitution
+from mlaunch.launch.substitutions.boolean_substitution import to_bool
 from mlaunch.plan.errors import MlaunchError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms

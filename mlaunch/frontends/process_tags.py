@@ -11,7 +11,7 @@ from mlaunch.frontends.entity import Entity
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
 from mlaunch.launch.frontend.cmdline import split_parts
-from mlaunch.launch.substitutions import to_bool
+from mlaunch.launch.substitutions.boolean_substitution import to_bool
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.plan.steps import OUTPUT_MODES
 

@@ -36,7 +36,7 @@ def load(path: str) -> LaunchDescription:
     The application serves the ROS 2 module names (``mlaunch.compat.install()``) before it loads
     anything, so the file's ``from launch... import`` get mlaunch's classes.
     """
-    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch.launch_description import LaunchDescription
 
     try:
         with open(path, "rb") as f:

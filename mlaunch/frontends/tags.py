@@ -25,7 +25,8 @@ from mlaunch.frontends.fields import (
 )
 from mlaunch.frontends.machine_tags import MACHINE_TAGS
 from mlaunch.frontends.process_tags import PROCESS_TAGS
-from mlaunch.launch.conditions import IfCondition, UnlessCondition
+from mlaunch.launch.conditions.if_condition import IfCondition
+from mlaunch.launch.conditions.unless_condition import UnlessCondition
 from mlaunch.plan.errors import MlaunchError
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -145,7 +146,9 @@ def _let(e: Entity) -> Any:
 
 
 def _include(e: Entity) -> Any:
-    from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
+    from mlaunch.launch.launch_description_sources.any_launch_description_source import (
+        AnyLaunchDescriptionSource,
+    )
 
     subs = e.subentities("arg") + e.subentities("let")
     subs.sort(key=lambda s: (s.line, s.col))  # XML keeps document order across arg and let

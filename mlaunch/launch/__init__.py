@@ -12,16 +12,18 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.launch.conditions import Condition
-    from mlaunch.launch.event_handlers import EventHandler
-    from mlaunch.launch.events import Event
+    from mlaunch.launch.action import Action
+    from mlaunch.launch.condition import Condition
+    from mlaunch.launch.event import Event
+    from mlaunch.launch.event_handler import EventHandler
     from mlaunch.launch.invalid_launch_file_error import InvalidLaunchFileError
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
-    from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+    from mlaunch.launch.launch_description import LaunchDescription
+    from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
+    from mlaunch.launch.launch_description_source import LaunchDescriptionSource
     from mlaunch.launch.launch_introspector import LaunchIntrospector
     from mlaunch.launch.some_entities_type import SomeEntitiesType, SomeEntitiesType_types_tuple
-    from mlaunch.launch.substitutions import (
+    from mlaunch.launch.substitution import (
         SomeSubstitutionsType,
         SomeSubstitutionsType_types_tuple,
         Substitution,

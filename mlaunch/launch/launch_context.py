@@ -148,7 +148,7 @@ class LaunchContext:
         self._globals.update(values)
 
     def perform_substitution(self, substitution: Any) -> str:
-        from mlaunch.launch.substitutions import perform
+        from mlaunch.launch.substitution import perform
 
         return perform(self, substitution)
 
@@ -188,7 +188,7 @@ class LaunchContext:
 
     def register_event_handler(self, event_handler: Any, append: bool = False) -> None:
         """Listen with ``event_handler`` from now on (first in line unless ``append``)."""
-        from mlaunch.launch.event_handlers import register_step
+        from mlaunch.launch.event_handler import register_step
 
         if append:
             self._event_handlers.append(event_handler)
@@ -214,7 +214,7 @@ class LaunchContext:
 
         A context that no run plans also holds the event in ``_event_queue``, as upstream's.
         """
-        from mlaunch.launch.actions import emit_event_entities
+        from mlaunch.launch.emission import emit_event_entities
 
         more = emit_event_entities(self, event, "")
         if more:

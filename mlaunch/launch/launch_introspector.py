@@ -27,7 +27,7 @@ def format_substitutions(substitutions: Any) -> str:
 
 def format_entities(entities: Iterable[Any]) -> list[str]:
     """The lines of each entity in turn."""
-    from mlaunch.launch.launch_description import Action
+    from mlaunch.launch.action import Action
 
     lines: list[str] = []
     for entity in entities:
@@ -66,15 +66,18 @@ def _process_line(action: Any) -> str:
 
 def format_action(action: Any) -> list[str]:
     """One action's lines."""
-    from mlaunch.launch import actions
+    from mlaunch.launch.actions.emit_event import EmitEvent
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
+    from mlaunch.launch.actions.log_info import LogInfo
+    from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
 
-    if isinstance(action, actions.LogInfo):
+    if isinstance(action, LogInfo):
         return [f"LogInfo({' + '.join(s.describe() for s in action.msg)})"]
-    if isinstance(action, actions.EmitEvent):
+    if isinstance(action, EmitEvent):
         return [f"EmitEvent(event='{action.event.name}')"]
-    if isinstance(action, actions.ExecuteProcess):
+    if isinstance(action, ExecuteProcess):
         return [_process_line(action)]
-    if isinstance(action, actions.RegisterEventHandler):
+    if isinstance(action, RegisterEventHandler):
         handler = action.event_handler
         return [f"RegisterEventHandler('{handler}'):", *indent(format_event_handler(handler))]
     return [f"Action('{action}')"]

@@ -132,18 +132,9 @@ class StandalonePlanner:
             return built
         locate = getattr(source, "get_launch_file_location", None)
         path = locate(self.context) if locate is not None else None
-        if path is not None and path.endswith(".py"):
-            from mlaunch.launch.launch_description_sources.python_launch_file_utilities import (
-                get_launch_description_from_python_launch_file,
-            )
-
-            return get_launch_description_from_python_launch_file(path)
-        if path is not None:
-            # XML, YAML (or a package's format): launch.frontend finds the implementation.
-            from mlaunch.launch.frontend.parser import Parser
-
-            root, parser = Parser.load(path)
-            return parser.parse_description(root)
+        load = getattr(source, "load_file", None)
+        if path is not None and load is not None:
+            return load(path)
         raise MlaunchError(
             f"{source!r} names no launch file and holds no description", where=origin
         )
@@ -171,7 +162,7 @@ def planner_of(context: object) -> Planner:
 
 def number(context: LaunchContext, value: object, what: str, origin: str) -> float:
     """A finite number from a number or substitutions, or a located error naming ``what``."""
-    from mlaunch.launch.substitutions import perform
+    from mlaunch.launch.substitution import perform
 
     text = value if isinstance(value, (int, float)) else perform(context, value)
     try:

@@ -2,7 +2,7 @@
 
 from collections.abc import Iterable
 
-from mlaunch.launch.launch_description import LaunchDescriptionEntity
+from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
 
 SomeEntitiesType = LaunchDescriptionEntity | Iterable[LaunchDescriptionEntity]
 SomeEntitiesType_types_tuple = (LaunchDescriptionEntity, Iterable)

@@ -32,12 +32,10 @@ class Visit:
 
 def children(entity: object) -> list[tuple[object, bool]]:
     """The entities directly inside ``entity``, each with whether it runs later (deferred)."""
-    from mlaunch.launch.actions import (
-        GroupAction,
-        IncludeLaunchDescription,
-        RegisterEventHandler,
-        TimerAction,
-    )
+    from mlaunch.launch.actions.group_action import GroupAction
+    from mlaunch.launch.actions.include_launch_description import IncludeLaunchDescription
+    from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+    from mlaunch.launch.actions.timer_action import TimerAction
     from mlaunch.launch.launch_description import LaunchDescription
 
     if isinstance(entity, LaunchDescription):
@@ -65,7 +63,7 @@ def walk(
     ``include(entity, conditional)`` gives what an IncludeLaunchDescription brings in (nothing
     when it is not given, or when it returns nothing).
     """
-    from mlaunch.launch.actions import IncludeLaunchDescription
+    from mlaunch.launch.actions.include_launch_description import IncludeLaunchDescription
 
     stack: list[tuple[object, bool, bool]] = [(r, False, False) for r in reversed(list(roots))]
     seen: set[int] = set()

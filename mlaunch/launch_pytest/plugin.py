@@ -20,8 +20,11 @@ from collections.abc import Sequence
 import pytest
 
 from mlaunch.app.launch_service import LaunchService
-from mlaunch.launch.actions import LaunchDescription, RegisterEventHandler
-from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
+from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
+from mlaunch.launch.event_handlers.on_process_io import OnProcessIO
+from mlaunch.launch.event_handlers.on_process_start import OnProcessStart
+from mlaunch.launch.launch_description import LaunchDescription
 from mlaunch.launch_testing.actions import ReadyToTest
 from mlaunch.launch_testing.io_handler import ActiveIoHandler
 from mlaunch.launch_testing.loader import iter_ready_to_test

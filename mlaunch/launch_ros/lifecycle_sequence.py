@@ -11,8 +11,8 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.actions import Action
-from mlaunch.launch.substitutions import SomeSubstitutionsType, normalize, perform_substitutions
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import SomeSubstitutionsType, normalize, perform_substitutions
 from mlaunch.plan.errors import LaunchFileError
 from mlaunch.plan.steps import LIFECYCLE, SEQUENCE_ARGUMENT, Note
 

@@ -20,10 +20,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from mlaunch.launch.substitutions import perform_substitutions
+from mlaunch.launch.substitution import perform_substitutions
 from mlaunch.launch_ros import params
-from mlaunch.launch_ros.actions import make_namespace_absolute, prefix_namespace
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile
+from mlaunch.launch_ros.scope import make_namespace_absolute, prefix_namespace
 from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
 from mlaunch.plan.record import Record
 
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch_ros.composable import ComposableNode
+    from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 
 # rcl_interfaces/msg/ParameterType, in the order rclpy tries them on a value.
 NOT_SET, BOOL, INTEGER, DOUBLE, STRING = 0, 1, 2, 3, 4

@@ -6,7 +6,8 @@
 - ``Parameter(name, value, *, value_type=None)``: a single ``-p name:=value`` on the command line.
 - ``ParameterFile(param_file, *, allow_substs=False)``: a params file; with ``allow_substs`` its
   ``$(...)`` are performed and the result is written to a new file.
-- ``ComposableNode``: the description of a component (in mlaunch.launch_ros.composable).
+- ``ComposableNode``: the description of a component (in
+  mlaunch.launch_ros.descriptions.composable_node).
 
 The typing rules are launch's ``type_utils``: plain values are checked against ``value_type``
 when built; substitutions are performed and coerced when the node is resolved (``int``/``float``
@@ -19,12 +20,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from mlaunch.launch.substitutions import (
-    Substitution,
-    describe,
-    normalize,
-    perform_substitutions,
-)
+from mlaunch.launch.substitution import Substitution, describe, normalize, perform_substitutions
 from mlaunch.plan.errors import (
     LaunchFileError,
     LaunchFileTypeError,
@@ -366,7 +362,8 @@ class ParameterFile:
 
 def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -> str:
     """Perform the ``$(...)`` in a params file and write the result to a new file."""
-    from mlaunch.launch_ros.subst import TemplateError, parse_template
+    from mlaunch.launch.frontend.template import TemplateError
+    from mlaunch.launch_ros.subst import parse_template
 
     try:
         text = path.read_text(encoding="utf-8")

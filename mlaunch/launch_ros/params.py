@@ -27,14 +27,14 @@ import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from mlaunch.launch.substitutions import (
-    LaunchConfiguration,
+from mlaunch.launch.substitution import (
     Substitution,
     TextSubstitution,
     describe,
     normalize,
     perform_substitutions,
 )
+from mlaunch.launch.substitutions.launch_configuration import LaunchConfiguration
 from mlaunch.launch_ros.parameter_descriptions import (
     Parameter,
     ParameterFile,

@@ -32,7 +32,7 @@ import types
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 
-from mlaunch.launch.substitutions import IN_PROCESS_COMMANDS
+from mlaunch.launch.substitutions.command import IN_PROCESS_COMMANDS
 from mlaunch.plan.errors import SubstitutionFailure
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms

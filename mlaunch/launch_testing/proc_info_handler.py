@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import threading
 
-from mlaunch.launch.events import ProcessExited
+from mlaunch.launch.events.process.process_exited import ProcessExited
 from mlaunch.launch_testing.util.proc_lookup import NoMatchingProcessException, resolveProcesses
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms

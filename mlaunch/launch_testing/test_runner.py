@@ -12,8 +12,11 @@ import threading
 import unittest
 
 from mlaunch.app.launch_service import LaunchService
-from mlaunch.launch.actions import LaunchDescription, RegisterEventHandler
-from mlaunch.launch.event_handlers import OnProcessExit, OnProcessIO, OnProcessStart
+from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
+from mlaunch.launch.event_handlers.on_process_io import OnProcessIO
+from mlaunch.launch.event_handlers.on_process_start import OnProcessStart
+from mlaunch.launch.launch_description import LaunchDescription
 from mlaunch.launch_testing.io_handler import ActiveIoHandler
 from mlaunch.launch_testing.parse_arguments import parse_launch_arguments
 from mlaunch.launch_testing.proc_info_handler import ActiveProcInfoHandler

@@ -10,9 +10,10 @@ launch configuration, so a scoped GroupAction keeps it inside.
 
 from __future__ import annotations
 
-from mlaunch.launch.execute_process import PUSHED_MACHINE as PUSHED
-from mlaunch.launch.launch_description import Action
-from mlaunch.launch.substitutions import describe, normalize, perform_substitutions, to_bool
+from mlaunch.launch.action import Action
+from mlaunch.launch.actions.execute_process import PUSHED_MACHINE as PUSHED
+from mlaunch.launch.substitution import describe, normalize, perform_substitutions
+from mlaunch.launch.substitutions.boolean_substitution import to_bool
 from mlaunch.plan.errors import LaunchFileError
 from mlaunch.plan.machine import DEFAULT_TIMEOUT, MachineSpec, check_name, declared, lookup
 
@@ -21,7 +22,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.launch.substitution import SomeSubstitutionsType
 
 
 class Machine(Action):

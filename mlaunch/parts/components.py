@@ -23,9 +23,9 @@ import threading
 from collections.abc import Callable
 
 from mlaunch.engine.part import Part
+from mlaunch.launch_ros.actions.node import same_name_warning
 from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
-from mlaunch.launch_ros.node import same_name_warning
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
 from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Said, ShutdownBegun

@@ -193,7 +193,7 @@ class LifecycleManager(Part):
         elif isinstance(event, ShutdownBegun):
             self._on_shutdown()
         elif isinstance(event, LaunchEvent):
-            from mlaunch.launch_ros.events import ChangeState
+            from mlaunch.launch_ros.events.lifecycle.change_state import ChangeState
 
             if isinstance(event.event, ChangeState):
                 event.taken = True
@@ -365,7 +365,7 @@ class LifecycleManager(Part):
 
     def _transition(self, event: Any) -> None:
         """A ``transition_event`` message: track the state, fire OnStateTransition handlers."""
-        from mlaunch.launch_ros.events import StateTransition
+        from mlaunch.launch_ros.events.lifecycle.state_transition import StateTransition
 
         managed = self.nodes.get(event.node)
         if managed is None:

@@ -56,7 +56,7 @@ def description(
     path: str, args: Mapping[str, str], environ: Mapping[str, str], temp_dir: str
 ) -> Any:
     """The launch description of a native ROS 1 run of ``path``."""
-    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch.launch_description import LaunchDescription
 
     env = dict(environ)
     config = load(path, args, environ=env, core=True)
@@ -154,7 +154,7 @@ def master_process(uri: str, env: dict[str, str]) -> Any:
     """``rosmaster --core -p PORT``, as roslaunch starts it."""
     import shutil
 
-    from mlaunch.launch.actions import ExecuteProcess
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
 
     program = shutil.which("rosmaster", path=env.get("PATH"))
     if program is None:
@@ -191,7 +191,7 @@ def machines(config: Config, path: str) -> list[Any]:
 
 
 def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: Any) -> Any:
-    from mlaunch.launch.actions import ExecuteProcess
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
 
     job = {
         "master_uri": uri,
@@ -214,8 +214,9 @@ def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: An
 def after_loading(loader: Any, processes: list[Any]) -> Any:
     """The nodes start once the parameter server is loaded (roslaunch's order); a failed load
     ends the run."""
-    from mlaunch.launch.actions import RegisterEventHandler, Shutdown
-    from mlaunch.launch.event_handlers import OnProcessExit
+    from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+    from mlaunch.launch.actions.shutdown_action import Shutdown
+    from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
 
     def on_exit(event: Any, context: Any) -> list[Any]:
         if event.returncode != 0:
@@ -230,7 +231,7 @@ def node_process(
 ) -> tuple[Any, str]:
     """The node's process as roslaunch starts it (its ``number``-th), and a warning: why it
     cannot start (in roslaunch's words), or what it runs instead of an old name."""
-    from mlaunch.launch.actions import ExecuteProcess
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
 
     program, note = find_node(node, finder, env)
     if program is None:

@@ -84,8 +84,9 @@ def _walk(obj: Any, uses: _Uses, seen: set[int], depth: int = 0) -> None:
     module = type(obj).__module__
     if not module.startswith("mlaunch.") or isinstance(obj, LaunchContext):
         return
-    from mlaunch.launch.actions import ExecuteProcess
-    from mlaunch.launch.substitutions import EnvironmentVariable, LaunchConfiguration
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
+    from mlaunch.launch.substitutions.environment_variable import EnvironmentVariable
+    from mlaunch.launch.substitutions.launch_configuration import LaunchConfiguration
 
     if isinstance(obj, LaunchConfiguration):
         name = _text(obj.variable_name)

@@ -6,7 +6,7 @@ import os
 import shlex
 from collections.abc import Sequence
 
-from mlaunch.launch.events import ExecutionComplete
+from mlaunch.launch.events.execution_complete import ExecutionComplete
 from mlaunch.plan.steps import (
     AddHandler,
     ArgumentInfo,

@@ -13,7 +13,7 @@ import os
 from mlaunch.frontends.limits import DEPTH_LIMIT, IncludeChain, allow_deep_trees, too_deep
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.planning import number
-from mlaunch.launch.substitutions import perform_substitutions
+from mlaunch.launch.substitution import perform_substitutions
 from mlaunch.plan.errors import (
     LaunchFileError,
     MlaunchError,
@@ -41,7 +41,7 @@ if TYPE_CHECKING:
 
     R = TypeVar("R")
 
-    from mlaunch.launch.launch_description import LaunchDescriptionEntity
+    from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
     from mlaunch.ros.search import PackageSearch, searching
 
 # --check notes at most this many errors of one file (a loop over a broken include stops).
@@ -309,7 +309,7 @@ class Resolver:
 
     def load_source(self, source: object, origin: str) -> object:
         """The LaunchDescription an include names (built directly, or loaded from its file)."""
-        from mlaunch.launch.launch_description_sources import LaunchDescriptionSource
+        from mlaunch.launch.launch_description_source import LaunchDescriptionSource
 
         if not isinstance(source, LaunchDescriptionSource):
             raise LaunchFileError(
@@ -341,7 +341,7 @@ class Resolver:
             if os.access(program, os.X_OK) and not os.path.isdir(program):
                 return argv, None
         else:
-            from mlaunch.launch.execute_process import which
+            from mlaunch.launch.actions.execute_process import which
 
             if which(program, env) is not None:
                 return argv, None
@@ -471,7 +471,7 @@ def resolve_deferred(
         with _package_search(options, context):
             entities = deferred.entities
             if deferred.callback is not None:
-                from mlaunch.launch.event_handlers import returned_entities
+                from mlaunch.launch.event_handler import returned_entities
 
                 entities = returned_entities(resolver.call_user(deferred.callback, event, context))
             resolver.visit_all(entities)
@@ -537,7 +537,7 @@ def collect_arguments(
     Conditional declarations (under a condition, in a timer or handler) are marked; nothing is
     spawned and no command substitution beyond what an include path needs is run.
     """
-    from mlaunch.launch.actions import DeclareLaunchArgument
+    from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
     from mlaunch.launch.walk import walk
 
     found: dict[str, ArgumentInfo] = {}

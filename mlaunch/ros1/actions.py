@@ -11,12 +11,14 @@ import os
 import shlex
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.actions import Action
-from mlaunch.launch.launch_description_sources import AnyLaunchDescriptionSource
-from mlaunch.launch.substitutions import TextSubstitution, normalize, perform_substitutions
+from mlaunch.launch.action import Action
+from mlaunch.launch.launch_description_sources.any_launch_description_source import (
+    AnyLaunchDescriptionSource,
+)
+from mlaunch.launch.substitution import TextSubstitution, normalize, perform_substitutions
 from mlaunch.launch_ros import params
-from mlaunch.launch_ros.actions import SetParameter
-from mlaunch.launch_ros.node import Node
+from mlaunch.launch_ros.actions.node import Node
+from mlaunch.launch_ros.actions.set_parameter import SetParameter
 from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 from mlaunch.plan.errors import MlaunchError
 from mlaunch.ros1 import config
@@ -27,7 +29,7 @@ from mlaunch.ros1.values import convert_value
 
 if TYPE_CHECKING:
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch_ros.node import NodeCommand, NodeNames
+    from mlaunch.launch_ros.actions.node import NodeCommand, NodeNames
 
 
 class RoslaunchSource(AnyLaunchDescriptionSource):

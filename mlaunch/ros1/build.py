@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.actions import SetLaunchConfiguration
+from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
 from mlaunch.launch_ros.parameter_descriptions import ParameterValue
 from mlaunch.ros1.actions import (
     GlobalParameter,
@@ -213,7 +213,8 @@ def _key(value: Value) -> Any:
 def _condition(cond: Cond | None) -> Any:
     if cond is None:
         return None
-    from mlaunch.launch.conditions import IfCondition, UnlessCondition
+    from mlaunch.launch.conditions.if_condition import IfCondition
+    from mlaunch.launch.conditions.unless_condition import UnlessCondition
 
     return (UnlessCondition if cond.unless else IfCondition)(subs(cond.value))
 
@@ -243,11 +244,11 @@ def _substitution(part: Part) -> Any:
     if isinstance(part, ArgRef):
         return core.LaunchConfiguration(part.name)
     if isinstance(part, FindRef):
-        from mlaunch.launch_ros.substitutions import FindPackageShare
+        from mlaunch.launch_ros.substitutions.find_package import FindPackageShare
 
         return FindPackageShare(part.package)
     if isinstance(part, ExecRef):
-        from mlaunch.launch_ros.substitutions import ExecutableInPackage
+        from mlaunch.launch_ros.substitutions.executable_in_package import ExecutableInPackage
 
         return ExecutableInPackage(part.executable, part.package)
     if isinstance(part, EnvRef):

@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterator, Mapping
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.substitutions import Substitution
+from mlaunch.launch.substitution import Substitution
 from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
 from mlaunch.ros1.model import (
     AnonRef,
@@ -189,7 +189,7 @@ class RoslaunchEval(Substitution):
             return os.path.dirname(context.current_launch_file_path or "")
 
         def anon(name: str) -> str:
-            from mlaunch.launch.substitutions import AnonName
+            from mlaunch.launch.substitutions.anon_name import AnonName
 
             return AnonName(name).perform(context)
 

@@ -26,7 +26,7 @@ from mlaunch.ros1.reading import read
 
 def load(path: str) -> Any:
     """The LaunchDescription of the roslaunch XML file at ``path``."""
-    from mlaunch.launch.actions import LaunchDescription
+    from mlaunch.launch.launch_description import LaunchDescription
 
     description = LaunchDescription(description_actions(os.path.abspath(path), read(path)))
     description.origin = f"{os.path.abspath(path)}:1"

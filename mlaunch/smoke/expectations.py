@@ -10,8 +10,8 @@ import re
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from mlaunch.launch.actions import Action
-from mlaunch.launch.substitutions import perform
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import perform
 from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.plan.steps import Note
 

@@ -1,268 +1,115 @@
-"""Actions: the launch description, as the same classes and keywords as ROS 2 ``launch.actions``.
+"""``launch.actions``: the actions of a launch description, as ROS 2's (same classes, keywords and
+module names).
 
 An action is data plus ``execute(context)`` (upstream's contract): it reads the context, hands
 what must happen at run time to ``context.planner`` as plan steps, and may return entities to
-visit next. Nothing here starts a process or prints. The base
-classes live in mlaunch.launch.launch_description and ExecuteProcess in
-mlaunch.launch.execute_process; both are served from here too, under ROS 2's names.
+visit next. Each lives in its own module, named as upstream's (``launch.actions.group_action``
+...); this package only gathers the names, each module loaded when one of its names is first
+asked for (``mlaunch.launch.gathering``). A new action is one new module and one line here.
 """
 
 from __future__ import annotations
 
-import os
-
-from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
-from mlaunch.launch.actions.for_loop import ForEach, ForLoop
-from mlaunch.launch.actions.register_event_handler import (
-    RegisterEventHandler,
-    UnregisterEventHandler,
-)
-from mlaunch.launch.actions.scoping import (
-    GroupAction,
-    IncludeLaunchDescription,
-    PopEnvironment,
-    PopLaunchConfigurations,
-    PushEnvironment,
-    PushLaunchConfigurations,
-    ResetEnvironment,
-    ResetLaunchConfigurations,
-    SetLaunchConfiguration,
-)
-from mlaunch.launch.execute_process import ExecuteLocal, ExecuteProcess
-from mlaunch.launch.launch_description import Action, LaunchDescription, LaunchDescriptionEntity
-from mlaunch.launch.substitutions import (
-    normalize,
-    perform,
-    perform_substitutions,
-    to_bool,
-)
-from mlaunch.plan.errors import LaunchFileError
-from mlaunch.plan.origin import caller_origin
-from mlaunch.plan.steps import EmitEvent as EmitEventStep
-from mlaunch.plan.steps import (
-    Log,
-    RequestShutdown,
-    StartTimer,
-)
+from mlaunch.launch.gathering import Gathered
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable, Iterable
-    from typing import Any
+    from mlaunch.launch.action import Action
+    from mlaunch.launch.actions.append_environment_variable import AppendEnvironmentVariable
+    from mlaunch.launch.actions.declare_launch_argument import DeclareLaunchArgument
+    from mlaunch.launch.actions.emit_event import EmitEvent
+    from mlaunch.launch.actions.execute_local import ExecuteLocal
+    from mlaunch.launch.actions.execute_process import ExecuteProcess
+    from mlaunch.launch.actions.for_loop import ForEach, ForLoop
+    from mlaunch.launch.actions.group_action import GroupAction
+    from mlaunch.launch.actions.include_launch_description import IncludeLaunchDescription
+    from mlaunch.launch.actions.log_info import LogInfo
+    from mlaunch.launch.actions.opaque_coroutine import OpaqueCoroutine
+    from mlaunch.launch.actions.opaque_function import OpaqueFunction
+    from mlaunch.launch.actions.pop_environment import PopEnvironment
+    from mlaunch.launch.actions.pop_launch_configurations import PopLaunchConfigurations
+    from mlaunch.launch.actions.push_environment import PushEnvironment
+    from mlaunch.launch.actions.push_launch_configurations import PushLaunchConfigurations
+    from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+    from mlaunch.launch.actions.reset_environment import ResetEnvironment
+    from mlaunch.launch.actions.reset_launch_configurations import ResetLaunchConfigurations
+    from mlaunch.launch.actions.set_environment_variable import SetEnvironmentVariable
+    from mlaunch.launch.actions.set_launch_configuration import SetLaunchConfiguration
+    from mlaunch.launch.actions.shutdown_action import Shutdown
+    from mlaunch.launch.actions.timer_action import TimerAction
+    from mlaunch.launch.actions.unregister_event_handler import (
+        HandlerNotRegistered as HandlerNotRegistered,
+    )
+    from mlaunch.launch.actions.unregister_event_handler import UnregisterEventHandler
+    from mlaunch.launch.actions.unset_environment_variable import UnsetEnvironmentVariable
+    from mlaunch.launch.actions.unset_launch_configuration import UnsetLaunchConfiguration
+    from mlaunch.launch.launch_description import LaunchDescription
+    from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
 
-    from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch.substitutions import SomeSubstitutionsType
-
-
-# --- arguments and configurations ------------------------------------------------------------
-
-
-class UnsetLaunchConfiguration(Action):
-    def __init__(self, name: SomeSubstitutionsType, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.name = normalize(name)
-
-    def execute(self, context: LaunchContext) -> None:
-        context.launch_configurations.pop(perform_substitutions(context, self.name), None)
-
-
-# --- environment -----------------------------------------------------------------------------
-
-
-class SetEnvironmentVariable(Action):
-    def __init__(self, name: SomeSubstitutionsType, value: SomeSubstitutionsType, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.name = normalize(name)
-        self.value = normalize(value)
-
-    def execute(self, context: LaunchContext) -> None:
-        context.environment[perform_substitutions(context, self.name)] = perform_substitutions(
-            context, self.value
-        )
-
-
-class UnsetEnvironmentVariable(Action):
-    def __init__(self, name: SomeSubstitutionsType, **kwargs: Any):
-        super().__init__(**kwargs)
-        self.name = normalize(name)
-
-    def execute(self, context: LaunchContext) -> None:
-        context.environment.pop(perform_substitutions(context, self.name), None)
-
-
-class AppendEnvironmentVariable(Action):
-    def __init__(
-        self,
-        name: SomeSubstitutionsType,
-        value: SomeSubstitutionsType,
-        prepend: Any = False,
-        separator: SomeSubstitutionsType = os.pathsep,
-        **kwargs: Any,
-    ):
-        super().__init__(**kwargs)
-        self.name = normalize(name)
-        self.value = normalize(value)
-        self.prepend = prepend
-        self.separator = normalize(separator)
-
-    def execute(self, context: LaunchContext) -> None:
-        name = perform_substitutions(context, self.name)
-        value = perform_substitutions(context, self.value)
-        prepend = (
-            self.prepend
-            if isinstance(self.prepend, bool)
-            else to_bool(perform(context, self.prepend), "prepend")
-        )
-        old = context.environment.get(name)
-        sep = perform_substitutions(context, self.separator)
-        if not old:
-            context.environment[name] = value
-        else:
-            context.environment[name] = f"{value}{sep}{old}" if prepend else f"{old}{sep}{value}"
-
-
-# --- structure -------------------------------------------------------------------------------
-
-
-class OpaqueFunction(Action):
-    """Call ``function(context, *args, **kwargs)`` while resolving; visit what it returns."""
-
-    def __init__(
-        self,
-        *,
-        function: Callable[..., Any],
-        args: Iterable[Any] | None = None,
-        kwargs: dict[str, Any] | None = None,
-        **action_kwargs: Any,
-    ) -> None:
-        super().__init__(**action_kwargs)
-        self.function = function
-        self.args = list(args or [])
-        self.kwargs = dict(kwargs or {})
-
-    def execute(self, context: LaunchContext) -> list[Any] | None:
-        planner = context.planner
-        result = planner.call_user(self.function, context, *self.args, **self.kwargs)
-        return list(result) if result else None
-
-    def describe_short(self) -> str:
-        return f"OpaqueFunction({getattr(self.function, '__qualname__', self.function)!r})"
-
-
-class OpaqueCoroutine(OpaqueFunction):
-    """Not supported: mlaunch does not run an asyncio loop for launch files."""
-
-    def __init__(self, *, coroutine: Callable[..., Any], **kwargs: Any) -> None:
-        raise LaunchFileError(
-            "OpaqueCoroutine is not supported by mlaunch (no asyncio loop runs launch code);"
-            " use an OpaqueFunction or a TimerAction",
-            where=caller_origin(),
-        )
-
-
-class TimerAction(Action):
-    """Resolve and run ``actions`` after ``period`` seconds (cancelled on shutdown by default)."""
-
-    completes_later = True  # ExecutionComplete when it fires (the engine's timer)
-
-    def __init__(
-        self,
-        *,
-        period: float | SomeSubstitutionsType,
-        actions: Iterable[Any],
-        cancel_on_shutdown: Any = True,
-        **kwargs: Any,
-    ) -> None:
-        super().__init__(**kwargs)
-        self.period = period
-        self.actions = list(actions)
-        self.cancel_on_shutdown = cancel_on_shutdown
-
-    def get_sub_entities(self) -> list[Any]:
-        return list(self.actions)
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        period = planner.float_value(self.period, "TimerAction period", self.origin)
-        cancel = self.cancel_on_shutdown
-        if not isinstance(cancel, bool):
-            cancel = to_bool(perform(context, cancel), "cancel_on_shutdown")
-        planner.add(
-            StartTimer(
-                origin=self.origin,
-                period=period,
-                body=planner.defer(self.actions, self.origin),
-                cancel_on_shutdown=cancel,
-                action=self,
-                ros_time=self._ros_time(context),
-            )
-        )
-
-    def _ros_time(self, context: LaunchContext) -> dict[str, Any] | None:
-        """Where the run records whether the period is simulated ROS time (StartTimer's
-        ``ros_time``); None: wall-clock time, as launch's TimerAction counts it."""
-        return None
-
-    def describe_short(self) -> str:
-        return f"TimerAction(period={self.period!r})"
-
-
-# --- events ----------------------------------------------------------------------------------
-
-
-class EmitEvent(Action):
-    def __init__(self, *, event: Any, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.event = event
-
-    def execute(self, context: LaunchContext) -> list[Any] | None:
-        return emit_event_entities(context, self.event, self.origin)
-
-
-def emit_event_entities(context: LaunchContext, event: Any, origin: str) -> list[Any] | None:
-    """Plan the emission of ``event``; the entities to visit now for an include event."""
-    from mlaunch.launch.events import IncludeLaunchDescription
-    from mlaunch.launch.events import Shutdown as ShutdownEvent
-
-    step: RequestShutdown | EmitEventStep | None = None
-    if isinstance(event, ShutdownEvent):
-        sigint = bool(event.due_to_sigint)
-        step = RequestShutdown(
-            origin=origin,
-            reason=event.reason,
-            due_to_sigint=sigint,
-            send_sigint=not sigint or context.noninteractive,
-        )
-    elif not isinstance(event, IncludeLaunchDescription):
-        step = EmitEventStep(origin=origin, event=event)
-    context.planner.emit(event, step)
-    # An included description is planned here and now, where the event was given.
-    return [event.launch_description] if step is None else None
-
-
-class Shutdown(Action):
-    """Shut the launch down (what ``on_exit=Shutdown()`` uses to make a process required)."""
-
-    def __init__(self, *, reason: SomeSubstitutionsType = "reason not given", **kwargs: Any):
-        super().__init__(**kwargs)
-        self.reason = normalize(reason)
-
-    def execute(self, context: LaunchContext) -> None:
-        from mlaunch.launch.events import Shutdown as ShutdownEvent
-
-        reason = perform_substitutions(context, self.reason)
-        emit_event_entities(context, ShutdownEvent(reason=reason), self.origin)
-
-
-class LogInfo(Action):
-    def __init__(self, *, msg: SomeSubstitutionsType, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.msg = normalize(msg)
-
-    def execute(self, context: LaunchContext) -> None:
-        planner = context.planner
-        planner.add(Log(origin=self.origin, message=perform_substitutions(context, self.msg)))
-
+_gathered = Gathered(
+    globals(),
+    {
+        "ForEach": ".for_loop",
+        "ForLoop": ".for_loop",
+        "Action": "mlaunch.launch.action",
+        "AppendEnvironmentVariable": ".append_environment_variable",
+        "DeclareLaunchArgument": ".declare_launch_argument",
+        "EmitEvent": ".emit_event",
+        "ExecuteLocal": ".execute_local",
+        "ExecuteProcess": ".execute_process",
+        "GroupAction": ".group_action",
+        "HandlerNotRegistered": ".unregister_event_handler",
+        "IncludeLaunchDescription": ".include_launch_description",
+        "LaunchDescription": "mlaunch.launch.launch_description",
+        "LaunchDescriptionEntity": "mlaunch.launch.launch_description_entity",
+        "LogInfo": ".log_info",
+        "OpaqueCoroutine": ".opaque_coroutine",
+        "OpaqueFunction": ".opaque_function",
+        "PopEnvironment": ".pop_environment",
+        "PopLaunchConfigurations": ".pop_launch_configurations",
+        "PushEnvironment": ".push_environment",
+        "PushLaunchConfigurations": ".push_launch_configurations",
+        "RegisterEventHandler": ".register_event_handler",
+        "ResetEnvironment": ".reset_environment",
+        "ResetLaunchConfigurations": ".reset_launch_configurations",
+        "SetEnvironmentVariable": ".set_environment_variable",
+        "SetLaunchConfiguration": ".set_launch_configuration",
+        "Shutdown": ".shutdown_action",
+        "TimerAction": ".timer_action",
+        "UnregisterEventHandler": ".unregister_event_handler",
+        "UnsetEnvironmentVariable": ".unset_environment_variable",
+        "UnsetLaunchConfiguration": ".unset_launch_configuration",
+    },
+    submodules=(
+        "for_loop",
+        "append_environment_variable",
+        "declare_launch_argument",
+        "emit_event",
+        "execute_local",
+        "execute_process",
+        "group_action",
+        "include_launch_description",
+        "log_info",
+        "opaque_coroutine",
+        "opaque_function",
+        "pop_environment",
+        "pop_launch_configurations",
+        "push_environment",
+        "push_launch_configurations",
+        "register_event_handler",
+        "reset_environment",
+        "reset_launch_configurations",
+        "set_environment_variable",
+        "set_launch_configuration",
+        "shutdown_action",
+        "timer_action",
+        "unregister_event_handler",
+        "unset_environment_variable",
+        "unset_launch_configuration",
+    ),
+)
+__getattr__ = _gathered.attribute
+__dir__ = _gathered.listing
 
 __all__ = [
     "Action",
@@ -274,6 +121,7 @@ __all__ = [
     "ForEach",
     "ForLoop",
     "GroupAction",
+    "HandlerNotRegistered",
     "IncludeLaunchDescription",
     "LaunchDescription",
     "LaunchDescriptionEntity",

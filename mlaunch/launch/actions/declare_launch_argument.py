@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from mlaunch.launch.launch_description import Action
-from mlaunch.launch.substitutions import TextSubstitution, normalize, perform_substitutions
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import TextSubstitution, normalize, perform_substitutions
 from mlaunch.plan.errors import LaunchArgumentError
 from mlaunch.plan.steps import ArgumentInfo
 
@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.launch.substitution import SomeSubstitutionsType
 
 
 class DeclareLaunchArgument(Action):

@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import copy
 
-from mlaunch.launch.launch_description import Action
-from mlaunch.launch.substitutions import normalize, perform_substitutions
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import normalize, perform_substitutions
 from mlaunch.plan.errors import LaunchFileError
 from mlaunch.plan.steps import Log
 
@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.launch.substitutions import SomeSubstitutionsType
+    from mlaunch.launch.substitution import SomeSubstitutionsType
 
 
 class ForEach(Action):
@@ -76,7 +76,7 @@ class ForEach(Action):
     def iteration_entities(cls, children: list[Any], values: Mapping[str, Any]) -> list[Any]:
         """One iteration of a frontend's loop: a copy of ``children`` that sees ``values``
         through $(for-var) and $(index), in locals of its own."""
-        from mlaunch.launch.actions import OpaqueFunction
+        from mlaunch.launch.actions.opaque_function import OpaqueFunction
         from mlaunch.launch.substitutions.for_loop_var import ForEachVar
 
         local = {ForEachVar.get_local_arg_name(k): str(v) for k, v in values.items()}

@@ -1,5 +1,4 @@
-"""``launch.actions.register_event_handler``: listen with an event handler from here on, and
-UnregisterEventHandler (``launch.actions.unregister_event_handler`` re-exports it): stop.
+"""``launch.actions.register_event_handler``: listen with an event handler from here on.
 
 Any handler registers: one of the kinds the engine dispatches itself (process start, exit,
 output, shutdown, completion, a transition) or any other, whose ``matches(event)`` then decides
@@ -8,10 +7,9 @@ output, shutdown, completion, a transition) or any other, whose ``matches(event)
 
 from __future__ import annotations
 
-from mlaunch.launch.event_handlers import register_step
-from mlaunch.launch.launch_description import Action
+from mlaunch.launch.action import Action
+from mlaunch.launch.event_handler import register_step
 from mlaunch.plan.errors import LaunchFileError
-from mlaunch.plan.steps import RemoveHandler
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -19,6 +17,7 @@ if TYPE_CHECKING:
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
+
 
 # The handlers registered in a run (shared by every context of the run, as its state is):
 # what UnregisterEventHandler may unregister, wherever its context was copied.
@@ -54,35 +53,4 @@ class RegisterEventHandler(Action):
         return [(text, list(entities))] if entities else []
 
 
-class HandlerNotRegistered(LaunchFileError, ValueError):
-    """Unregistering a handler that is not registered (a ValueError, as launch raises)."""
-
-
-class UnregisterEventHandler(Action):
-    """Unregister ``event_handler``; an error when it is not registered (as launch's)."""
-
-    def __init__(self, event_handler: Any, **kwargs: Any) -> None:
-        super().__init__(**kwargs)
-        self.event_handler = event_handler
-
-    def execute(self, context: LaunchContext) -> None:
-        handler = self.event_handler
-        here = handler in context._event_handlers
-        run = context.run_state.get(REGISTERED, [])
-        # A handler of the run counts even where this context is a copy made before it was
-        # registered (a timer's body that takes its values where written).
-        in_run = any(h is handler for h in run)
-        if not here and not in_run:
-            raise HandlerNotRegistered(
-                f"UnregisterEventHandler: {type(handler).__name__} is not registered"
-                " (never registered, or unregistered already)",
-                where=self.origin,
-            )
-        if here:
-            context._event_handlers.remove(handler)
-        if in_run:
-            run[:] = [h for h in run if h is not handler]
-        context.planner.add(RemoveHandler(origin=self.origin, handler=handler))
-
-
-__all__ = ["REGISTERED", "HandlerNotRegistered", "RegisterEventHandler", "UnregisterEventHandler"]
+__all__ = ["REGISTERED", "RegisterEventHandler"]

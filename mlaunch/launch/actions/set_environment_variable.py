@@ -1,5 +1,25 @@
-"""``launch.actions.set_environment_variable``, where upstream defines it."""
+"""``launch.actions.set_environment_variable``: set an environment variable for what follows."""
 
-from mlaunch.launch.actions import SetEnvironmentVariable
+from __future__ import annotations
 
-__all__ = ["SetEnvironmentVariable"]
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import normalize, perform_substitutions
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.substitution import SomeSubstitutionsType
+
+
+class SetEnvironmentVariable(Action):
+    def __init__(self, name: SomeSubstitutionsType, value: SomeSubstitutionsType, **kwargs: Any):
+        super().__init__(**kwargs)
+        self.name = normalize(name)
+        self.value = normalize(value)
+
+    def execute(self, context: LaunchContext) -> None:
+        context.environment[perform_substitutions(context, self.name)] = perform_substitutions(
+            context, self.value
+        )

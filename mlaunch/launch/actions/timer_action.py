@@ -1,5 +1,65 @@
-"""``launch.actions.timer_action``, where upstream defines it."""
+"""``launch.actions.timer_action``: resolve and run actions after a period."""
 
-from mlaunch.launch.actions import TimerAction
+from __future__ import annotations
 
-__all__ = ["TimerAction"]
+from mlaunch.launch.action import Action
+from mlaunch.launch.substitution import perform
+from mlaunch.launch.substitutions.boolean_substitution import to_bool
+from mlaunch.plan.steps import (
+    StartTimer,
+)
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+    from typing import Any
+
+    from mlaunch.launch.launch_context import LaunchContext
+    from mlaunch.launch.substitution import SomeSubstitutionsType
+
+
+class TimerAction(Action):
+    """Resolve and run ``actions`` after ``period`` seconds (cancelled on shutdown by default)."""
+
+    completes_later = True  # ExecutionComplete when it fires (the engine's timer)
+
+    def __init__(
+        self,
+        *,
+        period: float | SomeSubstitutionsType,
+        actions: Iterable[Any],
+        cancel_on_shutdown: Any = True,
+        **kwargs: Any,
+    ) -> None:
+        super().__init__(**kwargs)
+        self.period = period
+        self.actions = list(actions)
+        self.cancel_on_shutdown = cancel_on_shutdown
+
+    def get_sub_entities(self) -> list[Any]:
+        return list(self.actions)
+
+    def execute(self, context: LaunchContext) -> None:
+        planner = context.planner
+        period = planner.float_value(self.period, "TimerAction period", self.origin)
+        cancel = self.cancel_on_shutdown
+        if not isinstance(cancel, bool):
+            cancel = to_bool(perform(context, cancel), "cancel_on_shutdown")
+        planner.add(
+            StartTimer(
+                origin=self.origin,
+                period=period,
+                body=planner.defer(self.actions, self.origin),
+                cancel_on_shutdown=cancel,
+                action=self,
+                ros_time=self._ros_time(context),
+            )
+        )
+
+    def _ros_time(self, context: LaunchContext) -> dict[str, Any] | None:
+        """Where the run records whether the period is simulated ROS time (StartTimer's
+        ``ros_time``); None: wall-clock time, as launch's TimerAction counts it."""
+        return None
+
+    def describe_short(self) -> str:
+        return f"TimerAction(period={self.period!r})"

@@ -43,7 +43,7 @@ class Executable:
         additional_env: Mapping[Any, Any] | None = None,
         arguments: Iterable[Any] | None = None,
     ) -> None:
-        from mlaunch.launch.substitutions import LaunchConfiguration
+        from mlaunch.launch.substitutions.launch_configuration import LaunchConfiguration
 
         if isinstance(cmd, str):
             cmd = [cmd]

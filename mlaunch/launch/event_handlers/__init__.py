@@ -1,337 +1,61 @@
-"""Event handlers: what to resolve when a process starts, exits, prints, or the launch shuts down.
+"""``launch.event_handlers``: what to visit when a process starts, exits, prints, an action
+completes or the launch shuts down.
 
-Handlers are data. RegisterEventHandler turns one into an AddHandler step of the plan; the
-supervisor fires it and resolves its entities with the context captured at registration.
+Each handler lives in its own module, named as upstream's; the base class, and how a handler
+becomes a step of the plan, is ``launch.event_handler``. This package only gathers the names
+(``mlaunch.launch.gathering``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-
-from mlaunch.plan.origin import caller_origin
-from mlaunch.plan.steps import AddHandler
+from mlaunch.launch.gathering import Gathered
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Callable
-    from typing import Any
-
-
-def _as_entities(value: Any) -> tuple[list[Any], Callable[..., Any] | None]:
-    """Split ``on_*`` into entities or a callable(event, context) -> entities (a callable
-    first, as launch: no launch entity is callable)."""
-    if value is None:
-        return [], None
-    if callable(value) and not isinstance(value, type):
-        return [], value
-    if isinstance(value, Iterable) and not isinstance(value, (str, bytes)):
-        return list(value), None
-    return [value], None
-
-
-def check_entities(entities: list[Any], handler: str) -> None:
-    """launch's TypeError for an ``on_*`` list holding something that is not an entity."""
-    from mlaunch.launch.launch_description import LaunchDescriptionEntity
-
-    for entity in entities:
-        if not isinstance(entity, LaunchDescriptionEntity):
-            raise TypeError(
-                f"{handler}: expected all items in the handler's entities to be launch entities"
-                f" (actions, descriptions), got {type(entity).__name__}: {entity!r:.60}"
-            )
-
-
-def _is_predicate(target: Any) -> bool:
-    """A target given as a function of the action: launch tries this before identity."""
-    return callable(target)
-
-
-def check_target(target: Any, handler: str, target_class: type, what: str) -> None:
-    """launch's TypeError for a target that is neither ``target_class``, a callable nor None."""
-    if target is None or callable(target) or isinstance(target, target_class):
-        return
-    raise TypeError(
-        f"{handler}: target_action must be {what} or a callable, got"
-        f" {type(target).__name__}: {target!r:.60}"
+    from mlaunch.launch.event_handler import (
+        MATCHER_KIND,
+        BaseEventHandler,
+        EventHandler,
+        returned_entities,
     )
-
-
-def _process_target(target: Any, handler: str) -> None:
-    from mlaunch.launch.execute_process import ExecuteProcess
-
-    check_target(target, handler, ExecuteProcess, "an ExecuteProcess (or Node) action")
-
-
-def returned_entities(result: Any) -> list[Any]:
-    """What a handler callable returned, as launch accepts it: None, one entity, or an iterable
-    of entities (Nones in it skipped)."""
-    if result is None:
-        return []
-    if isinstance(result, Iterable) and not isinstance(result, (str, bytes)):
-        return [entity for entity in result if entity is not None]
-    return [result]
-
-
-class EventHandler:
-    """Base handler: ``kind`` names the event, ``target_action`` narrows it to one action."""
-
-    kind = ""
-
-    def __init__(
-        self,
-        *,
-        target_action: Any = None,
-        entities: Any = None,
-        handle_once: bool = False,
-        matcher: Callable[[Any], bool] | None = None,
-    ) -> None:
-        self.target_action = target_action
-        self.entities, self.callback = _as_entities(entities)
-        self.handle_once = handle_once
-        self.custom_matcher = matcher
-        self.origin = caller_origin()
-
-    def process_matcher(self) -> Callable[[Any], bool] | None:
-        """A predicate over ProcessSpec; None matches every process."""
-        target = self.target_action
-        if target is None:
-            return self.custom_matcher
-        if _is_predicate(target):
-            return lambda spec: bool(target(spec.action))
-        return lambda spec: spec.action is target
-
-    def describe_short(self) -> str:
-        return type(self).__name__
-
-    # --- upstream's handler API (launch.event_handler), for code that calls handlers itself --
-
-    def event_type(self) -> type | None:
-        """The event class this handler's kind listens for (None: only its matcher decides)."""
-        return None
-
-    def matches(self, event: Any) -> bool:
-        """Whether this handler handles ``event``: its matcher, or its kind and target."""
-        if self.custom_matcher is not None:
-            return bool(self.custom_matcher(event))
-        event_type = self.event_type()
-        if event_type is None or not isinstance(event, event_type):
-            return False
-        target = self.target_action
-        if target is None:
-            return True
-        action = getattr(event, "action", None)
-        if _is_predicate(target):
-            return bool(target(action))
-        return action is target
-
-    def handle(self, event: Any, context: Any) -> list[Any] | None:
-        """``event`` becomes ``context.locals.event``; the entities to visit for it."""
-        self._begin_handling(event, context)
-        if self.callback is not None:
-            return returned_entities(self.callback(event, context))
-        return list(self.entities)
-
-    def _begin_handling(self, event: Any, context: Any) -> None:
-        context.extend_locals({"event": event})
-        if self.handle_once:
-            context.unregister_event_handler(self)
-
-    @property
-    def handler_description(self) -> str | None:
-        return None
-
-    @property
-    def matcher_description(self) -> str | None:
-        return None
-
-    def describe(self) -> tuple[str, list[Any]]:
-        """launch's description: a line about the handler, then its entities."""
-        text = (
-            f"{type(self).__name__}(matcher='{self.matcher_description}',"
-            f" handler='{self.handler_description}', handle_once={self.handle_once})"
-        )
-        return text, list(self.entities)
-
-
-# The kind of a handler the engine does not dispatch by itself: its ``matches(event)`` decides
-# for each event of the run, as every handler of launch's does (the general path).
-MATCHER_KIND = "matcher"
-
-
-def handler_step(handler: Any, planner: Any, origin: str) -> AddHandler | None:
-    """The plan step that registers ``handler``; None for an object that is no event handler
-    (no kind mlaunch dispatches, and no ``matches(event)``)."""
-    kind = getattr(handler, "kind", "")
-    if not kind:
-        if not callable(getattr(handler, "matches", None)):
-            return None
-        kind = MATCHER_KIND
-    entities, callback = getattr(handler, "entities", []), getattr(handler, "callback", None)
-    matcher = handler.process_matcher() if hasattr(handler, "process_matcher") else None
-    if kind == MATCHER_KIND:
-        matcher = None  # its matches(event) decides, event by event
-        if getattr(type(handler), "handle", EventHandler.handle) is not EventHandler.handle:
-            entities, callback = [], handler.handle  # a handler of its own: its handle() says
-    return AddHandler(
-        origin=origin,
-        kind=kind,
-        matcher=matcher,
-        body=planner.defer(entities, origin, callback=callback),
-        io_callbacks=dict(getattr(handler, "io_callbacks", {})),
-        once=bool(getattr(handler, "handle_once", False)),
-        handler=handler,
+    from mlaunch.launch.event_handlers.on_action_event_base import OnActionEventBase
+    from mlaunch.launch.event_handlers.on_execution_complete import OnExecutionComplete
+    from mlaunch.launch.event_handlers.on_include_launch_description import (
+        OnIncludeLaunchDescription,
     )
+    from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
+    from mlaunch.launch.event_handlers.on_process_io import OnProcessIO
+    from mlaunch.launch.event_handlers.on_process_start import OnProcessStart
+    from mlaunch.launch.event_handlers.on_shutdown import OnShutdown
 
-
-def register_step(context: Any, handler: Any, origin: str) -> AddHandler | None:
-    """``handler_step`` for a handler registered with ``context``; the run notes from then on
-    that actions' completions may be awaited (ExecutionComplete)."""
-    step = handler_step(handler, context.planner, origin)
-    if step is not None and step.kind in ("execution_complete", MATCHER_KIND):
-        from mlaunch.launch.launch_description import COMPLETION_HANDLERS
-
-        context.run_state[COMPLETION_HANDLERS] = True
-    return step
-
-
-def event_named(name: str) -> Callable[[Any], bool]:
-    """A matcher of the events called ``name``."""
-    return lambda event: getattr(event, "name", None) == name
-
-
-class OnProcessStart(EventHandler):
-    kind = "process_start"
-
-    def event_type(self) -> type:
-        from mlaunch.launch import events
-
-        return events.ProcessStarted
-
-    def __init__(self, *, target_action: Any = None, on_start: Any, handle_once: bool = False):
-        _process_target(target_action, "OnProcessStart")
-        super().__init__(target_action=target_action, entities=on_start, handle_once=handle_once)
-        check_entities(self.entities, "OnProcessStart")
-
-
-class OnProcessExit(EventHandler):
-    kind = "process_exit"
-
-    def event_type(self) -> type:
-        from mlaunch.launch import events
-
-        return events.ProcessExited
-
-    def __init__(self, *, target_action: Any = None, on_exit: Any, handle_once: bool = False):
-        _process_target(target_action, "OnProcessExit")
-        super().__init__(target_action=target_action, entities=on_exit, handle_once=handle_once)
-        check_entities(self.entities, "OnProcessExit")
-
-
-class OnProcessIO(EventHandler):
-    """Callables receive the ProcessIO event (bytes in ``event.text``), as in ROS 2."""
-
-    kind = "process_io"
-
-    def event_type(self) -> type:
-        from mlaunch.launch import events
-
-        return events.ProcessIO
-
-    def __init__(
-        self,
-        *,
-        target_action: Any = None,
-        on_stdin: Callable[[Any], Any] | None = None,
-        on_stdout: Callable[[Any], Any] | None = None,
-        on_stderr: Callable[[Any], Any] | None = None,
-        handle_once: bool = False,
-    ) -> None:
-        _process_target(target_action, "OnProcessIO")
-        super().__init__(target_action=target_action, handle_once=handle_once)
-        self.io_callbacks = {
-            k: v for k, v in (("stdout", on_stdout), ("stderr", on_stderr)) if v is not None
-        }
-        self.on_stdin = on_stdin
-
-    def handle(self, event: Any, context: Any) -> list[Any] | None:
-        """The callback of the event's stream (stdin, stdout, stderr), given the event."""
-        self._begin_handling(event, context)
-        streams: dict[Any, Callable[[Any], Any] | None] = {
-            0: self.on_stdin,
-            1: self.io_callbacks.get("stdout"),
-            2: self.io_callbacks.get("stderr"),
-        }
-        callback = streams.get(getattr(event, "fd", None))
-        return None if callback is None else returned_entities(callback(event))
-
-
-class OnShutdown(EventHandler):
-    kind = "shutdown"
-
-    def event_type(self) -> type:
-        from mlaunch.launch import events
-
-        return events.Shutdown
-
-    def __init__(self, *, on_shutdown: Any, handle_once: bool = False) -> None:
-        super().__init__(entities=on_shutdown, handle_once=handle_once)
-        self.on_shutdown = on_shutdown
-
-    def handle(self, event: Any, context: Any) -> Any:
-        """What ``on_shutdown`` gives: its entities as given, or the callable's result."""
-        self._begin_handling(event, context)
-        if self.callback is not None:
-            return self.callback(event, context)
-        return self.on_shutdown
-
-
-class OnExecutionComplete(EventHandler):
-    """Fires when the target action completes: a process when it exits for good, a timer when
-    it has fired; only for targets visited after the handler was registered (as in launch)."""
-
-    kind = "execution_complete"
-
-    def event_type(self) -> type:
-        from mlaunch.launch import events
-
-        return events.ExecutionComplete
-
-    def __init__(
-        self, *, target_action: Any = None, on_completion: Any, handle_once: bool = False
-    ) -> None:
-        from mlaunch.launch.launch_description import Action
-
-        check_target(target_action, "OnExecutionComplete", Action, "an action")
-        super().__init__(
-            target_action=target_action, entities=on_completion, handle_once=handle_once
-        )
-        check_entities(self.entities, "OnExecutionComplete")
-
-
-class OnIncludeLaunchDescription(EventHandler):
-    """Visits the description an IncludeLaunchDescription event carries."""
-
-    def __init__(self, **kwargs: Any) -> None:
-        from mlaunch.launch import events
-
-        super().__init__(
-            matcher=lambda event: isinstance(event, events.IncludeLaunchDescription),
-            entities=lambda event, context: [event.launch_description],
-            **kwargs,
-        )
-
-    @property
-    def handler_description(self) -> str:
-        return "returns the launch_description in the event"
-
-    @property
-    def matcher_description(self) -> str:
-        return "event issubclass of launch.events.IncludeLaunchDescription"
-
-
-# launch's base classes, by the names extensions import.
-BaseEventHandler = EventHandler
-OnActionEventBase = EventHandler
+_gathered = Gathered(
+    globals(),
+    {
+        "BaseEventHandler": "mlaunch.launch.event_handler",
+        "EventHandler": "mlaunch.launch.event_handler",
+        "MATCHER_KIND": "mlaunch.launch.event_handler",
+        "OnActionEventBase": ".on_action_event_base",
+        "OnExecutionComplete": ".on_execution_complete",
+        "OnIncludeLaunchDescription": ".on_include_launch_description",
+        "OnProcessExit": ".on_process_exit",
+        "OnProcessIO": ".on_process_io",
+        "OnProcessStart": ".on_process_start",
+        "OnShutdown": ".on_shutdown",
+        "returned_entities": "mlaunch.launch.event_handler",
+    },
+    submodules=(
+        "event_named",
+        "on_action_event_base",
+        "on_execution_complete",
+        "on_include_launch_description",
+        "on_process_exit",
+        "on_process_io",
+        "on_process_start",
+        "on_shutdown",
+    ),
+)
+__getattr__ = _gathered.attribute
+__dir__ = _gathered.listing
 
 __all__ = [
     "MATCHER_KIND",

@@ -1,5 +1,9 @@
-"""``launch.event_handlers.on_action_event_base``, where upstream defines it."""
+"""``launch.event_handlers.on_action_event_base``: the base of the handlers of one action's
+events (mlaunch's EventHandler, which takes a target action).
+"""
 
-from mlaunch.launch.event_handlers import OnActionEventBase
+from __future__ import annotations
 
-__all__ = ["OnActionEventBase"]
+from mlaunch.launch.event_handler import EventHandler
+
+OnActionEventBase = EventHandler

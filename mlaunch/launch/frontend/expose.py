@@ -17,9 +17,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable, Iterable
     from typing import Any
 
+    from mlaunch.launch.action import Action
     from mlaunch.launch.frontend.entity import Entity
     from mlaunch.launch.frontend.parser import Parser
-    from mlaunch.launch.launch_description import Action
     from mlaunch.launch.substitution import Substitution
 
 action_parse_methods: dict[str, Any] = {}

@@ -29,7 +29,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import Any, TextIO
 
-    from mlaunch.launch.launch_description import Action, LaunchDescription
+    from mlaunch.launch.action import Action
+    from mlaunch.launch.launch_description import LaunchDescription
     from mlaunch.launch.substitution import Substitution
 
 PARSER_GROUPS = ("launch.frontend.parser", "mlaunch.frontend.parser")

@@ -30,8 +30,7 @@ from collections.abc import Callable
 from functools import partial
 
 import mlaunch.launch.substitutions as core
-from mlaunch.launch.substitution import SUBSTITUTION_DEPTH_LIMIT
-from mlaunch.launch.substitutions import Substitution
+from mlaunch.launch.substitution import SUBSTITUTION_DEPTH_LIMIT, Substitution
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

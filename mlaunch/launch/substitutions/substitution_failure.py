@@ -1,5 +1,5 @@
 """``launch.substitutions.substitution_failure``, where upstream defines it."""
 
-from mlaunch.launch.substitutions import SubstitutionFailure
+from mlaunch.plan.errors import SubstitutionFailure
 
 __all__ = ["SubstitutionFailure"]

@@ -1,5 +1,5 @@
 """``launch.substitutions.text_substitution``, where upstream defines it."""
 
-from mlaunch.launch.substitutions import TextSubstitution
+from mlaunch.launch.substitution import TextSubstitution
 
 __all__ = ["TextSubstitution"]

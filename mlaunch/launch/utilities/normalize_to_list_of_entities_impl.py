@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from mlaunch.launch.launch_description import LaunchDescriptionEntity
+from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
 
 
 def normalize_to_list_of_entities(entities: Iterable[Any]) -> list[LaunchDescriptionEntity]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import asyncio
 
-from mlaunch.launch.events import ProcessExited
+from mlaunch.launch.events.process.process_exited import ProcessExited
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

@@ -11,11 +11,17 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
-from mlaunch.launch.actions import EmitEvent, RegisterEventHandler, UnregisterEventHandler
-from mlaunch.launch.launch_description import Action
+from mlaunch.launch.action import Action
+from mlaunch.launch.actions.emit_event import EmitEvent
+from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+from mlaunch.launch.actions.unregister_event_handler import UnregisterEventHandler
 from mlaunch.launch.substitution import normalize, perform_substitutions
-from mlaunch.launch_ros.events import ChangeState, OnStateTransition, StateTransition
-from mlaunch.launch_ros.events import matches_node_name as _matches_node_name
+from mlaunch.launch_ros.event_handlers.on_state_transition import OnStateTransition
+from mlaunch.launch_ros.events.lifecycle.change_state import ChangeState
+from mlaunch.launch_ros.events.lifecycle.state_transition import StateTransition
+from mlaunch.launch_ros.events.matchers.matches_node_name import (
+    matches_node_name as _matches_node_name,
+)
 
 # lifecycle_msgs Transition id -> the states a node passes through and reaches.
 TRANSITION_TARGETS: dict[int, dict[str, str]] = {

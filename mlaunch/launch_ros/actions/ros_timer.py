@@ -13,9 +13,9 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from mlaunch.launch.actions import TimerAction
+from mlaunch.launch.actions.timer_action import TimerAction
 from mlaunch.launch.substitution import SomeSubstitutionsType_types_tuple
-from mlaunch.launch.utilities import ensure_argument_type
+from mlaunch.launch.utilities.ensure_argument_type_impl import ensure_argument_type
 
 
 class ROSTimer(TimerAction):

@@ -1,30 +1,30 @@
-"""``launch_ros.descriptions``: what a launch file describes a node's parts with.
+"""``launch_ros.descriptions``: what a launch file describes for launch_ros to use: parameters,
+params files and parameter values (``launch_ros.parameter_descriptions``), and composable
+nodes.
 
-The parameter types live in ``parameter_descriptions``; ``ComposableNode`` lives with the
-composition code and loads only when a file names it, so a launch without composable nodes does
-not pay for it.
+This package only gathers the names (``mlaunch.launch.gathering``).
 """
 
 from __future__ import annotations
 
-from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
+from mlaunch.launch.gathering import Gathered
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.launch_ros.composable import ComposableNode
+    from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
+    from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile, ParameterValue
 
+_gathered = Gathered(
+    globals(),
+    {
+        "ComposableNode": ".composable_node",
+        "Parameter": "mlaunch.launch_ros.parameter_descriptions",
+        "ParameterFile": "mlaunch.launch_ros.parameter_descriptions",
+        "ParameterValue": "mlaunch.launch_ros.parameter_descriptions",
+    },
+    submodules=("composable_node",),
+)
+__getattr__ = _gathered.attribute
+__dir__ = _gathered.listing
 
-def __getattr__(name: str) -> type[ComposableNode]:
-    if name == "ComposableNode":
-        from mlaunch.launch_ros.composable import ComposableNode
-
-        return ComposableNode
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-__all__ = [
-    "ComposableNode",
-    "Parameter",
-    "ParameterFile",
-    "ParameterValue",
-]
+__all__ = ["ComposableNode", "Parameter", "ParameterFile", "ParameterValue"]

@@ -6,7 +6,10 @@ from collections.abc import Iterable, Iterator
 from typing import Any
 
 from mlaunch.launch.substitution import Substitution
-from mlaunch.launch.utilities import ensure_argument_type, normalize_to_list_of_substitutions
+from mlaunch.launch.utilities.ensure_argument_type_impl import ensure_argument_type
+from mlaunch.launch.utilities.normalize_to_list_of_substitutions_impl import (
+    normalize_to_list_of_substitutions,
+)
 
 RemapRule = tuple[tuple[Substitution, ...], tuple[Substitution, ...]]
 

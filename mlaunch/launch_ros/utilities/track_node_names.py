@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from mlaunch.launch_ros.node import node_name_counts
+from mlaunch.launch_ros.actions.node import node_name_counts
 
 
 def add_node_name(context: Any, node_name: str) -> None:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mlaunch.launch.actions import Action
+from mlaunch.launch.action import Action
 from mlaunch.plan.steps import StartTimer
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from mlaunch.launch.event_handlers import OnProcessIO
+from mlaunch.launch.event_handlers.on_process_io import OnProcessIO
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

@@ -8,14 +8,14 @@ once no test is still armed.
 
 from __future__ import annotations
 
-from mlaunch.launch.actions import EmitEvent, ExecuteProcess, RegisterEventHandler
-from mlaunch.launch.event_handlers import (
-    OnExecutionComplete,
-    OnProcessExit,
-    OnProcessIO,
-    OnShutdown,
-)
-from mlaunch.launch.events import Shutdown
+from mlaunch.launch.actions.emit_event import EmitEvent
+from mlaunch.launch.actions.execute_process import ExecuteProcess
+from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
+from mlaunch.launch.event_handlers.on_execution_complete import OnExecutionComplete
+from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
+from mlaunch.launch.event_handlers.on_process_io import OnProcessIO
+from mlaunch.launch.event_handlers.on_shutdown import OnShutdown
+from mlaunch.launch.events.shutdown import Shutdown
 from mlaunch.launch_testing.legacy import output
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms

@@ -7,14 +7,13 @@ still runs.
 
 from __future__ import annotations
 
-from mlaunch.launch.actions import ExecuteProcess, LaunchDescription
-from mlaunch.launch.events import (
-    IncludeLaunchDescription,
-    ProcessExited,
-    ProcessStarted,
-    ShutdownProcess,
-    matches_action,
-)
+from mlaunch.launch.actions.execute_process import ExecuteProcess
+from mlaunch.launch.events.include_launch_description import IncludeLaunchDescription
+from mlaunch.launch.events.matchers import matches_action
+from mlaunch.launch.events.process.process_exited import ProcessExited
+from mlaunch.launch.events.process.process_started import ProcessStarted
+from mlaunch.launch.events.process.shutdown_process import ShutdownProcess
+from mlaunch.launch.launch_description import LaunchDescription
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

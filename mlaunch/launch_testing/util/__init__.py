@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from mlaunch.launch.actions import ExecuteProcess
+from mlaunch.launch.actions.execute_process import ExecuteProcess
 from mlaunch.launch_testing.util.proc_lookup import (
     NO_CMD_ARGS,
     NoMatchingProcessException,

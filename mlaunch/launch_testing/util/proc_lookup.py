@@ -6,7 +6,7 @@ launch_testing goes through; ``info_obj`` is a ProcInfoHandler or an IoHandler.
 
 from __future__ import annotations
 
-from mlaunch.launch.actions import ExecuteProcess
+from mlaunch.launch.actions.execute_process import ExecuteProcess
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:

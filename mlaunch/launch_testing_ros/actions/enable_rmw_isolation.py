@@ -13,8 +13,8 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from mlaunch.launch.actions import Action
-from mlaunch.launch.event_handlers import OnShutdown
+from mlaunch.launch.action import Action
+from mlaunch.launch.event_handlers.on_shutdown import OnShutdown
 from mlaunch.ros import domain
 
 
