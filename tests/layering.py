@@ -208,3 +208,48 @@ def package_cycles(root: str) -> list[list[str]]:
         if node not in index:
             connect(node)
     return cycles
+
+
+def _components(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one node (Tarjan's), each sorted."""
+    found: list[list[str]] = []
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+
+    def connect(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for nxt in sorted(graph.get(node, ())):
+            if nxt not in index:
+                connect(nxt)
+                low[node] = min(low[node], low[nxt])
+            elif nxt in on_stack:
+                low[node] = min(low[node], index[nxt])
+        if low[node] == index[node]:
+            group = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                group.append(member)
+                if member == node:
+                    break
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for node in sorted(graph):
+        if node not in index:
+            connect(node)
+    return sorted(found)
+
+
+def module_cycles(root: str) -> list[list[str]]:
+    """Circles between the modules of one package (each as its modules, dotted, sorted), by the
+    same imports as the layers: what makes a module impossible to read or change alone."""
+    graph: dict[str, set[str]] = {}
+    for edge in _all_imports(root):
+        if package_of(edge.source) == package_of(edge.target):
+            graph.setdefault(edge.source, set()).add(edge.target)
+    return _components(graph)
