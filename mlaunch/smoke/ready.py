@@ -48,9 +48,15 @@ class ReadyWatch(SmokeRun):
         settings = Settings(timeout=float("inf"), hold=0.0)
         super().__init__(supervisor, expectations, settings, lifecycle=lifecycle)
 
+    SOURCE = "ready"
+
     def seed(self, logs: Callable[[str], list[str]] | None = None) -> None:
         """Attached after the run began: the processes started (and ended) so far, and their
-        last lines of output (``logs(label)``) for the output checks."""
+        last lines of output (``logs(label)``) for the output checks. Times count from the
+        first process's start, as they would had the watch been there."""
+        starts = [p.started_at for p in self.supervisor.processes]
+        if starts:
+            self.started_at = min(starts)
         for process in list(self.supervisor.processes):
             if logs is not None:
                 lines = logs(process.label)

@@ -60,6 +60,9 @@ class SmokeRun(Part):
     ROS graph checks run in one checker thread that hands its findings to the loop.
     """
 
+    # Whose lines the printer shows ([test]; a running launch's readiness says [ready]).
+    SOURCE = "test"
+
     def __init__(
         self,
         supervisor: Supervisor,
@@ -347,9 +350,9 @@ class SmokeRun(Part):
         self.ready_at = self.elapsed()
         emit = self.supervisor.events.emit
         count = sum(1 for e in self.expectations if e.status == "met")
-        emit(Said("INFO", "test", f"ready after {self.elapsed():.1f} s ({count} checks met)"))
+        emit(Said("INFO", self.SOURCE, f"ready after {self.elapsed():.1f} s ({count} checks met)"))
         if self.settings.hold > 0:
-            emit(Said("INFO", "test", f"holding for {self.settings.hold:g} s"))
+            emit(Said("INFO", self.SOURCE, f"holding for {self.settings.hold:g} s"))
             self.supervisor.schedule(self.settings.hold, self._held, keeps_alive=False)
         else:
             self._held()
