@@ -187,8 +187,10 @@ def _guess(text: str) -> Any:
     the text as written. YAML's own reading of a string counts: ``'7'`` is the text 7."""
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        value = yaml.safe_load(text)
+        value = load_yaml(text)
     except yaml.YAMLError:
         return text
     if isinstance(value, (bool, int, float, str)):
@@ -221,8 +223,10 @@ def _guess_list(p: Entity, attr: Attr, value: Any) -> list[Any]:
         return value
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        loaded = yaml.safe_load(value) if isinstance(value, str) else value
+        loaded = load_yaml(value) if isinstance(value, str) else value
     except yaml.YAMLError:
         loaded = None
     if not isinstance(loaded, list):

@@ -17,6 +17,7 @@ from mlaunch.frontends.entity import Attr, Entity
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 from mlaunch.plan.errors import LaunchFileError
+from mlaunch.plan.yamldata import bound_of_depth, check_aliases, shape
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -63,7 +64,7 @@ class _Reader:
 
     def root(self, data: bytes) -> Entity:
         try:
-            if _bound_of_depth(data) > _NODE_DEPTH_LIMIT:
+            if bound_of_depth(data) > _NODE_DEPTH_LIMIT:
                 self.check_depth(data)
             root = yaml.compose(data, Loader=_Loader)
         except yaml.MarkedYAMLError as e:
@@ -104,35 +105,14 @@ class _Reader:
                 depth -= 1
 
     def check_expansion(self, root: Node) -> None:
-        """Stop aliases that expand the file past ``EXPANDED_NODE_LIMIT`` nodes, or into itself.
+        """Stop aliases that expand the file past ``ALIAS_LIMIT`` more nodes, or into itself.
 
         Composing shares an anchored node among its aliases, so a 75-line file of lists of
         aliases of lists (a "billion laughs") composes at once and only explodes when walked:
-        24 levels took 6.5 GB, 16 planned 131,071 processes. Each node's expanded size is
-        counted once (iteratively, a flat walk), before any entity is built.
+        24 levels took 6.5 GB, 16 planned 131,071 processes. ``check_aliases`` counts each
+        node's expanded size once, before any entity is built (parameter files get the same).
         """
-        sizes: dict[int, int] = {}
-        on_path: set[int] = set()
-        stack: list[tuple[Node, bool]] = [(root, False)]
-        while stack:
-            node, finished = stack.pop()
-            key = id(node)
-            if finished:
-                on_path.discard(key)
-                size = 1 + sum(sizes[id(c)] for c in _node_children(node))
-                if size > EXPANDED_NODE_LIMIT:
-                    raise self.error(
-                        node,
-                        f"YAML aliases expand this {_shape(node)[2:]} past {EXPANDED_NODE_LIMIT:,}"
-                        " nodes, mlaunch's limit for a launch file (an alias bomb?)",
-                    )
-                sizes[key] = size
-            elif key in on_path:
-                raise self.error(node, f"a YAML alias repeats the {_shape(node)[2:]} it is in")
-            elif key not in sizes:
-                on_path.add(key)
-                stack.append((node, True))
-                stack.extend((c, False) for c in _node_children(node))
+        check_aliases(root, self.error)
 
     # --- nodes to entities ----------------------------------------------------------------------
 
@@ -179,7 +159,7 @@ class _Reader:
                     if isinstance(item, MappingNode)
                     else ""
                 )
-                got = f"a map with keys {keys}" if keys else f"{_shape(item)}"
+                got = f"a map with keys {keys}" if keys else f"{shape(item)}"
                 raise self.error(
                     item,
                     f"each entity is a map with one key, its tag (- node: {{...}}); got {got}"
@@ -219,7 +199,7 @@ class _Reader:
 
     def key_text(self, key: Node) -> str:
         if not isinstance(key, ScalarNode) or key.tag != "tag:yaml.org,2002:str":
-            raise self.error(key, f"expected a tag or attribute name, got {_shape(key)}")
+            raise self.error(key, f"expected a tag or attribute name, got {shape(key)}")
         return str(key.value)
 
     def construct(self, node: Node) -> Any:
@@ -254,26 +234,3 @@ class _Reader:
 
 # A nesting level of groups is two or three YAML levels (a map, its children list ...).
 _NODE_DEPTH_LIMIT = 3 * DEPTH_LIMIT
-# YAML nodes a launch file may expand to, aliases repeated: a 10,000-line file has ~30,000.
-EXPANDED_NODE_LIMIT = 200_000
-
-
-def _node_children(node: Node) -> list[Node]:
-    if isinstance(node, SequenceNode):
-        return list(node.value)
-    if isinstance(node, MappingNode):
-        return [n for pair in node.value for n in pair]
-    return []
-
-
-def _bound_of_depth(data: bytes) -> int:
-    """An upper bound of the YAML nesting depth: each map or list needs one of these bytes."""
-    return data.count(b":") + data.count(b"-") + data.count(b"[") + data.count(b"{")
-
-
-def _shape(node: Node) -> str:
-    if isinstance(node, SequenceNode):
-        return "a list"
-    if isinstance(node, MappingNode):
-        return "a map"
-    return repr(node.value)

@@ -219,9 +219,11 @@ def _file_section(context: LaunchContext, path: Path, key: str) -> dict[str, Any
     """The parameters a params file gives the node ``key``, None when it gives none."""
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
         with open(path, encoding="utf-8") as f:
-            data = yaml.safe_load(f)
+            data = load_yaml(f.read(), str(path))
     except OSError as e:
         raise SubstitutionFailure(f"parameter file {str(path)!r} cannot be read: {e.strerror}")
     except yaml.YAMLError as e:

@@ -216,8 +216,10 @@ def _is_scalar(value: Any, scalar: type) -> bool:
 def _yaml(text: str, what: str) -> Any:
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        return yaml.safe_load(text)
+        return load_yaml(text, what)
     except yaml.YAMLError as e:
         problem = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise SubstitutionValueError(f"value {text[:200]!r} cannot be read as {what}: {problem}")
@@ -379,8 +381,10 @@ def substituted_copy(context: LaunchContext, path: Path, temp_dir: str | None) -
     performed = perform_substitutions(context, normalize(parts))
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        yaml.safe_load(performed)
+        load_yaml(performed, str(path))
     except yaml.YAMLError as e:
         raise SubstitutionFailure(
             f"parameter file {str(path)!r} is not valid YAML once substituted: {e}"

@@ -277,8 +277,10 @@ def read_yaml(text: str, name: str) -> Any:
     """Performed text read with YAML, as launch_ros reads a parameter's substitutions."""
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        return yaml.safe_load(text)
+        return load_yaml(text, f"parameter {name!r}")
     except yaml.YAMLError as e:
         first = str(e).splitlines()[0] if str(e) else type(e).__name__
         raise SubstitutionTypeError(

@@ -140,10 +140,10 @@ def _params_files(spec: ProcessSpec, made: dict[str, str]) -> list[str]:
         if path not in made:
             continue
         try:
-            import yaml
+            from mlaunch.plan.yamldata import load as load_yaml
 
             with open(path, encoding="utf-8") as f:
-                data = yaml.safe_load(f)
+                data = load_yaml(f.read(), path)
         except (OSError, ValueError):
             continue
         for node, section in (data or {}).items():

@@ -377,8 +377,10 @@ def params_file_data(path: str, shown: str) -> dict[str, Any]:
         "error": None,
     }
     try:
+        from mlaunch.plan.yamldata import load as load_yaml
+
         with open(path, encoding="utf-8") as f:
-            contents = yaml.safe_load(f)
+            contents = load_yaml(f.read(), path)
     except OSError as e:
         entry["error"] = f"cannot be read: {e.strerror}"
         return entry
@@ -409,7 +411,9 @@ def _yaml_value(text: str) -> Any:
     import yaml
 
     try:
-        return yaml.safe_load(text) if text else ""
+        from mlaunch.plan.yamldata import load as load_yaml
+
+        return load_yaml(text, "a -p name:=value") if text else ""
     except yaml.YAMLError:
         return text
 

@@ -143,8 +143,10 @@ def rule(name: str, value: Any) -> str:
 def _yaml(text: str) -> Any:
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        return yaml.safe_load(text)
+        return load_yaml(text)
     except yaml.YAMLError:
         return None
 

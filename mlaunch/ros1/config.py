@@ -19,6 +19,7 @@ import yaml
 
 from mlaunch.frontends.limits import IncludeChain
 from mlaunch.plan.errors import LaunchFileError, MlaunchError
+from mlaunch.plan.yamldata import load as load_yaml
 from mlaunch.ros1.elements import Element, parse_xml
 from mlaunch.ros1.rosargs import ArgMissing, Substitutions
 from mlaunch.ros1.values import RosparamLoader, convert_value
@@ -445,7 +446,7 @@ class Loader:
         if subst:
             text = ctx.subst.resolve(text)
         try:
-            data = yaml.load(text, Loader=RosparamLoader)
+            data = load_yaml(text, attrs["file"] or "<rosparam>", loader=RosparamLoader)
         except yaml.YAMLError as e:
             raise LaunchFileError(f"invalid YAML in <rosparam>: {e}")
         if data is None:

@@ -8,6 +8,8 @@ from typing import Any
 import yaml
 
 from mlaunch.frontends.encoding import not_utf8
+from mlaunch.plan.yamldata import YamlLimitError
+from mlaunch.plan.yamldata import load as load_yaml
 from mlaunch.ros1.elements import Element, ElementReader
 from mlaunch.ros1.model import (
     ArgRef,
@@ -193,7 +195,9 @@ class ParamReader(ElementReader):
             raise self.error(el, "subst_value must be known when the file is read")
         data = self.rosparam_text(el, scope)
         try:
-            loaded = yaml.load(data, Loader=RosparamLoader)
+            loaded = load_yaml(data, el.attrs.get("file", ""), loader=RosparamLoader)
+        except YamlLimitError as e:
+            raise self.error(el, f"rosparam {e}")
         except (yaml.YAMLError, ValueError) as e:
             raise self.error(el, f"rosparam YAML is invalid: {e}")
         param = self.attr(el, "param", scope)

@@ -45,7 +45,9 @@ def convert_value(value: str, type_name: str) -> Any:
             return False
         raise ValueError(f"{value!r} is not a bool (true, false, 1, 0)")
     if kind == "yaml":
-        return yaml.load(value, Loader=RosparamLoader)
+        from mlaunch.plan.yamldata import load as load_yaml
+
+        return load_yaml(value, loader=RosparamLoader)
     raise ValueError(f"unknown type {type_name!r}")
 
 

@@ -69,8 +69,10 @@ def read_display_config(path: str | None) -> DisplayConfig:
         return DisplayConfig(warnings=(f"display config {path!r} not loaded: {exc.strerror}",))
     import yaml  # only when there is a config to read
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text, path)
     except yaml.YAMLError as exc:
         return DisplayConfig(warnings=(f"display config {path!r} is not valid YAML: {exc}",))
     return config_from_data(data)

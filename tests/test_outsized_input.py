@@ -1,0 +1,120 @@
+"""Outsized input in every YAML mlaunch reads and every deep structure it walks: one located
+line, never gigabytes, a RecursionError or an internal error (issue 38, items 10-12)."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+from procutil import REPO, clean_env, run_mlaunch
+
+from mlaunch.plan.yamldata import ALIAS_LIMIT
+
+PREFIX = REPO / "launches" / "examples" / "prefix"
+
+
+@pytest.fixture
+def env(tmp_path: Path) -> dict[str, str]:
+    return clean_env(ROS_LOG_DIR=str(tmp_path / "logs"), AMENT_PREFIX_PATH=str(PREFIX))
+
+
+def bomb(levels: int = 30, indent: str = "") -> str:
+    """A parameter value of 2**levels strings through 30 lines of aliases (a billion laughs)."""
+    lines = [f"{indent}l0: &l0 [lol, lol]"]
+    lines += [f"{indent}l{i}: &l{i} [*l{i - 1}, *l{i - 1}]" for i in range(1, levels + 1)]
+    return "\n".join(lines) + "\n"
+
+
+def one_error(done: object, path: Path) -> str:
+    """Exit 2 and one ``mlaunch: error:`` line naming ``path`` (where the bomb is)."""
+    assert done.returncode == 2, done.stdout[-2000:] + done.stderr[-2000:]  # type: ignore[attr-defined]
+    lines = done.stderr.strip().splitlines()  # type: ignore[attr-defined]
+    assert len(lines) == 1 and lines[0].startswith("mlaunch: error: "), lines
+    assert str(path) in lines[0] and len(lines[0]) < 600, lines[0]
+    return lines[0]
+
+
+# --- item 10: alias bombs in parameter files ----------------------------------------------------
+
+
+def ros2_bomb(tmp_path: Path) -> Path:
+    params = tmp_path / "bomb.yaml"
+    params.write_text("/**:\n  ros__parameters:\n" + bomb(indent="    "))
+    return params
+
+
+def ros2_launch(tmp_path: Path, params: Path) -> Path:
+    launch = tmp_path / "node.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([Node(package='mlaunch_demo', executable='talker',"
+        f" parameters=[{str(params)!r}])])\n"
+    )
+    return launch
+
+
+def test_an_alias_bomb_in_a_params_file_is_one_line(tmp_path: Path, env: dict[str, str]) -> None:
+    # (--print without --format json does not read a params file the launch file names)
+    params = ros2_bomb(tmp_path)
+    start = time.monotonic()
+    launch = ros2_launch(tmp_path, params)
+    done = run_mlaunch(str(launch), "--print", "--format", "json", env=env, timeout=60)
+    error = one_error(done, params)  # before: grew until memory ran out (--format json)
+    assert f"expand this list by more than {ALIAS_LIMIT:,} nodes" in error
+    assert time.monotonic() - start < 20
+
+
+def ros1_launch(tmp_path: Path, params: Path) -> Path:
+    launch = tmp_path / "robot.launch"
+    launch.write_text(
+        "<launch>\n"
+        f'  <rosparam file="{params}" command="load"/>\n'
+        '  <node pkg="mlaunch_demo" type="talker" name="talker"/>\n'
+        "</launch>\n"
+    )
+    return launch
+
+
+@pytest.mark.parametrize(
+    "command",
+    [["--print"], ["--print", "--format", "json"], ["--ros1", "--print"], ["convert"]],
+)
+def test_an_alias_bomb_in_a_rosparam_file_is_one_line(
+    tmp_path: Path, env: dict[str, str], command: list[str]
+) -> None:
+    params = tmp_path / "bomb.yaml"
+    params.write_text(bomb())
+    launch = ros1_launch(tmp_path, params)
+    if command[0] == "convert":
+        args = ["convert", str(launch), "--to", "xml", "-o", str(tmp_path / "out.launch.xml")]
+    else:
+        args = [str(launch), *command]
+    env = dict(env, ROS_MASTER_URI="http://localhost:9/")  # nothing answers: no master needed
+    start = time.monotonic()
+    done = run_mlaunch(*args, env=env, timeout=60)
+    error = one_error(done, params)  # before: memory ran out
+    assert "by more than" in error
+    assert time.monotonic() - start < 20
+
+
+def test_aliases_a_params_file_really_uses_still_work(tmp_path: Path, env: dict[str, str]) -> None:
+    params = tmp_path / "shared.yaml"
+    params.write_text(
+        "/**:\n  ros__parameters:\n"
+        "    limits: &limits {max: 2.5, min: -2.5}\n"
+        "    left: *limits\n"
+        "    right: *limits\n"
+    )
+    launch = ros2_launch(tmp_path, params)
+    done = run_mlaunch(str(launch), "--print", "--format", "json", env=env)
+    assert done.returncode == 0, done.stderr
+    (entry,) = json.loads(done.stdout)["steps"][0]["parameters"]
+    assert {p["name"]: p["value"] for p in entry["parameters"]} == {
+        f"{side}.{end}": value
+        for side in ("limits", "left", "right")
+        for end, value in (("max", 2.5), ("min", -2.5))
+    }
