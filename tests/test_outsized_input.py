@@ -118,3 +118,95 @@ def test_aliases_a_params_file_really_uses_still_work(tmp_path: Path, env: dict[
         for side in ("limits", "left", "right")
         for end, value in (("max", 2.5), ("min", -2.5))
     }
+
+
+# --- item 12: nesting, one located line everywhere ------------------------------------------------
+
+
+def nested_env(depth: int) -> str:
+    inner = "x"
+    for _ in range(depth):
+        inner = f"$(env X {inner})"
+    return inner
+
+
+@pytest.mark.parametrize("suffix", ["xml", "yaml"])
+def test_check_of_substitutions_nested_600_deep_is_a_located_finding(
+    tmp_path: Path, env: dict[str, str], suffix: str
+) -> None:
+    path = tmp_path / f"deep.launch.{suffix}"
+    command = f"echo {nested_env(600)}"
+    if suffix == "xml":
+        path.write_text(f'<launch>\n  <executable cmd="{command}" name="e"/>\n</launch>\n')
+    else:
+        path.write_text(f'launch:\n- executable: {{cmd: "{command}", name: e}}\n')
+    done = run_mlaunch(str(path), "--check", env=env, timeout=60)
+    assert done.returncode == 1, done.stdout + done.stderr  # before: RecursionError, exit 70
+    assert "internal error" not in done.stderr
+    finding = done.stdout.splitlines()[0]
+    assert finding.startswith(f"{path}:2:") and len(finding) < 600, finding
+    assert "substitutions nest deeper than 200 levels" in finding
+
+
+PY_NESTED = """\
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+from launch.substitutions import PathJoinSubstitution, PythonExpression, TextSubstitution
+
+def generate_launch_description():
+    value = TextSubstitution(text="a")
+    for _ in range(20000):
+        value = NEST
+    return LaunchDescription([ExecuteProcess(cmd=["echo", value], name="e")])
+"""
+
+
+@pytest.mark.parametrize(
+    "nest", ["PathJoinSubstitution([value, 'b'])", "PythonExpression([value, '+1'])"]
+)
+@pytest.mark.parametrize("check", [False, True])
+def test_python_substitutions_nested_20000_deep_are_a_located_line(
+    tmp_path: Path, env: dict[str, str], nest: str, check: bool
+) -> None:
+    path = tmp_path / "deep.launch.py"
+    path.write_text(PY_NESTED.replace("NEST", nest))
+    done = run_mlaunch(str(path), "--check" if check else "--print", env=env, timeout=60)
+    assert "internal error" not in done.stderr, done.stderr  # before: RecursionError, exit 70
+    line = (done.stdout if check else done.stderr).splitlines()[0]
+    assert done.returncode == (1 if check else 2), done.stdout + done.stderr
+    assert f"{path}:9:" in line and len(line) < 600, line
+    assert "substitutions nest deeper than 200 levels" in line
+
+
+def nested_params(depth: int) -> str:
+    return "top: " + "{a: " * depth + "1" + "}" * depth + "\n"
+
+
+@pytest.mark.parametrize(
+    "command", [["--print"], ["--ros1", "--print"], ["--print", "--format", "json"], ["convert"]]
+)
+def test_ros1_parameters_nested_3000_deep_are_a_located_line(
+    tmp_path: Path, env: dict[str, str], command: list[str]
+) -> None:
+    params = tmp_path / "deep.yaml"
+    params.write_text(nested_params(3000))
+    launch = ros1_launch(tmp_path, params)
+    if command[0] == "convert":
+        args = ["convert", str(launch), "--to", "xml", "-o", str(tmp_path / "out.launch.xml")]
+    else:
+        args = [str(launch), *command]
+    env = dict(env, ROS_MASTER_URI="http://localhost:9/")
+    error = one_error(run_mlaunch(*args, env=env, timeout=60), params)  # before: RecursionError
+    assert f"{params}:1:" in error
+    assert "YAML maps and lists nest deeper than 200 levels" in error
+
+
+def test_ros1_parameters_nested_to_the_limit_still_load(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    params = tmp_path / "deep.yaml"
+    params.write_text(nested_params(199))
+    env = dict(env, ROS_MASTER_URI="http://localhost:9/")
+    for command in (["--print"], ["--ros1", "--print"]):
+        done = run_mlaunch(str(ros1_launch(tmp_path, params)), *command, env=env, timeout=60)
+        assert done.returncode == 0, done.stderr

@@ -57,6 +57,11 @@ class Finding:
 
 def check(path: str) -> list[Finding]:
     """Every finding for the launch file at ``path`` and the files it includes by a plain path."""
+    from mlaunch.frontends.limits import allow_deep_trees
+
+    # The walks below are recursive like a run's (a substitution 200 deep is ~1,200 frames):
+    # they get the same room, so the limits say where a file is too deep, not a RecursionError.
+    allow_deep_trees()
     findings: list[Finding] = []
     seen: set[str] = set()
     todo = [os.path.abspath(path)]

@@ -110,10 +110,24 @@ def perform(context: LaunchContext, value: Any) -> str:
     return perform_substitutions(context, normalize(value))
 
 
+_describing = [0]  # values being described inside one another now
+
+
 def describe(value: Any) -> str:
-    """Describe an unresolved value: text in quotes, substitutions by their describe()."""
-    subs = normalize(value)
-    return " + ".join(s.describe() for s in subs) if subs else "''"
+    """Describe an unresolved value: text in quotes, substitutions by their describe().
+
+    Past ``SUBSTITUTION_DEPTH_LIMIT`` levels the rest is ``...``: a description is for people,
+    and one built 20,000 deep in a Python loop must not end in a RecursionError before the
+    performing says where it is too deep.
+    """
+    if _describing[0] >= SUBSTITUTION_DEPTH_LIMIT:
+        return "..."
+    _describing[0] += 1
+    try:
+        subs = normalize(value)
+        return " + ".join(s.describe() for s in subs) if subs else "''"
+    finally:
+        _describing[0] -= 1
 
 
 class TextSubstitution(Substitution):

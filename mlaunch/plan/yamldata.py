@@ -9,13 +9,16 @@ A parameter file is data, not code, but YAML can still make it huge or deep from
   ``ALIAS_LIMIT`` nodes to what the text itself holds; a file without aliases is never limited
   (a 1,000,000-key parameter file stays readable).
 - depth: libyaml composes recursively in C (a segmentation fault past ~20,000 levels), PyYAML's
-  Python composer and every later walk recursively (RecursionError). Past ``DEPTH_LIMIT``
-  levels the text is refused, found by a flat pass over its events.
+  Python composer and every later walk recursively (RecursionError; ROS 1 parameters 3,000
+  deep ended so). Past ``DEPTH_LIMIT`` levels the text is refused, found by a flat pass over
+  its events.
 
 Both are a ``YamlLimitError`` (a ``LaunchFileError``) at the line and column of the node.
 """
 
 from __future__ import annotations
+
+import sys
 
 from mlaunch.plan.errors import LaunchFileError
 
@@ -28,8 +31,13 @@ if TYPE_CHECKING:
 
 # Nodes aliases may add to a document beyond those written in it.
 ALIAS_LIMIT = 200_000
-# Nested maps and lists a document may have (a launch file's 1000 levels of groups, x3).
-DEPTH_LIMIT = 3000
+# Nested maps and lists a parameter document may have: real ones nest a dozen; every later
+# walk of the data (flattening, JSON, XML-RPC to a ROS 1 master) is recursive too.
+DEPTH_LIMIT = 200
+# Frames the walks of such data may take (PyYAML's Python composer ~3 per level), on top of a
+# launch tree's own (mlaunch.frontends.limits gives those 25,000): pure Python frames do not use
+# the C stack in Python 3.11+.
+_RECURSION_LIMIT = 25_000
 
 
 class YamlLimitError(LaunchFileError):
@@ -47,8 +55,11 @@ def load(text: str | bytes, where: str = "", *, loader: Any = None) -> Any:
 
     if loader is None:
         loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
-    if bound_of_depth(text) > DEPTH_LIMIT:
+    bound = bound_of_depth(text)
+    if bound > DEPTH_LIMIT:
         check_depth(text, where, loader)
+    if bound > 50 and sys.getrecursionlimit() < _RECURSION_LIMIT:
+        sys.setrecursionlimit(_RECURSION_LIMIT)
     reader = loader(text)
     try:
         root = reader.get_single_node()

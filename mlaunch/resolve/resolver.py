@@ -385,8 +385,11 @@ def _note_needs(entities: Iterable[Any], needs: set[Need]) -> None:
 
 
 def _short(entity: Any) -> str:
+    """The action an error names; cut at 200 characters (a command line of substitutions
+    built 200 deep describes itself in kilobytes, and an error is one line)."""
     describe = getattr(entity, "describe_short", None)
-    return describe() if describe else type(entity).__name__
+    text = describe() if describe else type(entity).__name__
+    return text if len(text) <= 200 else text[:197] + "..."
 
 
 # --- entry points ------------------------------------------------------------------------------
