@@ -15,6 +15,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+import reference
 from test_supervision import Harness, plan_from
 
 from mlaunch.plan.events import (
@@ -31,7 +32,6 @@ from mlaunch.plan.events import (
 from mlaunch.plan.steps import Need, Plan, Step
 
 PY = sys.executable
-REFERENCE_ENV = Path.home() / ".cache" / "ros2-launch-jazzy" / "env.sh"
 
 
 def test_records_emitted_while_one_is_handled_wait_for_it_to_finish() -> None:
@@ -165,16 +165,14 @@ def test_a_handler_registered_after_its_target_sees_the_start(tmp_path: Path) ->
     assert records == ["Started", "Output", "Exited"]
 
 
-@pytest.mark.skipif(
-    not REFERENCE_ENV.exists(), reason="the reference ros2 launch is not built on this machine"
-)
+@pytest.mark.skipif(not reference.ENV_SH.exists(), reason=reference.MISSING)
 def test_late_handlers_print_what_the_reference_ros2_launch_prints(tmp_path: Path) -> None:
     path = tmp_path / "late.launch.py"
     path.write_text(textwrap.dedent(LATE_HANDLERS))
     env = {k: v for k, v in os.environ.items() if not k.startswith("MLAUNCH")}
     env["ROS_LOG_DIR"] = str(tmp_path / "logs")
     done = subprocess.run(
-        ["bash", "-c", f"source {REFERENCE_ENV} && ros2 launch {path}"],
+        ["bash", "-c", f"source {reference.ENV_SH} && ros2 launch {path}"],
         capture_output=True,
         text=True,
         env=env,

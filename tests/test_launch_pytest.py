@@ -12,13 +12,14 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+import reference
 from conftest import requires_rclpy
 from procutil import REPO, clean_env
 
 EXAMPLES = REPO / "tests" / "launch_pytest"
 LAUNCH_TESTING = REPO / "tests" / "launch_testing"
 RECORDED = json.loads((EXAMPLES / "reference_results.json").read_text())
-UPSTREAM = Path.home() / ".cache/ros2-launch-jazzy/src/launch/launch_pytest/test/launch_pytest"
+UPSTREAM = reference.SOURCES / "launch/launch_pytest/test/launch_pytest"
 TIMEOUT = 120
 
 
@@ -72,7 +73,8 @@ def test_launch_testing_files_collected_by_pytest(name: str, tmp_path: Path) -> 
 
 
 needs_upstream = pytest.mark.skipif(
-    not UPSTREAM.is_dir(), reason=f"the upstream launch_pytest examples are not at {UPSTREAM}"
+    not UPSTREAM.is_dir(),
+    reason=f"the upstream launch_pytest examples are not at {UPSTREAM}: {reference.MISSING}",
 )
 
 

@@ -13,14 +13,14 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+import reference
 from conftest import requires_rclpy
 from procutil import REPO, clean_env, mlaunch
 
 EXAMPLES = REPO / "tests" / "launch_testing"
 RECORDED = json.loads((EXAMPLES / "reference_results.json").read_text())
-REFERENCE = Path.home() / ".cache" / "ros2-launch-jazzy"
-UPSTREAM_EXAMPLES = REFERENCE / "src/launch/launch_testing/test/launch_testing/examples"
-UPSTREAM_PROCESSES = REFERENCE / "src/launch/launch_testing/example_processes"
+UPSTREAM_EXAMPLES = reference.SOURCES / "launch/launch_testing/test/launch_testing/examples"
+UPSTREAM_PROCESSES = reference.SOURCES / "launch/launch_testing/example_processes"
 # What the upstream examples were run with (args_launch_test needs a non-default dut_arg).
 UPSTREAM_ARGS = ["dut_arg:=hello"]
 TIMEOUT = 120
@@ -141,8 +141,7 @@ def _upstream_prefix(tmp_path: Path) -> Path:
 
 needs_upstream = pytest.mark.skipif(
     not UPSTREAM_EXAMPLES.is_dir(),
-    reason=f"the upstream launch_testing examples are not at {UPSTREAM_EXAMPLES}"
-    " (/work/shared/tools/ros2-launch/setup.sh builds the reference with them)",
+    reason=f"the upstream launch_testing examples are not at {UPSTREAM_EXAMPLES}: {reference.MISSING}",
 )
 
 
@@ -159,14 +158,11 @@ def test_upstream_examples_give_the_reference_results(name: str, tmp_path: Path)
     assert done.returncode == expected_status(expected), done.stdout + done.stderr
 
 
-@pytest.mark.skipif(
-    not (REFERENCE / "env.sh").exists(),
-    reason=f"the reference ros2 launch is not built at {REFERENCE}",
-)
+@pytest.mark.skipif(not reference.ENV_SH.exists(), reason=reference.MISSING)
 def test_recording_still_matches_the_live_reference(tmp_path: Path) -> None:
     """The recorded results are what the reference gives today (one file, to stay quick)."""
     report = tmp_path / "report.xml"
-    script = f"source {REFERENCE}/env.sh && launch_test {EXAMPLES / 'failing.test.py'}"
+    script = f"source {reference.ENV_SH} && launch_test {EXAMPLES / 'failing.test.py'}"
     done = run_launch_test(["bash", "-c", f'{script} "$@"', "launch_test"], report, clean_env())
     assert outcomes(report) == RECORDED["ours"]["failing.test.py"], done.stdout + done.stderr
     assert done.returncode == 1

@@ -25,7 +25,7 @@ import harness  # noqa: E402
 REFERENCE = harness.reference_environ()
 requires_reference = pytest.mark.skipif(
     REFERENCE is None,
-    reason="the reference ros2 launch is not built here (~/.cache/ros2-launch-jazzy)",
+    reason=harness.reference.MISSING,
 )
 
 # name -> (file name, text, the words the one finding must contain)

@@ -35,8 +35,10 @@ CASES = HERE / "cases"
 EXPECTED = HERE / "expected"
 REPO = HERE.parent.parent
 PACKAGE = "conf_pkg"
-REFERENCE_HOME = Path(os.path.expanduser("~/.cache/ros2-launch-jazzy"))
-REFERENCE_ENV_SH = REFERENCE_HOME / "env.sh"
+sys.path.insert(0, str(HERE.parent))  # tests/, when record.py runs this outside pytest
+import reference  # noqa: E402
+
+REFERENCE_ENV_SH = reference.ENV_SH
 SUFFIXES = (".launch.py", ".launch.yaml", ".launch.xml")
 # The same search path for both launchers (the reference puts its venv in front), so that
 # FindExecutable and friends find the same programs here and on CI.

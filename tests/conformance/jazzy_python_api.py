@@ -1,6 +1,6 @@
 """Write down the Python names and keyword arguments of the reference launch (run under its python).
 
-    bash -c 'source ~/.cache/ros2-launch-jazzy/env.sh && python tests/conformance/jazzy_python_api.py' > mlaunch/check/jazzy_python.json
+    bash -c 'source REFERENCE/env.sh && python tests/conformance/jazzy_python_api.py' > mlaunch/check/jazzy_python.json  # REFERENCE: tests/reference.py
 
 The output (mlaunch/check/jazzy_python.json) is data the portability check holds .launch.py files to (which
 ``launch``/``launch_ros`` modules exist, what names they export, which keyword arguments their

@@ -3,7 +3,7 @@
     .venv/bin/python tests/conformance/record.py [CASE ...]                # all cases when none are named
     .venv/bin/python tests/conformance/record.py --components [CASE ...]   # component_cases/ instead
 
-Needs the reference built at ~/.cache/ros2-launch-jazzy (see /work/shared/tools/ros2-launch). The
+Needs the reference built (tests/reference.py says where: scripts/reference builds it). The
 recordings are what the conformance tests hold mlaunch to where the reference is absent (CI).
 Component cases also need rclpy and the composition_interfaces ./scripts/setup builds; they run
 in a ROS domain of their own.
@@ -26,9 +26,7 @@ import ros_domain
 def main(names: list[str]) -> int:
     reference = harness.reference_environ()
     if reference is None:
-        print(
-            "the reference ros2 launch is not built (~/.cache/ros2-launch-jazzy)", file=sys.stderr
-        )
+        print(harness.reference.MISSING, file=sys.stderr)
         return 2
     if names[:1] == ["--components"]:
         return record_components(names[1:], reference)

@@ -30,8 +30,7 @@ KNOWN_DIFFERENCES: dict[str, str] = {
 REFERENCE = harness.reference_environ()
 requires_reference = pytest.mark.skipif(
     REFERENCE is None,
-    reason="the reference ros2 launch is not built here (~/.cache/ros2-launch-jazzy, see "
-    "/work/shared/tools/ros2-launch/README.md); the recorded requests are checked instead",
+    reason=f"{harness.reference.MISSING}; the recorded requests are checked instead",
 )
 requires_composition_interfaces = pytest.mark.skipif(
     importlib.util.find_spec("composition_interfaces") is None,
