@@ -102,10 +102,15 @@ def parse_config(text: str, path: str) -> list[Bridge]:
     """The ``config_file`` YAML: a list of bridges, each a mapping of ros_gz_bridge's keys."""
     import yaml  # only when there is a config to read
 
+    from mlaunch.plan.yamldata import YamlLimitError
+    from mlaunch.plan.yamldata import load as load_yaml
+
     if len(text) > MAX_CONFIG_BYTES:
         raise BridgeError(f"config_file {path!r} is over {MAX_CONFIG_BYTES} bytes")
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text, path)
+    except YamlLimitError as exc:
+        raise BridgeError(f"config_file {exc}") from None
     except yaml.YAMLError as exc:
         raise BridgeError(f"config_file {path!r} is not valid YAML: {exc}") from None
     if data is None:

@@ -138,8 +138,10 @@ def _mapping(piece: str, origin: str) -> dict[str, Any] | None:
     """One iteration's values: a YAML mapping (None for an empty piece)."""
     import yaml
 
+    from mlaunch.plan.yamldata import load as load_yaml
+
     try:
-        values = yaml.safe_load(piece)
+        values = load_yaml(piece, origin)
     except yaml.YAMLError as e:
         raise LaunchFileError(f"ForEach values {piece!r} are not YAML: {e}", where=origin) from e
     if values is not None and not isinstance(values, dict):

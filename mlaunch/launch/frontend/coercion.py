@@ -59,10 +59,13 @@ def _as_yaml(value: str, can_be_str: bool, message: str) -> Any:
     """The text read as a YAML value (empty text stays empty)."""
     if not value:
         return value
-    import yaml  # only markup read from Python coerces this way
+    from mlaunch.plan.errors import MlaunchError
+    from mlaunch.plan.yamldata import load as load_yaml
 
     try:
-        output = yaml.safe_load(value)
+        output = load_yaml(value)
+    except MlaunchError:
+        raise  # past a bound: an alias bomb is not text to fall back to
     except Exception as err:
         if can_be_str:
             return value
