@@ -226,8 +226,9 @@ def test_an_unset_environment_variable_the_file_reads_is_named_as_one(
 def test_a_keyerror_of_a_dict_is_not_called_an_environment_variable() -> None:
     from mlaunch.plan.origin import unset_variable_hint
 
+    empty: dict[str, str] = {}
     try:
-        {}["HOME"]
+        empty["HOME"]
     except KeyError as e:
         assert unset_variable_hint(e) == ""
 
