@@ -220,3 +220,27 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     assert down.returncode == 0, down.stdout + down.stderr
     assert wait_until(lambda: not talkers(), 30), talkers()
     assert not root.exists(), list(root.rglob("*"))
+
+
+def test_a_launch_with_machines_is_said_to_go_to_one_host(tmp_path: Path) -> None:
+    launch = tmp_path / "machines.launch.py"
+    launch.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import ExecuteProcess\n"
+        "from mlaunch.actions import Machine\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        "        Machine(name='gpu', address='gpu-alias'),\n"
+        "        ExecuteProcess(cmd=['sleep', '9'], name='here'),\n"
+        "        ExecuteProcess(cmd=['sleep', '9'], name='there', machine='gpu'),\n"
+        "    ])\n"
+    )
+    out = tmp_path / "out"
+    done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), env=clean_env())
+    assert done.returncode == 0, done.stderr
+    assert "declares machines (gpu)" in done.stderr and "-e hosts=NAME" in done.stderr
+    assert "declares machines (gpu)" in (out / "README.md").read_text()
+    exported = json.loads((out / "export.yml").read_text().split("\n", 1)[1])
+    assert exported["mlaunch_export"]["launch"] == "machines.launch.py"
+    assert (out / "files" / "launch" / "machines.launch.py").read_text() == launch.read_text()
+    assert not (out / "files" / "launch" / "out").exists()  # the export is not copied into itself

@@ -199,7 +199,7 @@ def write_units(
             folder.write(name, text.encode("utf-8"), 0o644)
         folder.write(f"{prefix}.target", target.encode("utf-8"), 0o644)
         folder.write(f"{prefix}.service", launch_service.encode("utf-8"), 0o644)
-        copy_launch_tree(source, folder, "launch")
+        copy_launch_tree(source, folder, "launch", export_root=out_dir)
         readme = systemd.readme_text(prefix, install_dir, os.path.basename(source), export.warnings)
         folder.write("README.md", readme.encode("utf-8"), 0o644)
     finally:

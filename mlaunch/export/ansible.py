@@ -137,6 +137,16 @@ def export_ansible(opts: Options, settings: argparse.Namespace, out_dir: str) ->
         raise MlaunchError(f"{path}: the launch starts no process; nothing to export")
     warnings = list(plan.warnings)
     check_portable(specs, settings.allow_standins, warnings)
+    machines = sorted(
+        {s.machine.name for s in specs if s.machine is not None and not s.machine.local}
+    )
+    if machines:
+        # Each host would run the whole launch, SSH to the machines included: twice with two.
+        warnings.append(
+            f"the launch declares machines ({', '.join(machines)}): each host it is deployed to"
+            " runs the whole launch and starts their processes over SSH itself, so deploy it to"
+            " one host (-e hosts=NAME); the plays do not split a launch by machine"
+        )
     launch = os.path.basename(path)
     texts = {name: _read(os.path.join(PLAYBOOK, name)) for name in PLAYBOOK_FILES}
     texts |= {
@@ -148,7 +158,7 @@ def export_ansible(opts: Options, settings: argparse.Namespace, out_dir: str) ->
     try:
         files = folder.subfolder("files", 0o755)
         try:
-            copy_launch_tree(path, files, "launch")
+            copy_launch_tree(path, files, "launch", export_root=out_dir)
         finally:
             files.close()
         tasks = folder.subfolder("tasks", 0o755)

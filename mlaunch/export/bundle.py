@@ -85,13 +85,14 @@ def check_portable(specs: Iterable[ProcessSpec], allow: bool, warnings: list[str
     warnings.extend(lines)
 
 
-def copy_launch_tree(path: str, folder: Folder, name: str) -> str:
+def copy_launch_tree(path: str, folder: Folder, name: str, *, export_root: str) -> str:
     """Copy the folder of the launch file ``path`` into ``folder``/``name`` (through the export
     folder's checks: nothing planted there is followed); returns the file's name in it.
 
-    The export folder itself is not copied when it lies inside the launch file's folder."""
+    ``export_root``, the folder the export writes, is not copied when it lies inside the
+    launch file's folder."""
     source = os.path.dirname(os.path.abspath(path))
-    skipped = os.path.realpath(folder.path)
+    skipped = os.path.realpath(export_root)
     total = 0
     tree = folder.subfolder(name, 0o755)
     opened = {source: tree}
