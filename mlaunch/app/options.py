@@ -68,6 +68,8 @@ class Options:
         # --dashboard / --dashboard-port: the launch panel's own port (None: only the viewer's)
         self.dashboard_port: int | None = None
         self.metrics: str | None = None  # --metrics FILE.csv
+        # --log-level [NAME:=]LEVEL, each given to every ROS process as --log-level
+        self.log_levels: list[str] = []
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -235,6 +237,16 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         " its last lines, Esc or q back to the table; Ctrl-C stops everything",
     )
     parser.add_argument(
+        "--log-level",
+        action="append",
+        default=[],
+        metavar="[NAME:=]LEVEL",
+        help="the log level of every ROS process (its --ros-args --log-level), composable nodes"
+        " through their container, and of mlaunch's own lines: LEVEL alone, or NAME:=LEVEL for"
+        " the logger NAME ('launch' is mlaunch's own); repeatable; LEVEL is one of "
+        + ", ".join(LOG_LEVELS),
+    )
+    parser.add_argument(
         "-q",
         "--quiet",
         action="store_true",
@@ -296,6 +308,7 @@ def _version() -> str:
 # Options that take a value: the token after them is theirs even if it contains ":=".
 VALUE_OPTIONS = frozenset(
     {
+        "--log-level",
         "--package-path",
         "--launch-prefix",
         "--launch-prefix-filter",
@@ -327,6 +340,31 @@ def split_launch_arguments(argv: Sequence[str]) -> tuple[list[str], list[str]]:
     return launch_args, others
 
 
+# rcutils' severities, as --ros-args --log-level takes them.
+LOG_LEVELS = ("debug", "info", "warn", "error", "fatal")
+
+
+def log_level(item: str) -> str:
+    """``--log-level [NAME:=]LEVEL`` checked, LEVEL in lower case (``warning`` is ``warn``)."""
+    from mlaunch.plan.errors import UsageError, did_you_mean
+
+    name, sep, level = item.rpartition(":=")
+    level = level.strip().lower()
+    level = "warn" if level == "warning" else level
+    if level not in LOG_LEVELS or (sep and not name):
+        raise UsageError(
+            f"--log-level {item!r}: expected LEVEL or NAME:=LEVEL, LEVEL one of"
+            f" {', '.join(LOG_LEVELS)}{did_you_mean(level, LOG_LEVELS)}"
+        )
+    return f"{name}:={level}" if sep else level
+
+
+def own_log_level(levels: Sequence[str]) -> str | None:
+    """The level mlaunch's own lines follow: the last one given alone or for 'launch'."""
+    own = [lvl.rpartition(":=")[2] for lvl in levels if lvl.rpartition(":=")[0] in ("", "launch")]
+    return own[-1] if own else None
+
+
 def parse_options(argv: Sequence[str]) -> Options:
     from mlaunch.plan.errors import UsageError
 
@@ -353,6 +391,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         log_keep=_log_keep(ns.log_keep),
     )
     opts.capture = ns.capture_at_definition
+    opts.log_levels = [log_level(item) for item in ns.log_level]
     opts.noninteractive = ns.noninteractive
     opts.format = ns.format
     if opts.format != "text" and not (opts.print_plan or opts.show_args):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 
-from mlaunch.app.options import Options
+from mlaunch.app.options import Options, own_log_level
 from mlaunch.app.parts import PartMaker, Run
 from mlaunch.plan.events import Said
 from mlaunch.plan.steps import Plan
@@ -126,6 +126,7 @@ def resolve_for_run(
         scoped_parameters=opts.scoped_parameters,
         scoped_file_locals=opts.scoped_file_locals,
         dry_run=opts.print_plan,
+        log_levels=tuple(opts.log_levels),
     )
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions.set_parameter import with_use_sim_time
@@ -238,6 +239,7 @@ def supervise(
         color=color,
         log_dir=log_dir,
         quiet=opts.quiet,
+        level=own_log_level(opts.log_levels),
         rotate_bytes=rotate,
         rotate_keep=DEFAULT_ROTATE_KEEP if opts.log_keep is None else opts.log_keep,
     )

@@ -45,6 +45,8 @@ SCREEN_STREAMS: dict[str, frozenset[str]] = {
 }
 LAUNCH_LOG_MODES = frozenset({"log", "both", "full"})
 
+# mlaunch's own levels by severity, with rcutils' names for them (--log-level).
+OWN_LEVELS = {"DEBUG": 0, "INFO": 1, "WARN": 2, "WARNING": 2, "ERROR": 3, "FATAL": 4}
 LEVEL_COLORS = {"INFO": b"", "WARNING": b"\x1b[33m", "ERROR": b"\x1b[31m", "DEBUG": b"\x1b[2m"}
 LABEL_COLORS = [b"\x1b[32m", b"\x1b[36m", b"\x1b[35m", b"\x1b[34m", b"\x1b[33m", b"\x1b[92m",
                 b"\x1b[96m", b"\x1b[95m", b"\x1b[94m", b"\x1b[93m"]  # fmt: skip
@@ -112,6 +114,7 @@ class Printer:
         rotate_keep: int = DEFAULT_ROTATE_KEEP,
         quiet: bool = False,
         clock: Callable[[], float] = time.time,
+        level: str | None = None,
     ) -> None:
         self.out = out
         self.color = color
@@ -120,6 +123,8 @@ class Printer:
         self.rotate_keep = rotate_keep
         self.quiet = quiet
         self.clock = clock
+        # The least severe of mlaunch's own lines shown (--log-level; -q is WARNING).
+        self._rank = OWN_LEVELS.get((level or "").upper(), 2 if quiet else 1)
         # The Screen under whatever the screen output goes through (a status view wraps it).
         self._screen: Screen | None
         self._write: Callable[[bytes], object]
@@ -203,7 +208,7 @@ class Printer:
     def message(self, level: str, source: str, text: str, *, always: bool = False) -> None:
         """``[LEVEL] [source]: text`` on screen and in launch.log (``always``: under -q too)."""
         line = f"[{level}] [{source}]: {text}\n".encode("utf-8", "replace")
-        if always or not self.quiet or level in ("WARNING", "ERROR"):
+        if always or OWN_LEVELS.get(level, 1) >= self._rank:
             write = getattr(self._write, "urgent", self._write)
             if self.color and LEVEL_COLORS.get(level):
                 write(LEVEL_COLORS[level] + line[:-1] + RESET + b"\n")

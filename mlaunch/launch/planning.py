@@ -31,6 +31,7 @@ class StandaloneOptions:
     __slots__ = ()
     standins = False
     dry_run = False
+    log_levels: tuple[str, ...] = ()
     temp_dir: str | None = None
     capture = False
     scoped_parameters = False

@@ -43,6 +43,9 @@ class PlanningOptions(Protocol):
     @property
     def dry_run(self) -> bool: ...  # --print: a program not built is a warning, not an error
 
+    @property
+    def log_levels(self) -> tuple[str, ...]: ...  # --log-level: given to every ROS node
+
 
 class Planner(Protocol):
     """How an action's execution becomes steps of a Plan (see the module docstring)."""

@@ -76,6 +76,7 @@ class ResolveOptions(Record):
         "scoped_file_locals",
         "dry_run",
         "collect",
+        "log_levels",
     )
     __slots__ = _fields
 
@@ -89,6 +90,7 @@ class ResolveOptions(Record):
         dry_run: bool = False,
         scoped_file_locals: bool = False,
         collect: list[MlaunchError] | None = None,
+        log_levels: tuple[str, ...] = (),
     ) -> None:
         self.standins = standins
         self.packages = packages
@@ -105,6 +107,8 @@ class ResolveOptions(Record):
         # --check: an action that fails is noted here and the visit goes on with the next one,
         # so one check names every error a run would stop at (None: the first error raises).
         self.collect = collect
+        # --log-level: each item given to every ROS node's command line (--log-level ITEM).
+        self.log_levels = log_levels
 
 
 class Resolver:

@@ -293,6 +293,10 @@ class Node(ExecuteProcess):
             argv += ["-r", f"__ns:={names.namespace}"]
         part = self._ros_part(context, names)
         argv += part.argv
+        planner = getattr(context, "planner", None)
+        options = None if planner is None else planner.options
+        for level in getattr(options, "log_levels", ()):
+            argv += ["--log-level", level]  # mlaunch --log-level: every ROS process
         self._record(names, part)
         return NodeCommand(names, package, executable, exe_argv, standin, argv, part.temp_files)
 
