@@ -96,7 +96,7 @@ class CtlError(MlaunchError):
 def parser() -> argparse.ArgumentParser:
     p = ArgumentParser(
         prog="mlaunch ctl",
-        usage="mlaunch ctl [-h] [-n LINES] [--json] [RUN] OPERATION [LABEL]",
+        usage="mlaunch ctl [-h] [-n LINES] [--json] [--timeout S] [RUN] OPERATION [LABEL]",
         description=DESCRIPTION,
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
