@@ -66,29 +66,50 @@ def package_search(opts: Options, launch_file: str | None) -> PackageSearch:
     return PackageSearch(opts.package_path, launch_file, os.environ, standins=opts.standins)
 
 
-def load_target(opts: Options, temp_dir: str | None = None) -> tuple[str, LaunchDescription]:
-    """The launch file the command line names (a path, or PKG FILE) and its description.
-
-    A roslaunch file runs natively on ROS 1 (``mlaunch.parts.ros1_native``, its files in
-    ``temp_dir``) with --ros1, or in a shell set up for ROS 1 unless --ros2 says otherwise.
-    """
+def find_target(opts: Options) -> tuple[str, PackageSearch]:
+    """The launch file the command line names (a path, or PKG FILE) and the run's package search,
+    made once: the search that found the file, unless naming the file changes it."""
     from mlaunch.ros.search import searching
 
     # `mlaunch PKG FILE` looks the package up with the search settings, before there is a file.
     given = os.path.abspath(opts.target) if opts.second is None else None
-    with searching(package_search(opts, given if given and os.path.exists(given) else None)):
+    search = package_search(opts, given if given and os.path.exists(given) else None)
+    with searching(search):
         path = find_launch_file(opts)
+    if search.launch_file != path:
+        search = package_search(opts, path)
+    return path, search
+
+
+def load_target(opts: Options, temp_dir: str | None = None) -> tuple[str, LaunchDescription]:
+    """The launch file the command line names (a path, or PKG FILE) and its description."""
+    path, search = find_target(opts)
+    return path, load_file(opts, path, search, temp_dir)
+
+
+def load_file(
+    opts: Options, path: str, search: PackageSearch, temp_dir: str | None = None
+) -> LaunchDescription:
+    """The description of the launch file at ``path``, loaded with the run's package search.
+
+    A roslaunch file runs natively on ROS 1 (``mlaunch.parts.ros1_native``, its files in
+    ``temp_dir``) with --ros1, or in a shell set up for ROS 1 unless --ros2 says otherwise.
+    """
     from mlaunch import readers
     from mlaunch.frontends.python import set_launch_argv
+    from mlaunch.ros.search import searching
 
     set_launch_argv(opts.target, opts.second, opts.launch_argv)
     # Launch-file code run while loading (get_package_share_directory) sees the same search.
-    with searching(package_search(opts, path)):
+    with searching(search):
         if temp_dir is not None and native_ros1(opts, path):
             from mlaunch.parts import ros1_native
 
-            return path, ros1_native.description(path, opts.arguments, os.environ, temp_dir)
-        return path, readers.load(path)
+            native: LaunchDescription = ros1_native.description(
+                path, opts.arguments, os.environ, temp_dir
+            )
+            return native
+        return readers.load(path)
 
 
 def native_ros1(opts: Options, path: str) -> bool:
@@ -114,13 +135,15 @@ def resolve_for_run(
     *,
     temp_dir: str,
     log_dir: str,
+    search: PackageSearch | None = None,
 ) -> tuple[Plan, ResolveOptions, LabelCounter]:
-    """(plan, resolve options, label counter) for a run of ``description`` as opts say."""
+    """(plan, resolve options, label counter) for a run of ``description`` as opts say;
+    ``search``: the run's package search, when the caller made it (``find_target``)."""
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve
 
     options = ResolveOptions(
         standins=opts.standins,
-        packages=package_search(opts, path),
+        packages=search or package_search(opts, path),
         temp_dir=temp_dir,
         capture=opts.capture,
         scoped_parameters=opts.scoped_parameters,
@@ -156,14 +179,15 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
     # From here on a launch file's code and substitutions may start processes: signals, the
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
     with Lifeline() as life:
-        path, description = load_target(opts, temp_dir=life.temp_dir)
+        path, search = find_target(opts)
+        description = load_file(opts, path, search, temp_dir=life.temp_dir)
         streams_back(path)
         if opts.show_args:
             from mlaunch.resolve.describe import format_arguments
             from mlaunch.resolve.resolver import collect_arguments
             from mlaunch.ros.search import searching
 
-            with searching(package_search(opts, path)):
+            with searching(search):
                 infos = collect_arguments(
                     description, path=path, arguments=opts.arguments, environ=os.environ
                 )
@@ -180,7 +204,7 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
 
             log_dir = make_run_log_dir(os.environ)
         plan, options, labels = resolve_for_run(
-            opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir
+            opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir, search=search
         )
         streams_back(path)
         if opts.print_plan:

@@ -260,14 +260,38 @@ class Log(Step):
         self.message = message
 
 
-class StartTimer(Step):
-    """Run ``body`` after ``period`` seconds of wall-clock time, or of ROS time for a ROSTimer:
-    its ``ros_time`` is the run's state (``LaunchContext.run_state``), where SetUseSimTime
-    records whether launch's own ROS clock follows /clock; the engine looks when it starts the
-    timer, so a SetUseSimTime after the timer in the same description counts, as in launch_ros.
+class RosClock:
+    """launch's own ROS clock, one per run: whether it follows simulated time (/clock).
+
+    SetUseSimTime sets ``simulated``; a ROSTimer's StartTimer holds the run's clock, and the
+    engine asks it when it starts the timer (``StartTimer.on_sim_time``), so a SetUseSimTime
+    after the timer in the same description counts, as in launch_ros. The one place that says
+    whether a run's ROS time is simulated (``ros_clock`` finds it in the run's state).
     """
 
-    __slots__ = ("action", "body", "cancel_on_shutdown", "period", "ros_time")
+    __slots__ = ("simulated",)
+
+    def __init__(self) -> None:
+        self.simulated = False
+
+
+# The key of ``LaunchContext.run_state`` that holds the run's RosClock.
+ROS_CLOCK_STATE = "ros_clock"
+
+
+def ros_clock(run_state: dict[str, Any]) -> RosClock:
+    """The run's RosClock (made on first use) in its state (``LaunchContext.run_state``)."""
+    clock = run_state.get(ROS_CLOCK_STATE)
+    if not isinstance(clock, RosClock):
+        clock = run_state[ROS_CLOCK_STATE] = RosClock()
+    return clock
+
+
+class StartTimer(Step):
+    """Run ``body`` after ``period`` seconds of wall-clock time, or of ROS time for a ROSTimer
+    (``ros_clock``: the run's, which says at start whether that time is simulated)."""
+
+    __slots__ = ("action", "body", "cancel_on_shutdown", "period", "ros_clock")
     _fields = (*Step._fields, "period", "body", "cancel_on_shutdown", "action")
 
     def __init__(
@@ -277,19 +301,19 @@ class StartTimer(Step):
         body: Deferred | None = None,
         cancel_on_shutdown: bool = True,
         action: Any = None,
-        ros_time: dict[str, Any] | None = None,
+        ros_clock: RosClock | None = None,
     ) -> None:
         self.origin = origin
         self.period = period
         self.body = body
         self.cancel_on_shutdown = cancel_on_shutdown
         self.action = action  # the TimerAction (OnExecutionComplete targets it)
-        self.ros_time = ros_time
+        self.ros_clock = ros_clock
 
     @property
     def on_sim_time(self) -> bool:
         """A ROSTimer whose clock is simulated time (/clock) at this moment."""
-        return self.ros_time is not None and bool(self.ros_time.get(SIM_TIME_STATE))
+        return self.ros_clock is not None and self.ros_clock.simulated
 
 
 class AddHandler(Step):
@@ -390,8 +414,6 @@ class Need(enum.Enum):
 NO_NEEDS: frozenset[Need] = frozenset()
 LIFECYCLE: frozenset[Need] = frozenset({Need.LIFECYCLE})
 COMPONENTS: frozenset[Need] = frozenset({Need.COMPONENTS})
-# The key of ``LaunchContext.run_state`` where SetUseSimTime records launch's own use_sim_time.
-SIM_TIME_STATE = "ros_use_sim_time"
 
 
 # The YAML/XML form of a LifecycleSequence: a launch argument listing the nodes.

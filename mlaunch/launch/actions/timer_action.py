@@ -16,6 +16,7 @@ if TYPE_CHECKING:
 
     from mlaunch.launch.launch_context import LaunchContext
     from mlaunch.launch.substitution import SomeSubstitutionsType
+    from mlaunch.plan.steps import RosClock
 
 
 class TimerAction(Action):
@@ -52,13 +53,13 @@ class TimerAction(Action):
                 body=planner.defer(self.actions, self.origin),
                 cancel_on_shutdown=cancel,
                 action=self,
-                ros_time=self._ros_time(context),
+                ros_clock=self._ros_clock(context),
             )
         )
 
-    def _ros_time(self, context: LaunchContext) -> dict[str, Any] | None:
-        """Where the run records whether the period is simulated ROS time (StartTimer's
-        ``ros_time``); None: wall-clock time, as launch's TimerAction counts it."""
+    def _ros_clock(self, context: LaunchContext) -> RosClock | None:
+        """The clock the period is counted on: None, wall-clock time, as launch's TimerAction
+        counts it (a ROSTimer's is the run's ROS clock)."""
         return None
 
     def describe_short(self) -> str:

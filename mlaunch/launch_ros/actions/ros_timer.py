@@ -3,9 +3,9 @@
 launch_ros counts the period on the clock of launch's own ROS node: system time, or simulated
 time once SetUseSimTime(True) has set use_sim_time on that node (anywhere in the launch, before
 or after the timer: the node's clock follows /clock from then on). mlaunch records SetUseSimTime
-in the run's state and the engine looks when it starts the timer: on system time the period is
-counted by the engine's own timers; on simulated time it is handed to the ROS clock part
-(mlaunch.parts.ros_clock), which reads /clock.
+in the run's ROS clock (``mlaunch.plan.steps.RosClock``) and the engine asks it when it starts
+the timer: on system time the period is counted by the engine's own timers; on simulated time it
+is handed to the ROS clock part (mlaunch.parts.ros_clock), which reads /clock.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from typing import Any
 from mlaunch.launch.actions.timer_action import TimerAction
 from mlaunch.launch.substitution import SomeSubstitutionsType_types_tuple
 from mlaunch.launch.utilities.ensure_argument_type_impl import ensure_argument_type
+from mlaunch.plan.steps import RosClock, ros_clock
 
 
 class ROSTimer(TimerAction):
@@ -28,9 +29,8 @@ class ROSTimer(TimerAction):
         ensure_argument_type(actions, Iterable, "actions", "ROSTimer")
         super().__init__(period=period, actions=actions, **kwargs)
 
-    def _ros_time(self, context: Any) -> dict[str, Any] | None:
-        state: dict[str, Any] = context.run_state
-        return state
+    def _ros_clock(self, context: Any) -> RosClock:
+        return ros_clock(context.run_state)
 
 
 RosTimer = ROSTimer

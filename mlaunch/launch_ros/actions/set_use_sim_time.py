@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from mlaunch.launch.action import Action
 from mlaunch.launch_ros.parameter_descriptions import normalize_typed, perform_typed
-from mlaunch.plan.steps import SIM_TIME_STATE
+from mlaunch.plan.steps import ros_clock
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -32,7 +32,7 @@ class SetUseSimTime(Action):
         value = bool(perform_typed(context, self.value, bool))
         context.launch_configurations["ros_use_sim_time"] = value
         # launch's own ROS node is one per launch: not scoped (a ROSTimer reads it, run time).
-        context.run_state[SIM_TIME_STATE] = value
+        ros_clock(context.run_state).simulated = value
         planner.warn(
             f"{self.origin}: SetUseSimTime({value}) sets use_sim_time only for launch's own ROS"
             " clock, not for the nodes (as in ROS 2 Jazzy); use SetParameter('use_sim_time',"
