@@ -6,8 +6,9 @@ and 20 pages open.
 A launch whose one process prints a line stamped with the monotonic clock every 10 ms runs
 under mlaunch --dashboard; mlaunch's stdout is read by a thread that notes when each line
 arrives, so each line's delay through mlaunch is measured. For each number of pages, that many
-pages are opened as the panel's script opens them (the state stream and a log view following
-the printing process; a quarter of them never read what they are sent, as a stuck tab), and
+pages are opened as the panel's script opens them (its one stream: the state, and a log view
+following the printing process; a quarter of them never read what they are sent, as a stuck
+tab), and
 mlaunch's own CPU time (/proc/PID/stat: user + system, its threads included) is read over the
 window. ``tests/test_dashboard_load.py`` uses ``Pages`` and ``Stamps`` with a shorter window.
 """
@@ -76,8 +77,8 @@ class Stamps(threading.Thread):
 
 
 class Pages(threading.Thread):
-    """``count`` pages on the panel at 127.0.0.1:port, each with its state stream and a log
-    view of ``label``; every fourth page never reads (a stuck tab). One thread, one selector."""
+    """``count`` pages on the panel at 127.0.0.1:port, each with its stream (the state and a log
+    view of ``label``); every fourth page never reads (a stuck tab). One thread, one selector."""
 
     def __init__(self, port: int, count: int, label: str = "stamp-1") -> None:
         super().__init__(daemon=True)
@@ -85,7 +86,7 @@ class Pages(threading.Thread):
         self.sockets: list[socket.socket] = []
         self.received = 0
         self._done = threading.Event()
-        paths = ("/launch/events", f"/launch/follow?label={label}&lines=50")
+        paths = (f"/launch/events?follow={label}&lines=50",)
         for page in range(count):
             for path in paths:
                 conn = socket.create_connection(("127.0.0.1", port), timeout=10)

@@ -221,7 +221,7 @@ def assert_refuses_strangers(port: int, label: str = "ticker-1") -> None:
         port, "POST", "/launch/control", origin=own, token=token, body={"op": "exec", "label": "ls"}
     )
     assert status == 400 and b"valid" in text
-    status, text = request(port, "GET", "/launch/follow?label=../../etc/passwd&lines=5")
+    status, text = request(port, "GET", "/launch/events?follow=../../etc/passwd&lines=5")
     assert status == 404 and b"no process" in text
 
 

@@ -10,10 +10,13 @@ browser can ask is the control layer's (list, stop, start, restart, mute, unmute
 label of the run; no request names a file or a command.
 
     GET  /launch/                  the page (with the token)
-    GET  /launch/events            server-sent events: ``state`` once a second
-    GET  /launch/follow?label=L&lines=N
-                                   server-sent events: ``lines`` (the last N, then each new one)
+    GET  /launch/events[?follow=LABEL&lines=N]
+                                   server-sent events: ``state`` once a second; with ``follow``,
+                                   ``lines`` too: LABEL's last N lines, then each new one
     POST /launch/control           {"op": ..., "label": ...}: the control layer's answer
+
+One stream per page (a browser opens at most six connections to a server, and a page's log view
+would otherwise take a second); the page closes it while it is hidden.
 """
 
 from __future__ import annotations
@@ -123,9 +126,7 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
             elif path in ("/launch/", "/launch/index.html"):
                 self._send(200, "text/html; charset=utf-8", page)
             elif path == "/launch/events":
-                self._stream(lambda: self._states())
-            elif path == "/launch/follow":
-                self._follow(parse_qs(query))
+                self._events(parse_qs(query))
             else:
                 self._text(404, "not found: try /launch/\n")
 
@@ -195,48 +196,50 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
             self.wfile.write(b"event: " + name.encode() + b"\ndata: " + data + b"\n\n")
             self.wfile.flush()
 
-        def _states(self) -> None:
-            """Each new state as it comes (only the latest: a slow page skips some)."""
-            seen = -1
+        def _events(self, query: dict[str, list[str]]) -> None:
+            """The state stream, and LABEL's lines with ``follow=LABEL``."""
+            label = (query.get("follow") or [""])[0]
+            start: dict[str, Any] | None = None
+            if label:
+                try:
+                    lines = min(MAX_LINES, max(0, int((query.get("lines") or ["200"])[0])))
+                except ValueError:
+                    self._text(400, "expected ?follow=LABEL&lines=N (N: 0 or more)\n")
+                    return
+                start = dashboard.follow_start(label, lines)
+                if not start.get("ok"):
+                    self._json(404, start)
+                    return
+            self._stream(lambda: self._send_events(start))
+
+        def _send_events(self, start: dict[str, Any] | None) -> None:
+            """Each new state as it comes (only the latest: a slow page skips some), and the
+            followed label's new lines a few times a second."""
+            label, number = "", 0
+            if start is not None:
+                label, number = start["label"], start["next"]
+                first = {"label": label, "lines": start["lines"], "skipped": 0}
+                self._event("lines", json.dumps(first).encode())
+            seen, quiet_since = -1, time.monotonic()
             while True:
                 with hub.changed:
                     if hub.version == seen and not hub.closed:
-                        hub.changed.wait(KEEPALIVE)
+                        hub.changed.wait(FOLLOW_PERIOD if label else KEEPALIVE)
                     if hub.closed:
                         return
                     version, state = hub.version, hub.state
-                if version == seen:
-                    self.wfile.write(b": still here\n\n")
-                    self.wfile.flush()
-                    continue
-                seen = version
-                self._event("state", state)
-
-        def _follow(self, query: dict[str, list[str]]) -> None:
-            label = (query.get("label") or [""])[0]
-            try:
-                lines = min(MAX_LINES, max(0, int((query.get("lines") or ["200"])[0])))
-            except ValueError:
-                lines = -1
-            if not label or lines < 0:
-                self._text(400, "expected ?label=LABEL&lines=N (N: 0 or more)\n")
-                return
-            start = dashboard.follow_start(label, lines)
-            if not start.get("ok"):
-                self._json(404, start)
-                return
-            self._stream(lambda: self._lines(start))
-
-        def _lines(self, start: dict[str, Any]) -> None:
-            label, number = start["label"], start["next"]
-            first = {"label": label, "lines": start["lines"], "skipped": 0}
-            self._event("lines", json.dumps(first).encode())
-            quiet_since = time.monotonic()
-            while not hub.ended.wait(FOLLOW_PERIOD):
-                skipped, new, number = hub.lines_since(label, number)
-                if new or skipped:
-                    message = {"label": label, "lines": new, "skipped": skipped}
-                    self._event("lines", json.dumps(message).encode())
+                wrote = False
+                if version != seen:
+                    seen = version
+                    self._event("state", state)
+                    wrote = True
+                if label:
+                    skipped, new, number = hub.lines_since(label, number)
+                    if new or skipped:
+                        message = {"label": label, "lines": new, "skipped": skipped}
+                        self._event("lines", json.dumps(message).encode())
+                        wrote = True
+                if wrote:
                     quiet_since = time.monotonic()
                 elif time.monotonic() - quiet_since > KEEPALIVE:
                     self.wfile.write(b": still here\n\n")
