@@ -249,6 +249,13 @@ class Reader(ParamReader, NodeMapper):
                 envs += _collect.body
             else:
                 raise self.error(child, f"<{child.tag}> is not valid inside <include>")
+        if "pass_all_args" in el.attrs and self.flag(el, "pass_all_args", scope) is not False:
+            # roslaunch passes every arg the including file has (its own <arg>s win). ROS 2's
+            # include checks its required arguments against those it is given by name, so
+            # each is given as itself: $(arg x) for x.
+            given = {name for name, _ in arguments}
+            for name in sorted(set(scope.args) - given):
+                arguments.append((name, self.value(f"$(arg {name})", el, "pass_all_args", scope)))
         include = Include(origin=self.origin(el), path=path, arguments=arguments, warnings=notes)
         if "clear_params" in el.attrs:
             include.warnings.append(_CLEAR_PARAMS)
