@@ -116,6 +116,8 @@ class Executor:
         elif isinstance(step, RemoveHandler):
             self.handlers.remove(step.handler)
         elif isinstance(step, RequestShutdown):
+            if step.status:
+                self.exit_status(step.status)
             self.shutdown.request(
                 step.reason,
                 due_to_signal=2 if step.due_to_sigint else None,  # SIGINT, as the event said

@@ -27,6 +27,8 @@ import uuid
 from collections.abc import Mapping
 from typing import Any
 
+from mlaunch.launch.action import Action
+from mlaunch.launch.actions.execute_process import ExecuteProcess
 from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.ros1.actions import MappingWarning
 from mlaunch.ros1.config import Config, Ros1Node, load
@@ -95,7 +97,12 @@ def description(
         if process is not None:
             processes.append(process)
             started.append(node)
-    actions.append(after_loading(loader, processes))
+    from mlaunch.parts.ros1_print import DescribeNodes, NativeNodes
+
+    note = NativeNodes(loader.origin, [p.native for p in processes], config.params, environ)
+    for action in (DescribeNodes(note), after_loading(loader, processes)):
+        action.origin = loader.origin
+        actions.append(action)
     out = LaunchDescription(actions)
     out.__dict__[_RUN] = NativeRun(uri, tuple(started))
     return out
@@ -154,8 +161,6 @@ def master_process(uri: str, env: dict[str, str]) -> Any:
     """``rosmaster --core -p PORT``, as roslaunch starts it."""
     import shutil
 
-    from mlaunch.launch.actions.execute_process import ExecuteProcess
-
     program = shutil.which("rosmaster", path=env.get("PATH"))
     if program is None:
         raise LaunchFileError(
@@ -165,13 +170,47 @@ def master_process(uri: str, env: dict[str, str]) -> Any:
     from urllib.parse import urlparse
 
     port = str(urlparse(uri).port or 11311)
-    return ExecuteProcess(
+    return Ros1Process(
         cmd=[program, "--core", "-p", port, "-w", "3"],
         name="master",
         env=system_python_env(env),
         required=True,
         output="log",
     )
+
+
+class ParamsLoader(ExecuteProcess):
+    """The process that loads the parameter server (mlaunch.parts.ros1_params)."""
+
+    def describe_short(self) -> str:
+        return "roslaunch_params (the parameter server's loader)"
+
+
+class Ros1Process(ExecuteProcess):
+    """An ExecuteProcess for a ROS 1 program (the master, a node), stopped and set up as
+    roslaunch does: its stop ladder is roslaunch's (SIGINT, SIGTERM after 15 s, SIGKILL 2 s
+    later: ``_TIMEOUT_SIGINT`` and ``_TIMEOUT_SIGTERM`` of roslaunch's nodeprocess), and its
+    environment is the one it is given, without what mlaunch adds for ROS 2 children (rcutils'
+    line buffering). ``PYTHONUNBUFFERED`` stays: the program's output goes through mlaunch's
+    pipe, where Python would hold it back."""
+
+    RCUTILS = "RCUTILS_LOGGING_BUFFERED_STREAM"
+    SIGINT_TIMEOUT = 15.0
+    SIGTERM_TIMEOUT = 2.0
+
+    native: Any = None  # the node as --print shows it (mlaunch.parts.ros1_print.NativeNode)
+
+    def __init__(self, *, env: dict[str, str] | None = None, **kwargs: Any) -> None:
+        kwargs.setdefault("sigterm_timeout", self.SIGINT_TIMEOUT)
+        kwargs.setdefault("sigkill_timeout", self.SIGTERM_TIMEOUT)
+        super().__init__(env=env, **kwargs)
+        self._given_rcutils = env is not None and self.RCUTILS in env
+
+    def _environment(self, ctx: Any) -> dict[str, str]:
+        env = super()._environment(ctx)
+        if not self._given_rcutils:
+            env.pop(self.RCUTILS, None)
+        return env
 
 
 def machines(config: Config, path: str) -> list[Any]:
@@ -191,7 +230,6 @@ def machines(config: Config, path: str) -> list[Any]:
 
 
 def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: Any) -> Any:
-    from mlaunch.launch.actions.execute_process import ExecuteProcess
 
     job = {
         "master_uri": uri,
@@ -203,7 +241,7 @@ def params_process(config: Config, uri: str, run_id: str, temp_dir: str, env: An
     job_file = os.path.join(temp_dir, f"ros1-params-{run_id}.pickle")
     with open(job_file, "wb") as f:
         pickle.dump(job, f)
-    return ExecuteProcess(
+    return ParamsLoader(
         cmd=[sys.executable, "-m", "mlaunch.parts.ros1_params", job_file],
         name="roslaunch_params",
         env=env,
@@ -215,15 +253,43 @@ def after_loading(loader: Any, processes: list[Any]) -> Any:
     """The nodes start once the parameter server is loaded (roslaunch's order); a failed load
     ends the run."""
     from mlaunch.launch.actions.register_event_handler import RegisterEventHandler
-    from mlaunch.launch.actions.shutdown_action import Shutdown
     from mlaunch.launch.event_handlers.on_process_exit import OnProcessExit
 
-    def on_exit(event: Any, context: Any) -> list[Any]:
-        if event.returncode != 0:
-            return [Shutdown(reason="the ROS 1 parameter server could not be loaded")]
-        return processes
+    return RegisterEventHandler(OnProcessExit(target_action=loader, on_exit=StartNodes(processes)))
 
-    return RegisterEventHandler(OnProcessExit(target_action=loader, on_exit=on_exit))
+
+class StartNodes:
+    """The loader's exit: the nodes start when it loaded the parameter server, else the run
+    ends with status 1 (roslaunch's order and status)."""
+
+    def __init__(self, processes: list[Any]) -> None:
+        self.processes = processes
+
+    def __call__(self, event: Any, context: Any) -> list[Any]:
+        if event.returncode != 0:
+            return [FailedLoad()]
+        return self.processes
+
+    def describe(self) -> str:
+        return (
+            f"start the {len(self.processes)} node(s) above when it exited with status 0,"
+            " else end the run with status 1"
+        )
+
+
+class FailedLoad(Action):
+    """The parameter server could not be loaded: the run ends with exit status 1, as roslaunch
+    ends then (a Shutdown, whose status is 0, hid the failure)."""
+
+    REASON = "the ROS 1 parameter server could not be loaded"
+
+    def execute(self, context: Any) -> None:
+        from mlaunch.launch.events.shutdown import Shutdown as ShutdownEvent
+        from mlaunch.plan.errors import EXIT_FAILURE
+        from mlaunch.plan.steps import RequestShutdown
+
+        step = RequestShutdown(origin=self.origin, reason=self.REASON, status=EXIT_FAILURE)
+        context.planner.emit(ShutdownEvent(reason=self.REASON), step)
 
 
 def node_process(
@@ -231,7 +297,6 @@ def node_process(
 ) -> tuple[Any, str]:
     """The node's process as roslaunch starts it (its ``number``-th), and a warning: why it
     cannot start (in roslaunch's words), or what it runs instead of an old name."""
-    from mlaunch.launch.actions.execute_process import ExecuteProcess
 
     program, note = find_node(node, finder, env)
     if program is None:
@@ -245,8 +310,10 @@ def node_process(
         *shlex.split(node.args),
         *(f"{src}:={dst}" for src, dst in node.remaps),
         f"__name:={node.name}",
-        f"__log:={os.path.join(log_dir, process_name.replace('/', '-') + '.log')}",
     ]
+    # roslaunch sets the node's log file itself: a __log:= of the file is dropped
+    argv = [a for a in argv if not a.startswith("__log:=")]
+    argv.append(f"__log:={os.path.join(log_dir, process_name.replace('/', '-') + '.log')}")
     node_env = system_python_env(env)
     node_env.pop("ROS_NAMESPACE", None)
     namespace = node.namespace.rstrip("/")
@@ -262,7 +329,7 @@ def node_process(
         argv = [*remote_env(node, env["ROS_MASTER_URI"]), *argv]
     else:
         os.makedirs(str(cwd), exist_ok=True)
-    process = ExecuteProcess(
+    process = Ros1Process(
         cmd=argv,
         name=node.name,
         env=env_arg,
@@ -277,6 +344,10 @@ def node_process(
     # roslaunch's number for the process (its __log:= file's), not mlaunch's count, which
     # also counts the master and the parameter loader and skips the nodes that cannot start.
     process.exact_label = f"{node.name}-{number}"
+    from mlaunch.parts.ros1_print import NativeNode
+
+    stop = (Ros1Process.SIGINT_TIMEOUT, Ros1Process.SIGTERM_TIMEOUT)
+    process.native = NativeNode(node, argv, env_arg, cwd, stop)
     return process, note
 
 
@@ -331,21 +402,29 @@ def is_executable(path: str) -> bool:
     return mode & wanted == wanted
 
 
+# What mlaunch's own process has that is not the user's: the ROS 2 wheels' bootstrap (their
+# ``.pth`` re-executes Python with their libraries on LD_LIBRARY_PATH and this guard set).
+BOOTSTRAP_GUARD = "_ROS_WHEELS_BOOTSTRAP_COMPLETE"
+
+
 def system_python_env(env: Mapping[str, str]) -> dict[str, str]:
     """The environment without mlaunch's virtual environment: ROS 1's Python programs
-    (``#!/usr/bin/env python3``) must find the system's Python and its packages."""
+    (``#!/usr/bin/env python3``) must find the system's Python and its packages, and no ROS 1
+    program gets the ROS 2 wheels' libraries (LD_LIBRARY_PATH entries inside the venv) or
+    their bootstrap's guard."""
     out = dict(env)
     venv = sys.prefix if sys.prefix != sys.base_prefix else out.get("VIRTUAL_ENV")
     system_first(out)
     out.pop("VIRTUAL_ENV", None)
     out.pop("PYTHONHOME", None)
+    out.pop(BOOTSTRAP_GUARD, None)
     if venv:
         inside = os.path.realpath(venv) + os.sep
 
         def keep(entry: str) -> bool:
             return bool(entry) and not (os.path.realpath(entry) + os.sep).startswith(inside)
 
-        for name in ("PATH", "PYTHONPATH"):
+        for name in ("PATH", "PYTHONPATH", "LD_LIBRARY_PATH"):
             if name in out:
                 kept = [e for e in out[name].split(os.pathsep) if keep(e)]
                 if kept:

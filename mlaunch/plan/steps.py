@@ -214,6 +214,9 @@ class Deferred(Record):
 
     def describe(self) -> str:
         if self.callback is not None:
+            describe = getattr(self.callback, "describe", None)
+            if callable(describe):  # a callable object that says what it does
+                return str(describe())
             name = getattr(self.callback, "__qualname__", repr(self.callback))
             return f"call {name}()"
         return ", ".join(_entity_name(e) for e in self.entities) or "nothing"
@@ -354,10 +357,12 @@ class RequestShutdown(Step):
     """Shut the run down. ``due_to_sigint``: the Shutdown event said so (OnShutdown handlers
     see it); ``send_sigint``: whether the stop ladder starts with SIGINT. launch leaves SIGINT
     out for a Shutdown due to SIGINT in an interactive launch (the terminal is taken to have
-    sent it to the process group): SIGTERM then comes after ``sigterm_timeout``."""
+    sent it to the process group): SIGTERM then comes after ``sigterm_timeout``. ``status``:
+    the run's exit status is at least this (0 for launch's Shutdown; a native ROS 1 run whose
+    parameter server cannot be loaded ends with 1, as roslaunch)."""
 
-    __slots__ = ("due_to_sigint", "reason", "send_sigint")
-    _fields = (*Step._fields, "reason", "due_to_sigint", "send_sigint")
+    __slots__ = ("due_to_sigint", "reason", "send_sigint", "status")
+    _fields = (*Step._fields, "reason", "due_to_sigint", "send_sigint", "status")
 
     def __init__(
         self,
@@ -365,11 +370,13 @@ class RequestShutdown(Step):
         reason: str = "reason not given",
         due_to_sigint: bool = False,
         send_sigint: bool = True,
+        status: int = 0,
     ) -> None:
         self.origin = origin
         self.reason = reason
         self.due_to_sigint = due_to_sigint
         self.send_sigint = send_sigint
+        self.status = status
 
 
 class EmitEvent(Step):
