@@ -38,6 +38,10 @@ IDLE_TIMEOUT = 5.0  # seconds a connection may stay silent (the page polls every
 LOCAL_NAMES = ("127.0.0.1", "localhost")
 # The fastest the page may ask for (m/s, rad/s): a key held is a command, not a typo's 1e9.
 MAX_LINEAR, MAX_ANGULAR = 2.0, 3.0
+# The page sends a held key's command every 0.1 s; a motion no command renewed for this long
+# (a tab closed, a lost connection, a browser that stopped) is stopped by the server itself.
+DEADMAN = 0.5
+DEADMAN_CHECK = 0.05  # how often the server looks: a stop comes within 0.55 s
 PANEL = "/launch/"  # the launch panel's paths, passed on to mlaunch
 # What of a browser's request the panel needs (the rest stays here).
 PANEL_HEADERS = ("Host", "Origin", "Content-Type", "Accept", "X-Mlaunch-Token")
@@ -235,17 +239,62 @@ class PageServer(QuietErrors, ThreadingHTTPServer):
     """The page's HTTP server (QuietErrors)."""
 
     daemon_threads = True
+    deadman: DeadMan | None = None
+
+    def shutdown(self) -> None:
+        if self.deadman is not None:
+            self.deadman.stop()
+        super().shutdown()
+
+
+class DeadMan:
+    """The page's drive commands, with a dead-man: a motion that no command renews for
+    ``DEADMAN`` seconds gets a stop (0, 0), once, from the server's own thread."""
+
+    def __init__(self, drive: Drive, clock: Any) -> None:
+        self._drive = drive
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._moving_since: float | None = None  # when the last non-zero command came
+        self._stopped = threading.Event()
+
+    def __call__(self, linear: float, angular: float) -> None:
+        with self._lock:
+            self._moving_since = self._clock() if (linear or angular) else None
+            self._drive(linear, angular)
+
+    def check(self) -> bool:
+        """Stop a motion whose command is older than DEADMAN; whether it did."""
+        with self._lock:
+            since = self._moving_since
+            if since is None or self._clock() - since < DEADMAN:
+                return False
+            self._moving_since = None
+            self._drive(0.0, 0.0)
+            return True
+
+    def watch(self) -> None:
+        """Check every DEADMAN_CHECK seconds until stopped (a daemon thread's loop)."""
+        while not self._stopped.wait(DEADMAN_CHECK):
+            self.check()
+
+    def stop(self) -> None:
+        self._stopped.set()
 
 
 def serve(state: ViewerState, port: int, clock: Any, drive: Drive | None = None) -> PageServer:
     """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
     page = PAGE.read_bytes()
+    deadman = None if drive is None else DeadMan(drive, clock)
     try:
-        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock, drive))
+        server = PageServer(("127.0.0.1", port), make_handler(state, page, clock, deadman))
     except OSError as exc:
         raise ViewerError(
             f"cannot listen on 127.0.0.1:{port}: {exc.strerror}; valid: a free port, or 0 for"
             f" any free port (mlaunch --viewer-port, or {PORT_ENV})"
         ) from None
     threading.Thread(target=server.serve_forever, name="viewer-http", daemon=True).start()
+    if deadman is not None:
+        server.deadman = deadman
+        threading.Thread(target=deadman.watch, name="viewer-deadman", daemon=True).start()
     return server
