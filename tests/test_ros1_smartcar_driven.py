@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -185,3 +186,24 @@ def test_the_seed_runs_every_program_for_real_and_drives(tmp_path: Path, display
         code = run.finish(timeout=60)
     assert code == 0 or code == 130, run.text[-3000:]
     assert not registered(port)  # the master mlaunch started ended with the run
+
+
+def test_mlaunch_test_checks_the_seed_s_topics(tmp_path: Path, display: str) -> None:
+    """``mlaunch test`` on the seed, natively: every node registered, /odom and /tf read
+    through the rospy helper (arbotix publishes /odom at its controller's 10 Hz; half of it
+    is asked, for a loaded machine)."""
+    port = free_port()
+    env = ros1_shell(tmp_path, port)
+    env["DISPLAY"] = display
+    launch = REPO / "launches" / "smartcar_display.launch"
+    argv = [sys.executable, "-m", "mlaunch", "test", str(launch), "--timeout", "90"]
+    argv += ["--expect-topic", "/odom:5", "--expect-topic", "/tf", "--hold", "1"]
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=200, check=False)
+    assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
+    rows = done.stdout.splitlines()
+    odom = next(x for x in rows if "topic /odom " in x)
+    assert re.search(r"\d+\.\d Hz over", odom), odom
+    assert any("topic /tf " in x and "received" in x for x in rows), rows
+    for node in NODES:
+        assert any(f"node {node} " in x and "in the graph" in x for x in rows), node
+    assert not registered(port)
