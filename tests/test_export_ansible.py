@@ -25,6 +25,8 @@ from procutil import REPO, clean_env, run_mlaunch, wait_until
 PLAYBOOK = Path(sys.executable).parent / "ansible-playbook"
 MLAUNCH = Path(sys.executable).parent / "mlaunch"
 TALKER = REPO / "tests" / "nodes" / "talker.py"
+# The hosts' Python for Ansible's modules: the system's, as on a robot (else this one)
+PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
 # ssh's control sockets: a short path (108 bytes at most), one per test process
 CONTROL = f"/tmp/mlaunch-ansible-{os.getpid()}-%C"
 
@@ -113,7 +115,7 @@ def inventory(
                 "install_root": str(path.parent / "robots"),
                 "ready_timeout": 90,
                 "launch_environment": environment,
-                "ansible_python_interpreter": "/usr/bin/python3",
+                "ansible_python_interpreter": PYTHON,
             },
         }
     }
