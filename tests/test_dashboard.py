@@ -330,3 +330,22 @@ def test_the_page_shows_the_readiness_checks_as_ctl_wait_ready_has_them(
             "process ticker-1 starts and keeps running",
             "process busy-2 starts and keeps running",
         ]
+
+
+def test_the_log_ring_numbers_every_line_and_says_what_it_dropped() -> None:
+    from mlaunch.parts.dashboard import RING, Hub
+
+    hub = Hub()
+    hub.add_output("a", b"".join(b"line %d\n" % i for i in range(10)))
+    assert hub.lines_since("a", 0) == (0, [f"line {i}" for i in range(10)], 10)
+    assert hub.lines_since("a", 7) == (0, ["line 7", "line 8", "line 9"], 10)
+    # a burst longer than the ring: only its last RING lines are kept, numbered on
+    hub.add_output("a", b"".join(b"x %d\n" % i for i in range(RING + 5)))
+    skipped, lines, end = hub.lines_since("a", 10)
+    assert (skipped, len(lines), end) == (5, RING, 10 + RING + 5)
+    assert lines[0] == "x 5" and lines[-1] == f"x {RING + 4}"
+    hub.add_output("a", b"y\n")
+    assert hub.lines_since("a", end) == (0, ["y"], end + 1)
+    assert hub.lines_since("a", 0)[0] == end + 1 - RING  # what a late reader missed
+    assert hub.lines_since("other", 3) == (0, [], 3)
+    assert hub.last["a"] == "y"

@@ -89,10 +89,14 @@ class Hub:
             if ring is None:
                 ring = self.lines[label] = deque(maxlen=RING)
                 self.first[label] = 0
-            for line in text:
-                if len(ring) == RING:
-                    self.first[label] += 1
-                ring.append(line[:LINE_MAX])
+            # The ring keeps the last RING lines; the numbers of those it drops count on.
+            if len(text) >= RING:
+                self.first[label] += len(ring) + len(text) - RING
+                ring.clear()
+                text = text[-RING:]
+            else:
+                self.first[label] += max(0, len(ring) + len(text) - RING)
+            ring.extend(line[:LINE_MAX] for line in text)
             self.last[label] = text[-1][:LINE_MAX]
 
     def end(self, label: str) -> int:
