@@ -37,6 +37,8 @@ if TYPE_CHECKING:
     from mlaunch.parts.ros1_native import NativeRun
     from mlaunch.plan.steps import Plan, ProcessSpec
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
+    from mlaunch.smoke.artifacts import Bundle
+    from mlaunch.smoke.recorder import Recorder
 
 
 def command(args: Sequence[str]) -> int:
@@ -94,7 +96,9 @@ def _take_json(args: list[str]) -> bool:
     return False
 
 
-def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None, int] | None:
+def _many(
+    args: list[str],
+) -> tuple[list[str], list[str], int, str | None, int, str | None] | None:
     """``mlaunch test FILE... [-j N]``: (files, the arguments every run gets, N, --junit), or
     None for one launch. Several files are meant when -j is given, or when every positional
     word names a launch file that exists (``PKG FILE`` names a package first)."""
@@ -105,6 +109,7 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None, int] 
     jobs: int | None = None
     repeat = 1
     junit_path: str | None = None
+    evidence: str | None = None
     files: list[str] = []
     shared: list[str] = []
     words = iter(args)
@@ -120,6 +125,8 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None, int] 
             repeat = int(value) if value.isdigit() else 0
             if repeat < 1:
                 raise UsageError(f"--repeat {value!r}: expected a number of runs >= 1")
+        elif arg == "--artifacts" or arg.startswith("--artifacts="):
+            evidence = arg.split("=", 1)[1] if "=" in arg else next(words, "")
         elif arg in ("--junit", "--junit-xml"):
             junit_path = next(words, None)
         elif arg.startswith(("--junit=", "--junit-xml=")):
@@ -135,7 +142,7 @@ def _many(args: list[str]) -> tuple[list[str], list[str], int, str | None, int] 
         return None
     if not files:
         raise UsageError("mlaunch test FILE... -j N: name the launch files to test")
-    return files, shared, jobs or 1, junit_path, repeat
+    return files, shared, jobs or 1, junit_path, repeat, evidence
 
 
 # --- running --------------------------------------------------------------------------------------
@@ -168,6 +175,42 @@ def run(opts: Options, settings: Settings) -> int:
         if claimed is not None:
             claimed.release()
         _stdout_back(settings)
+
+
+def recorded_topics(expectations: list[Expectation], settings: Settings) -> list[str]:
+    """The topics whose last seconds the evidence keeps: those the checks name, --record's."""
+    topics = list(settings.record)
+    for e in expectations:
+        if e.kind in ("topic", "clock"):
+            topics.append(e.target)
+        elif e.kind == "tf":
+            topics += ["/tf", "/tf_static"]
+    return list(dict.fromkeys(topics))
+
+
+def write_evidence(
+    folder: str,
+    opts: Options,
+    plan: Plan,
+    path: str,
+    report: Report,
+    smoke: SmokeRun,
+    log_dir: str,
+    recorders: list[Recorder],
+) -> Bundle:
+    """The failure's evidence (mlaunch.smoke.artifacts); what cannot be written is said."""
+    from mlaunch.resolve.plan_json import plan_json
+    from mlaunch.smoke import artifacts
+
+    return artifacts.write(
+        folder,
+        verdict=report.data(),
+        plan_text=plan_json(plan, path, opts.arguments),
+        processes=smoke.supervisor.processes,
+        rings=smoke.rings,
+        log_dir=log_dir,
+        recorder=recorders[0] if recorders else None,
+    )
 
 
 def _stdout_back(settings: Settings) -> None:
@@ -355,6 +398,7 @@ def supervise(
     from mlaunch.app.parts import PartMaker, Run, standard_parts
 
     runs: list[SmokeRun] = []
+    recorders: list[Recorder] = []
 
     path, expectations, native = checked
     master = None
@@ -363,9 +407,20 @@ def supervise(
 
         master = SharedMaster(native.master_uri)
 
+    topics = recorded_topics(expectations, settings)
+    if topics and native is None and settings.record_seconds > 0:
+        from mlaunch.smoke.recorder import Recorder
+
+        recorders.append(Recorder(topics, settings.record_seconds))
+
     def smoke_checks(run: Run) -> SmokeRun:
         smoke = SmokeRun(
-            run.supervisor, expectations, settings, lifecycle=run.lifecycle, graph=master
+            run.supervisor,
+            expectations,
+            settings,
+            lifecycle=run.lifecycle,
+            graph=master,
+            recorder=recorders[0] if recorders else None,
         )
         runs.append(smoke)
         return smoke
@@ -373,6 +428,7 @@ def supervise(
     # Without its checks the run proves nothing: if they fail, the run ends (exit status 70).
     checks = PartMaker("the smoke checks", smoke_checks, essential=True)
     parts = [*standard_parts(opts), checks]
+
     code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
     if not runs:
         return code
@@ -388,6 +444,11 @@ def supervise(
         properties={"ros_domain_id": domain_id} if domain_id else {},
         notes=[f"ROS domain {words}"] if words else [],
     )
+    failed = not report.passed or code != EXIT_OK
+    if settings.artifacts or failed:
+        folder = settings.artifacts or os.path.join(log_dir, "artifacts")
+        bundle = write_evidence(folder, opts, plan, path, report, smoke, log_dir, recorders)
+        report.notes.append(bundle.line())
     if settings.json:
         sys.stderr.write(report.table())
         sys.stderr.flush()

@@ -35,6 +35,7 @@ class Job:
     path: str
     output: str  # where its stdout and stderr go
     junit: str  # where its JUnit report goes
+    extra: list[str] = field(default_factory=list)  # this run's own options (its --artifacts)
     code: int | None = None
     duration: float = 0.0
     process: subprocess.Popen[bytes] | None = field(default=None, repr=False)
@@ -90,6 +91,7 @@ def run_many(
     jobs: int,
     junit_path: str | None,
     repeat: int = 1,
+    evidence: str | None = None,
 ) -> int:
     """Test ``files`` with ``shared`` arguments and options, ``jobs`` at a time, each
     ``repeat`` times (then a table says how often each check held)."""
@@ -120,6 +122,10 @@ def run_many(
         )
         for i, path in enumerate(files, 1)
     ]
+    for job in batch:  # each run's evidence in a folder of its own
+        if evidence:
+            name = f"{job.index:0{width}}-{os.path.basename(job.path)}"
+            job.extra = ["--artifacts", os.path.join(evidence, name)]
     started = time.monotonic()
     stopped = _Runner(batch, shared, jobs).run()
     elapsed = time.monotonic() - started
@@ -176,7 +182,7 @@ class _Runner:
                 if self.stopped:
                     return
                 argv = [sys.executable, "-m", "mlaunch", "test", job.path, *self.shared]
-                argv += ["--junit", job.junit]
+                argv += ["--junit", job.junit, *job.extra]
                 start = time.monotonic()
                 with open(job.output, "wb") as out:
                     job.process = subprocess.Popen(

@@ -19,6 +19,7 @@ get), passed to rcl as an init option. The RMW implementation and the discovery 
 
 from __future__ import annotations
 
+import functools
 import itertools
 import os
 import threading
@@ -89,6 +90,8 @@ class RosGraph:
         self._thread: threading.Thread | None = None
         self._watches: dict[str, TopicWatch] = {}
         self._pending: list[TopicWatch] = []
+        # Raw subscriptions waiting for a publisher: (topic, keep(topic, type, cdr bytes)).
+        self._raw_pending: list[tuple[str, Callable[[str, str, bytes], None]]] = []
         self._poll_timer: Any = None
         self._clients: dict[str, Any] = {}
         self._settling = Settling()  # per service: when its client first saw it
@@ -323,11 +326,40 @@ class RosGraph:
         """Watch /clock (rosgraph_msgs/msg/Clock), published by simulators."""
         return self.watch_topic("/clock", "rosgraph_msgs/msg/Clock")
 
+    def record(self, topic: str, keep: Callable[[str, str, bytes], None]) -> None:
+        """Hand each message of ``topic`` to ``keep(topic, type, cdr_bytes)`` undecoded (the
+        test's recording), from when the topic has a publisher; ``keep`` must be quick."""
+        self._require_running()
+        name = topic_name(topic)
+        self._in_executor(lambda: self._add_raw(name, keep))
+
+    def _add_raw(self, name: str, keep: Callable[[str, str, bytes], None]) -> None:
+        # Runs in the executor thread.
+        if not self._try_raw(name, keep):
+            self._raw_pending.append((name, keep))
+            self._poll()
+
+    def _try_raw(self, name: str, keep: Callable[[str, str, bytes], None]) -> bool:
+        publishers = self._node.get_publishers_info_by_topic(name)
+        if not publishers:
+            return False
+        type_name = sorted({info.topic_type for info in publishers})[0]
+        try:
+            cls = message_class(type_name)
+        except RosBridgeError:
+            return True  # a type this Python cannot load: not recorded
+        callback = self._guarded(functools.partial(keep, name, type_name), name)
+        self._node.create_subscription(cls, name, callback, qos_for(publishers), raw=True)
+        return True
+
     def _add_pending(self, watch: TopicWatch) -> None:
         # Runs in the executor thread.
         if self._try_subscribe(watch):
             return
         self._pending.append(watch)
+        self._poll()
+
+    def _poll(self) -> None:
         if self._poll_timer is None:
             self._poll_timer = self._node.create_timer(POLL_PERIOD, self._poll_pending)
         elif self._poll_timer.is_canceled():
@@ -336,7 +368,8 @@ class RosGraph:
     def _poll_pending(self) -> None:
         # Runs in the executor thread, at POLL_PERIOD while a watch waits for its publisher.
         self._pending = [w for w in self._pending if not self._try_subscribe(w)]
-        if not self._pending:
+        self._raw_pending = [(n, k) for n, k in self._raw_pending if not self._try_raw(n, k)]
+        if not self._pending and not self._raw_pending:
             self._poll_timer.cancel()
 
     def _try_subscribe(self, watch: TopicWatch) -> bool:

@@ -64,6 +64,11 @@ lock for as long as the run lasts, and discovery on this machine
 tests several launch files, N at a time, each in a domain of its own, with one report and one
 JUnit file holding a testsuite per file.
 
+The evidence of a failed run (``--artifacts DIR`` writes it always): the verdict and the plan
+as JSON, each process's argv, environment, parameters and last output, the log files, a
+backtrace of a core dump (with gdb), and the last ``--record-seconds`` (10) of the topics the
+checks name and ``--record TOPIC`` as an MCAP file; the report says where.
+
 Exit status: 0 ready (and held, and stopped cleanly); 1 an expectation failed; 2 bad command
 line or launch file; 128+N interrupted by signal N.
 """
@@ -109,6 +114,9 @@ class Settings:
     allow_exit: list[str] = field(default_factory=list)
     repeat: int = 1
     json: bool = False  # --format json: the verdict as JSON on stdout
+    artifacts: str | None = None  # --artifacts DIR: the evidence, always
+    record: list[str] = field(default_factory=list)  # --record TOPIC: kept for the evidence
+    record_seconds: float = 10.0
     stdout: int | None = None  # the verdict's stdout, while the run's output goes to stderr
 
 
@@ -124,6 +132,9 @@ VALUE_FLAGS = (
     "--expect-action",
     "--forbid-output",
     "--repeat",
+    "--artifacts",
+    "--record",
+    "--record-seconds",
     "--within",
     "--timeout",
     "--hold",
@@ -201,6 +212,27 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE",
         dest="junit",
         help="write a JUnit XML report",
+    )
+    parser.add_argument(
+        "--artifacts",
+        metavar="DIR",
+        help="write the evidence of the run into DIR (verdict, plan, processes, logs, the"
+        " recording); without it, a failed run writes it into its log folder",
+    )
+    parser.add_argument(
+        "--record",
+        action="append",
+        default=[],
+        metavar="TOPIC",
+        help="keep the last seconds of TOPIC for the evidence (besides the topics the checks"
+        " name); repeatable",
+    )
+    parser.add_argument(
+        "--record-seconds",
+        type=float,
+        default=10.0,
+        metavar="S",
+        help="how many of the last seconds the recording keeps (default 10; 0: no recording)",
     )
     parser.add_argument(
         "--repeat",
@@ -285,7 +317,12 @@ def parse_settings(args: Sequence[str]) -> Settings:
     expectations = list(getattr(ns, "expectations", None) or [])
     if ns.no_errors:
         expectations.append(parse_target("forbid", ERROR_LINES, "--no-errors"))
+    if not ns.record_seconds >= 0 or ns.record_seconds == float("inf"):
+        raise UsageError(f"--record-seconds {ns.record_seconds!r}: expected seconds >= 0")
     return Settings(
+        artifacts=ns.artifacts,
+        record=[topic if topic.startswith("/") else f"/{topic}" for topic in ns.record],
+        record_seconds=ns.record_seconds,
         repeat=ns.repeat,
         expectations=expectations,
         timeout=ns.timeout,

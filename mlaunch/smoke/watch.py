@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from mlaunch.parts.ros1_graph import SharedMaster
     from mlaunch.plan.events import ProcessView
     from mlaunch.plan.steps import Plan, ProcessSpec
+    from mlaunch.smoke.recorder import Recorder
     from mlaunch.smoke.report import Window
 
 # At the end, the youngest process is given up to this long since its start before the stop
@@ -71,6 +72,7 @@ class SmokeRun(Part):
         *,
         lifecycle: LifecycleManager | None = None,
         graph: SharedMaster | None = None,
+        recorder: Recorder | None = None,
     ) -> None:
         from mlaunch.parts.handoff import LoopCall, SharedGraph
 
@@ -97,9 +99,12 @@ class SmokeRun(Part):
             self.graph = SharedGraph(graph_env, f"_mlaunch_test_{os.getpid()}")
         self._own_graph = lifecycle is None or graph is not None
         self._checker: threading.Thread | None = None
+        # The last seconds of the named topics, for the evidence of a failure: fed by the graph.
+        self.recorder = recorder if graph is None else None
+        self._recording = False
         supervisor.events.subscribe(self._on_event)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
-        if any(e.kind in GRAPH_KINDS for e in expectations):
+        if any(e.kind in GRAPH_KINDS for e in expectations) or self.recorder is not None:
             self._start_checker()
 
     def elapsed(self) -> float:
@@ -395,6 +400,12 @@ class SmokeRun(Part):
             failing = self._graph_expectations()
             self.loop.call_soon(lambda: self._fail_all(failing, message))
             return
+        if self.recorder is not None and not self._recording:
+            self._recording = True
+            try:
+                self.recorder.attach(graph)
+            except RosBridgeError:
+                pass  # the checks say what is wrong with the graph; the evidence lacks a recording
         probe = GraphProbe(graph)
         while not self._stop.is_set():
             try:
