@@ -132,3 +132,32 @@ def test_check_names_the_lifecycle_node_tag_as_newer(tmp_path: Path, env: dict[s
         f"{path}:2:1: the tag 'lifecycle_node' is newer than Jazzy: launch_ros after 0.29.3"
         " (Rolling, ros2/launch_ros#482) has it" in done.stdout
     ), done.stdout
+
+
+@pytest.mark.parametrize("ext", ["xml", "yaml"])
+def test_a_composable_lifecycle_node_says_it_is_newer_and_not_run_yet(
+    tmp_path: Path, env: dict[str, str], ext: str
+) -> None:
+    """It was "unexpected tag <composable_lifecycle_node> (did you mean 'composable_node'?)"."""
+    path = tmp_path / f"c.launch.{ext}"
+    if ext == "xml":
+        path.write_text(
+            '<launch>\n<node_container pkg="rclcpp_components" exec="component_container"'
+            ' name="c" namespace="">\n<composable_lifecycle_node pkg="p" plugin="p::N" name="n"'
+            ' autostart="true"/>\n</node_container>\n</launch>\n'
+        )
+    else:
+        path.write_text(
+            "launch:\n- node_container:\n    pkg: rclcpp_components\n"
+            "    exec: component_container\n    name: c\n    namespace: ''\n"
+            "    composable_lifecycle_node:\n    - {pkg: p, plugin: p::N, name: n}\n"
+        )
+    done = run_mlaunch(str(path), "--print", env=env)
+    assert done.returncode == 2
+    assert "composable_lifecycle_node" in done.stderr and (
+        "is newer than Jazzy (launch_ros 0.29.3, Rolling, ros2/launch_ros#480) and mlaunch does"
+        " not run it yet: write a composable_node" in done.stderr
+    ), done.stderr
+    checked = run_mlaunch(str(path), "--check", env=env)
+    assert checked.returncode == 1
+    assert "mlaunch does not run it yet either" in checked.stdout, checked.stdout

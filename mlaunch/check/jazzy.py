@@ -171,6 +171,10 @@ NEWER_TAGS = {
     "for": _LAUNCH_3_8,
     "lifecycle_node": "launch_ros after 0.29.3 (Rolling, ros2/launch_ros#482)",
 }
+# Sub-entities newer than Jazzy (inside node_container, load_composable_node).
+NEWER_SUBENTITIES = {
+    "composable_lifecycle_node": "launch_ros 0.29.3 (Rolling, ros2/launch_ros#480)",
+}
 NEWER_SUBSTITUTIONS = {
     "for-var": _LAUNCH_3_8,
     "index": _LAUNCH_3_8,
@@ -189,9 +193,8 @@ NEWER_PYTHON = {
 }
 
 
-def newer(what: str, release: str) -> str:
-    """The finding for syntax newer than Jazzy."""
-    return (
-        f"{what} is newer than Jazzy: {release} has it, ros2 launch (Jazzy) fails on it;"
-        " mlaunch runs it"
+def newer(what: str, release: str, *, runs: bool = True) -> str:
+    """The finding for syntax newer than Jazzy (``runs``: whether mlaunch runs it)."""
+    return f"{what} is newer than Jazzy: {release} has it, ros2 launch (Jazzy) fails on it;" + (
+        " mlaunch runs it" if runs else " mlaunch does not run it yet either"
     )

@@ -152,6 +152,10 @@ class _Walker:
             kind = table.get(name)
             if kind == "xml-only" and self.fmt == "yaml":
                 kind = None
+            if kind is None and name in jazzy.NEWER_SUBENTITIES:
+                newer = jazzy.newer(repr(name), jazzy.NEWER_SUBENTITIES[name], runs=False)
+                self.add(e, newer, attr)
+                continue
             if kind is None:
                 self.add(
                     e, f"Jazzy's {e.tag} has no attribute {name!r}: ros2 launch rejects it", attr
@@ -166,6 +170,10 @@ class _Walker:
         if self.fmt == "xml" and e.tag not in jazzy.TAKES_ACTIONS:
             for child in e.children or []:
                 kind = table.get(child.tag, "")
+                if child.tag in jazzy.NEWER_SUBENTITIES:
+                    release = jazzy.NEWER_SUBENTITIES[child.tag]
+                    self.add(child, jazzy.newer(f"<{child.tag}>", release, runs=False))
+                    continue
                 if not kind.startswith("entities:"):
                     self.add(child, f"Jazzy's {e.tag} takes no <{child.tag}> inside it")
                     continue
