@@ -54,6 +54,8 @@ def test_archives_that_are_not_the_pinned_ones_are_refused(tmp_path: Path) -> No
 
 @pytest.mark.skipif(bool(missing()), reason=f"Debian packages missing: {missing()}")
 def test_arbotix_is_built_once_and_found_as_roslaunch_finds_it(tmp_path: Path) -> None:
+    before = build(str(SOURCES), "--cached", cache=tmp_path / "cache")
+    assert before.returncode == 3 and not before.stdout  # not built yet: setup checks and builds
     done = build(str(SOURCES), cache=tmp_path / "cache")
     assert done.returncode == 0, done.stderr
     prefix = Path(done.stdout.strip())
@@ -62,6 +64,7 @@ def test_arbotix_is_built_once_and_found_as_roslaunch_finds_it(tmp_path: Path) -
     again = build(str(SOURCES), cache=tmp_path / "cache")
     assert again.stdout == done.stdout  # cached: the same prefix, not built again
     assert (prefix / ".complete").stat().st_mtime_ns == complete
+    assert build(str(SOURCES), "--cached", cache=tmp_path / "cache").stdout == done.stdout
     # A shell that sources its setup.sh: roslib finds the driver, Debian's Python imports it
     probe = (
         "import roslib.packages, rospkg; import arbotix_msgs.srv, control_msgs.msg;"

@@ -324,9 +324,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--missing", action="store_true", help="print the Debian packages it needs that are missing"
     )
+    parser.add_argument(
+        "--cached", action="store_true", help="print the prefix if it is built, else exit 3"
+    )
     args = parser.parse_args(argv)
     try:
-        if args.missing:
+        if args.cached:
+            done = cache_root() / f"prefix-{build_key(args.sources.resolve())}"
+            if not (done / ".complete").is_file():
+                return 3
+            print(done)
+        elif args.missing:
             print(" ".join(missing_debian_packages()))
         elif args.key:
             print(build_key(args.sources.resolve()))
