@@ -2,9 +2,9 @@
 """Upstream sources by repository and commit: what `scripts/setup --real-nodes` and
 `--ros1-sources` build when no folder of archives is given.
 
-A pin file in the repository (`scripts/real_nodes/sources.tsv`, `scripts/ros1_sources/sources.tsv`)
+A pin file in the repository (`scripts/sources-ros2.tsv`, `scripts/sources-ros1.tsv`)
 names, per archive, the repository, the ref it was taken from, the commit, the paths of the
-repository it keeps, and the sha256 of that content (`content`: every kept file's path, mode and
+repository it keeps, and the sha256 of that content (`content`: every kept file's path, executable bit and
 bytes, in path order, so it does not depend on how an archive was packed). `fetch` downloads each
 repository's tarball at its commit, keeps the paths, checks the content against the pin, and
 packs it as `ARCHIVE` (one top folder named like it) into a folder with a MANIFEST.tsv: the folder

@@ -23,9 +23,10 @@ sys.path.insert(0, str(REPO / "scripts"))
 import sources
 
 COMMIT = "0123456789abcdef0123456789abcdef01234567"
+# The pins (scripts/sources-NAME.tsv) -> CI's copy of the same archives.
 CI_SOURCES = {
-    "real_nodes": REPO.parent / "shared" / "ros2-src",
-    "ros1_sources": REPO.parent / "shared" / "ros1-src",
+    "ros2": REPO.parent / "shared" / "ros2-src",
+    "ros1": REPO.parent / "shared" / "ros1-src",
 }
 
 
@@ -157,12 +158,12 @@ def test_the_command_line_says_one_line_on_failure(tmp_path: Path, forge: Forge)
     assert done.stderr.splitlines()[-1].startswith("sources: cannot download ")
 
 
-@pytest.mark.parametrize("pin_folder", sorted(CI_SOURCES))
-def test_the_pins_match_the_archives_ci_builds_from(pin_folder: str) -> None:
-    ci = CI_SOURCES[pin_folder]
+@pytest.mark.parametrize("name", sorted(CI_SOURCES))
+def test_the_pins_match_the_archives_ci_builds_from(name: str) -> None:
+    ci = CI_SOURCES[name]
     if not (ci / "MANIFEST.tsv").is_file():
         pytest.skip(f"no copy of the source archives beside the clone ({ci})")
-    pinned = sources.read_pins(REPO / "scripts" / pin_folder / "sources.tsv")
+    pinned = sources.read_pins(REPO / "scripts" / f"sources-{name}.tsv")
     with (ci / "MANIFEST.tsv").open(newline="") as handle:
         manifest = {r["archive"]: r for r in csv.DictReader(handle, delimiter="\t")}
     assert sorted(p["archive"] for p in pinned) == sorted(manifest)

@@ -71,9 +71,7 @@ PACKAGES: tuple[tuple[str, str, str], ...] = (
     ("demos", "demo_nodes_cpp", "demo_nodes_cpp"),
     ("demos", "composition", "composition"),
 )
-# Not part of what is built: setup's side, the pure Python wheel, the pins of the sources
-# (scripts/sources.py checks those against the archives' content, which the key holds).
-NOT_BUILT = ("install", "python_packages.py", "sources.tsv")
+NOT_BUILT = ("install", "python_packages.py")
 JOBS = 2  # the machines this runs on share 2 cores between several builds and test runs
 SITE = f"lib/python{sys.version_info.major}.{sys.version_info.minor}/site-packages/"
 # Debian's libpython (package libpython3.X): see _cmake_arguments.
