@@ -17,7 +17,7 @@ from conftest import requires_rclpy
 from ports import free_port
 from procutil import Running, clean_env, demo_package, mlaunch, run_mlaunch
 
-from mlaunch import __version__
+from mlaunch import __version__, standins
 from mlaunch.app.options import VIEWER_PORT_ENV, build_parser
 from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES
 from mlaunch.engine.output import Printer
@@ -296,6 +296,7 @@ def test_use_sim_time_that_is_not_a_boolean_names_its_declaration(
 def _viewer_process(output: str) -> Process:
     argv = (PY, "-m", "mlaunch.standins.viewer", "-d", "x.rviz")
     spec = ProcessSpec("rviz2-1", argv, {}, {}, output=output, standin="rviz2/rviz2")
+    standins.equip(spec)  # what resolve gives a stand-in's spec
     process = Process(spec, 0)
     process.pid = 4242
     return process
@@ -325,9 +326,10 @@ def test_the_viewers_address_is_said_once_in_every_mode(
 def test_other_processes_lines_like_the_address_are_theirs() -> None:
     seen: list[bytes] = []
     printer = Printer(out=seen.append, quiet=True)
-    process = _viewer_process("screen")
-    process.spec.argv = (PY, "-c", "print('viewer: open http://example/')")
-    process.spec.standin = None
+    spec = ProcessSpec("rviz2-1", (PY, "-c", "print('viewer: open http://example/')"), {}, {})
+    standins.equip(spec)  # not a stand-in: nothing to say for it
+    assert spec.announce is None
+    process = Process(spec, 0)
     printer(Started(process))
     printer(Output(process, "stdout", b"viewer: open http://example/\n"))
     assert b"".join(seen) == b""  # a plain child's stdout under -q: not said

@@ -162,3 +162,18 @@ def test_the_architecture_page_names_only_modules_that_exist():
         }
     )
     assert not missing, f"docs/architecture.md names modules that do not exist: {missing}"
+
+
+def test_the_engine_knows_no_stand_in():
+    """A stand-in reaches the engine through the spec's general seams (``announce``,
+    ``prepare``), filled in by resolve from the stand-ins' table (issue 31 point 3)."""
+    edges = [
+        str(edge)
+        for edge in layering.imports(ROOT)
+        if layering.package_of(edge.source) == "engine"
+        and layering.package_of(edge.target) == "standins"
+    ]
+    assert edges == []
+    engine = Path(ROOT) / "engine"
+    named = [p.name for p in engine.glob("*.py") if "viewer" in p.read_text().lower()]
+    assert named == []

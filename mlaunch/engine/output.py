@@ -24,7 +24,7 @@ from mlaunch.engine.logfiles import (
     log_file_name,
     tail_lines,
 )
-from mlaunch.engine.sayings import VIEWER_ADDRESS, Sayings
+from mlaunch.engine.sayings import Sayings
 from mlaunch.engine.screen import Screen
 from mlaunch.plan.events import Event, Output, Summary
 
@@ -143,7 +143,8 @@ class Printer:
         self._muted: set[str] = set()
         self._dirty: set[LogFile] = set()
         self._log_errors: list[str] = []
-        self._viewers: set[str] = set()  # labels of viewer stand-ins, whose address is said
+        # label -> the start of its stdout lines that mlaunch says itself (ProcessSpec.announce)
+        self._announcing: dict[str, bytes] = {}
         self.sayings = Sayings(self)
         if self.log_dir:
             self._launch_log = self._open("launch.log", lazy=False, rotate=False)
@@ -337,35 +338,32 @@ class Printer:
         else:
             self.sayings(event)
 
-    def say_address_of(self, label: str) -> None:
-        """``label`` is a viewer stand-in: its address line is said whatever its output mode."""
-        self._viewers.add(label)
+    def say_lines_of(self, label: str, start: bytes) -> None:
+        """``label``'s stdout lines that begin with ``start`` are said whatever its output mode."""
+        self._announcing[label] = start
 
     def _summary(self, event: Summary) -> None:
         self.block(event.text)
 
     def _output(self, event: Output) -> None:
         process = event.process
-        if (
-            self._viewers
-            and process.label in self._viewers
-            and event.stream == "stdout"
-            and VIEWER_ADDRESS in event.data
-        ):
-            self._viewer_output(process, event.data)
+        start = self._announcing.get(process.label) if self._announcing else None
+        if start is not None and event.stream == "stdout" and start in event.data:
+            self._announced_output(process, event.data, start)
         else:
             self.output(process.label, event.stream, process.spec.output, event.data)
 
-    def _viewer_output(self, process: ProcessView, data: bytes) -> None:
-        """A viewer stand-in's stdout with its address line, which mlaunch says itself.
+    def _announced_output(self, process: ProcessView, data: bytes, start: bytes) -> None:
+        """A process's stdout with lines that say where to reach it, which mlaunch says itself.
 
-        The address must be seen whatever the viewer's output mode (``log`` hides its stdout)
-        and under -q, and only once: the child's copy goes to its own log file only.
+        Such a line (the address of a stand-in's page) must be seen whatever the output mode
+        (``log`` hides its stdout) and under -q, and only once: the child's copy goes to its own
+        log file.
         """
         label, mode = process.label, process.spec.output
         rest = b""
         for line in data.splitlines(keepends=True):
-            if not line.startswith(VIEWER_ADDRESS):
+            if not line.startswith(start):
                 rest += line
                 continue
             if rest:

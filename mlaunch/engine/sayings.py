@@ -40,11 +40,6 @@ if TYPE_CHECKING:
     from mlaunch.engine.output import Printer
     from mlaunch.plan.events import ProcessView
 
-# The viewer stand-in (mlaunch.standins.viewer) prints its page's address as a line starting
-# with this on stdout; mlaunch says the line itself, in every output mode and under -q.
-VIEWER_MODULE = "mlaunch.standins.viewer"
-VIEWER_ADDRESS = b"viewer: open "
-
 
 class Sayings:
     """The words for the run's records, said through ``printer``."""
@@ -68,8 +63,8 @@ class Sayings:
             self.message(
                 "INFO", spec.label, f"{spec.standin}: not installed, using mlaunch's stand-in"
             )
-            if VIEWER_MODULE in spec.argv:
-                self.printer.say_address_of(spec.label)
+        if spec.announce is not None and process.restarts == 0:
+            self.printer.say_lines_of(spec.label, spec.announce)
         self.message("INFO", spec.label, f"process started with pid [{process.pid}]")
 
     def _failed_to_start(self, event: FailedToStart) -> None:

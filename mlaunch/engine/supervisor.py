@@ -403,10 +403,8 @@ class Supervisor:
         if self.shutting_down:
             self.events.emit(NotStarted(spec))
             return None
-        if spec.standin is not None:  # a restarted viewer keeps its port (and the open tab)
-            from mlaunch.standins import pin_viewer_port
-
-            pin_viewer_port(spec.argv, spec.env)
+        if spec.prepare is not None:  # a stand-in's page keeps its port on a restart
+            spec.prepare(spec)
         process = self.spawner(spec, next(self._index), restarts)
         record = self.records.get(spec.label)
         if record is None:

@@ -20,6 +20,7 @@ from mlaunch.plan.record import Record
 # typing.TYPE_CHECKING.
 TYPE_CHECKING = False
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from typing import Any
 
     from mlaunch.plan.machine import MachineSpec
@@ -134,6 +135,8 @@ class ProcessSpec(Record):
         "temp_files",
         "machine",
         "launch_prefix",
+        "announce",
+        "prepare",
     )
     __slots__ = _fields
 
@@ -159,6 +162,8 @@ class ProcessSpec(Record):
         temp_files: tuple[str, ...] = (),
         machine: MachineSpec | None = None,
         launch_prefix: tuple[str, ...] = (),
+        announce: bytes | None = None,
+        prepare: Callable[[ProcessSpec], None] | None = None,
     ) -> None:
         self.label = label
         self.argv = argv
@@ -182,6 +187,12 @@ class ProcessSpec(Record):
         self.machine = machine
         # The launch prefix's words at the head of argv (--launch-prefix, prefix=), for --print.
         self.launch_prefix = launch_prefix
+        # The start of the stdout lines in which the program says where to reach it (a stand-in
+        # viewer's page): mlaunch says those lines itself, in every output mode and under -q.
+        self.announce = announce
+        # Called with the spec before each start (a stand-in viewer keeps its port across
+        # restarts, so an open page keeps working).
+        self.prepare = prepare
 
     @property
     def base_name(self) -> str:

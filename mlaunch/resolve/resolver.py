@@ -265,6 +265,10 @@ class Resolver:
             self.plan.needs.update(needs)
 
     def spawn(self, spec: ProcessSpec) -> None:
+        if spec.standin is not None:
+            from mlaunch import standins
+
+            standins.equip(spec)
         self.add(Spawn(origin=spec.origin, spec=spec))
 
     def emit(self, event: object, step: Step | None) -> None:

@@ -11,6 +11,10 @@ import importlib.util
 import os
 import sys
 
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
+if TYPE_CHECKING:
+    from mlaunch.plan.steps import ProcessSpec
+
 # The stand-ins' shares: a folder per package whose launch files other launch files include
 # (ros_gz_sim's gz_sim.launch.py, ...), found when the package is neither installed nor checked
 # out (mlaunch.ros.packages.PackageIndex.standin_share). Their programs are the stand-ins below.
@@ -63,7 +67,21 @@ def _module_argv(module: str) -> list[str]:
     return [sys.executable, "-m", f"mlaunch.standins.{module}"]
 
 
-def pin_viewer_port(argv: tuple[str, ...] | list[str], env: dict[str, str]) -> None:
+# The viewer stand-in (mlaunch.standins.viewer) prints its page's address as a line starting
+# with this on stdout.
+VIEWER_ADDRESS = b"viewer: open "
+
+
+def equip(spec: ProcessSpec) -> None:
+    """What a stand-in's process carries for the engine, through the spec's general seams: the
+    viewer's address line is said by mlaunch in every output mode (``announce``), and its port
+    is pinned before each start (``prepare``)."""
+    if spec.standin is not None and list(spec.argv[:3]) == _module_argv("viewer"):
+        spec.announce = VIEWER_ADDRESS
+        spec.prepare = pin_viewer_port
+
+
+def pin_viewer_port(spec: ProcessSpec) -> None:
     """Give a viewer stand-in that would take any free port a fixed free one, in its ``env``.
 
     The viewer picks a port when it starts; restarted (``mlaunch ctl restart``, respawn) it
@@ -72,13 +90,13 @@ def pin_viewer_port(argv: tuple[str, ...] | list[str], env: dict[str, str]) -> N
     """
     from mlaunch.standins.viewer_config import PORT_ENV
 
-    if list(argv[:3]) != _module_argv("viewer") or env.get(PORT_ENV, "").strip() not in ("", "0"):
+    if spec.env.get(PORT_ENV, "").strip() not in ("", "0"):
         return
     import socket
 
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
-        env[PORT_ENV] = str(probe.getsockname()[1])
+        spec.env[PORT_ENV] = str(probe.getsockname()[1])
 
 
 def standin_for(argv: list[str]) -> list[str] | None:
