@@ -213,3 +213,28 @@ def test_the_jtbot_passes_in_a_domain_of_its_own() -> None:
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "(a domain of its own, discovery LOCALHOST)" in done.stdout
+
+
+@pytest.mark.parametrize("shared", [True, False])
+def test_a_test_sharing_its_domain_with_another_says_so(
+    tmp_path: Path, ros_env: dict[str, str], shared: bool
+) -> None:
+    pytest.importorskip("rclpy")
+    path = _says_domain(tmp_path)
+    env = _env(ROS_DOMAIN_ID=ros_env["ROS_DOMAIN_ID"]) if shared else _env()
+    # Both wait for a topic nobody publishes, so both look at their graph the whole time.
+    args = ["test", str(path), "--hold", "0", "--expect-topic", "/nobody", "--within", "15"]
+    runs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "mlaunch", *args],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        for _ in range(2)
+    ]
+    outs = [run.communicate(timeout=120)[0] for run in runs]
+    for out in outs:
+        assert "topic /nobody publishes" in out, out
+        assert ("another test shares this ROS domain" in out) == shared, out

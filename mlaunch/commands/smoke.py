@@ -435,14 +435,23 @@ def supervise(
     smoke = runs[0]
     smoke.conclude()
     words, domain_id = isolation if native is None else ("", "")  # ROS 1 has no domains
+    notes = [f"ROS domain {words}"] if words else []
+    properties = {"ros_domain_id": domain_id} if domain_id else {}
+    if smoke.others:
+        shown = ", ".join(sorted(smoke.others)[:3])
+        notes.append(
+            f"warning: another test shares this ROS domain (its graph node {shown} was seen):"
+            " its nodes and topics may have been taken for this launch's"
+        )
+        properties["other_tests_seen"] = str(len(smoke.others))
     report = Report(
         path,
         expectations,
         smoke.rings,
         smoke.elapsed(),
         smoke.window(),
-        properties={"ros_domain_id": domain_id} if domain_id else {},
-        notes=[f"ROS domain {words}"] if words else [],
+        properties=properties,
+        notes=notes,
     )
     failed = not report.passed or code != EXIT_OK
     if settings.artifacts or failed:

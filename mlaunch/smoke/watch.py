@@ -48,6 +48,9 @@ _PHASES = {
     "holding": "during the hold",
     "done": "in the shutdown",
 }
+# The name of a test run's own graph node (its pid follows): another one in the graph means
+# another test shares the ROS domain.
+TEST_NODE = "_mlaunch_test_"
 GRAPH_KINDS = frozenset({"topic", "service", "node", "lifecycle", "clock", "tf", "param", "action"})
 _ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 
@@ -84,6 +87,8 @@ class SmokeRun(Part):
         self.rings: dict[str, deque[str]] = {}
         self._ended: set[str] = set()  # labels of processes that ended and are not respawned
         self.ready_at: float | None = None  # seconds from the start; None: never ready
+        # Other mlaunch test runs' graph nodes seen in this run's graph: a shared domain.
+        self.others: set[str] = set()
         self.ended_at: float | None = None  # when the watch ended (the shutdown was asked)
         self.loop = LoopCall(supervisor.selector)
         self.started_at = supervisor.clock()
@@ -96,7 +101,7 @@ class SmokeRun(Part):
             self.graph = lifecycle.graph
         else:
             graph_env = _graph_environ(supervisor.plan)
-            self.graph = SharedGraph(graph_env, f"_mlaunch_test_{os.getpid()}")
+            self.graph = SharedGraph(graph_env, f"{TEST_NODE}{os.getpid()}")
         self._own_graph = lifecycle is None or graph is not None
         self._checker: threading.Thread | None = None
         # The last seconds of the named topics, for the evidence of a failure: fed by the graph.
@@ -417,6 +422,9 @@ class SmokeRun(Part):
                     (e, False, f"ROS graph error: {exc}") for e in self._graph_expectations()
                 ]
             self.loop.call_soon(lambda f=findings: self._apply(f))  # type: ignore[misc]
+            if probe.others - self.others:
+                others = set(probe.others)
+                self.loop.call_soon(lambda o=others: self.others.update(o))  # type: ignore[misc]
             if not self._graph_expectations():
                 # A component loaded later may add one as this thread ends: the loop looks.
                 me = threading.current_thread()
@@ -523,9 +531,12 @@ class GraphProbe:
         self.watches: dict[str, Any] = {}
         self.clock_first: float | None = None
         self.tf: TfLinks | None = None
+        self.others: set[str] = set()  # other mlaunch test runs' graph nodes
 
     def check(self, expectations: list[Expectation]) -> list[tuple[Expectation, bool, str]]:
         nodes = self.graph.node_names()
+        mine = f"{TEST_NODE}{os.getpid()}"
+        self.others.update(n for n in nodes if n.startswith(f"/{TEST_NODE}") and n[1:] != mine)
         topics = self.graph.topic_types()
         wants = {e.kind for e in expectations}
         services = self.graph.service_names() if wants & {"service", "action"} else set()
