@@ -148,6 +148,8 @@ def test_subcommands_and_options(workspace: tuple[Path, dict[str, str]], tmp_pat
         "never",
     ]
     offered = complete("mlaunch test dev.launch.py --expect-t", here, env, tmp_path)
+    assert sorted(offered) == ["--expect-tf", "--expect-topic"]
+    offered = complete("mlaunch test dev.launch.py --expect-to", here, env, tmp_path)
     assert offered == ["--expect-topic"]
     assert complete("mlaunch test dev.launch.py sp", here, env, tmp_path) == ["speed:="]
     assert complete("mlaunch export dev.launch.py --to", here, env, tmp_path) == ["--to"]
