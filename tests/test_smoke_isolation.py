@@ -238,3 +238,17 @@ def test_a_test_sharing_its_domain_with_another_says_so(
     for out in outs:
         assert "topic /nobody publishes" in out, out
         assert ("another test shares this ROS domain" in out) == shared, out
+
+
+def test_launch_testing_files_run_at_once_too(tmp_path: Path) -> None:
+    values = {"imports": "import pytest", "first": "", "user": "-"}
+    files = []
+    for name in ("a.test.py", "b.test.py"):
+        files.append(tmp_path / name)
+        files[-1].write_text(LAUNCH_TEST % values)
+    report = tmp_path / "all.xml"
+    args = [str(f) for f in files]
+    done = run_mlaunch("test", *args, "-j", "2", "--junit", str(report), env=_env(), timeout=120)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "mlaunch test: 2 of 2 passed" in done.stdout
+    assert len(ET.parse(report).getroot().findall("testsuite")) == 2

@@ -47,6 +47,11 @@ def command(args: Sequence[str]) -> int:
     from mlaunch.app.options import parse_options
 
     args = list(args)
+    many = _many(args)  # several files (launch_testing files among them), each its own run
+    if many is not None:
+        from mlaunch.commands.smoke_many import run_many
+
+        return run_many(*many)
     from mlaunch.launch_testing.launch_test import is_launch_test_file
 
     if any(is_launch_test_file(a) for a in args if not a.startswith("-")):
@@ -54,11 +59,6 @@ def command(args: Sequence[str]) -> int:
         from mlaunch.launch_testing.launch_test import main as launch_test_main
 
         return launch_test_main(args, prog="mlaunch test")
-    many = _many(args)
-    if many is not None:
-        from mlaunch.commands.smoke_many import run_many
-
-        return run_many(*many)
     as_json = _take_json(args)
     mine, rest = split_arguments(args)
     try:
