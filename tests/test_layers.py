@@ -177,3 +177,24 @@ def test_the_engine_knows_no_stand_in():
     engine = Path(ROOT) / "engine"
     named = [p.name for p in engine.glob("*.py") if "viewer" in p.read_text().lower()]
     assert named == []
+
+
+def test_the_engine_s_modules_import_each_other_one_way():
+    """The launch file's handlers see the run through a protocol (``HandledRun``), the sayings
+    their printer through one (``Saying``): no module of the engine imports back (issue 31)."""
+    cycles = [c for c in layering.module_cycles(ROOT) if layering.package_of(c[0]) == "engine"]
+    assert cycles == []
+
+
+def test_resolve_edits_no_private_field_of_the_launch_context():
+    """A deferred body's visit borrows the context through ``LaunchContext.lend``."""
+    import re
+
+    resolve = Path(ROOT) / "resolve"
+    found = [
+        f"{path.name}:{number}"
+        for path in sorted(resolve.glob("*.py"))
+        for number, line in enumerate(path.read_text().splitlines(), 1)
+        if re.search(r"context\._[a-z]", line)
+    ]
+    assert found == []

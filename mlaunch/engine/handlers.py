@@ -34,16 +34,37 @@ from mlaunch.plan.steps import AddHandler, Deferred
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Protocol
 
-    from mlaunch.engine.supervisor import Supervisor
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.events import EventStream, ProcessView
+
+    class HandledRun(Protocol):
+        """What the launch file's handlers use of the run (the Supervisor is one): its
+        processes, the handlers' bodies fired, a failed handler said, a stop, the shutdown."""
+
+        @property
+        def processes(self) -> list[Process]: ...
+
+        @property
+        def shutting_down(self) -> bool: ...
+
+        @property
+        def events(self) -> EventStream: ...
+
+        def fire(self, body: Deferred, event: object, shutting_down: bool | None = None) -> None:
+            """Resolve and carry out ``body`` for ``event``."""
+
+        def handler_failed(self, message: str) -> None: ...
+
+        def stop(self, process: Process) -> None: ...
+
+        def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None: ...
 
 
 class LaunchHandlers:
     """The registered handlers of one run, newest first (as ROS 2), and their dispatch."""
 
-    def __init__(self, supervisor: Supervisor) -> None:
+    def __init__(self, supervisor: HandledRun) -> None:
         self.supervisor = supervisor
         self.handlers: list[AddHandler] = []
 

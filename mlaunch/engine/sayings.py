@@ -35,16 +35,27 @@ from mlaunch.plan.events import (
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Callable
-    from typing import Any
+    from typing import Any, Protocol
 
-    from mlaunch.engine.output import Printer
     from mlaunch.plan.events import ProcessView
+
+    class Saying(Protocol):
+        """What the sayings write through (the run's Printer, mlaunch.engine.output)."""
+
+        def message(self, level: str, source: str, text: str, *, always: bool = False) -> None:
+            """``[LEVEL] [source]: text``, on screen and in the run's log."""
+
+        def register(self, label: str, index: int) -> None:
+            """Prepare a process's prefix and log file."""
+
+        def say_lines_of(self, label: str, start: bytes) -> None:
+            """Say ``label``'s stdout lines that begin with ``start`` in every output mode."""
 
 
 class Sayings:
     """The words for the run's records, said through ``printer``."""
 
-    def __init__(self, printer: Printer) -> None:
+    def __init__(self, printer: Saying) -> None:
         self.printer = printer
         self.message = printer.message
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash

@@ -258,6 +258,12 @@ class LaunchContext:
         """Whether ``value`` (a list in the configurations) is also an enclosing scope's."""
         return any(value is v for configs, _ in self._scopes for v in configs.values())
 
+    def lend(self, values: Mapping[str, Any], warn: Callable[[str], None] | None) -> _Lent:
+        """``with context.lend(values, warn):`` the context as a timer's or a handler's body is
+        visited with it: ``values`` as its locals, its warnings to ``warn``; its own locals,
+        warnings and planner are back after (the run's live context, under launch's rule)."""
+        return _Lent(self, dict(values), warn)
+
     def file_locals(self, path: str) -> _FileLocals:
         """Locals of an included file: ThisLaunchFile and friends point at it inside."""
         return _FileLocals(self, path)
@@ -307,3 +313,27 @@ class _FileLocals:
 
     def __exit__(self, *exc_info: object) -> None:
         self.context._locals = self.saved
+
+
+class _Lent:
+    """``with context.lend(values, warn)`` (see ``LaunchContext.lend``)."""
+
+    __slots__ = ("context", "saved", "values", "warn")
+
+    def __init__(
+        self, context: LaunchContext, values: dict[str, Any], warn: Callable[[str], None] | None
+    ) -> None:
+        self.context = context
+        self.values = values
+        self.warn = warn
+        self.saved: tuple[Any, ...] = ()
+
+    def __enter__(self) -> LaunchContext:
+        context = self.context
+        self.saved = (context._locals, context._warn, context._planner)
+        context._locals, context._warn = self.values, self.warn
+        return context
+
+    def __exit__(self, *exc_info: object) -> None:
+        context = self.context
+        context._locals, context._warn, context._planner = self.saved

@@ -290,7 +290,7 @@ class Resolver:
         scoped: bool,
     ) -> None:
         # the includer's locals, before the include points them at the file
-        before = dict(self.context._locals)
+        before = self.context.get_locals_as_dict_of_scope()
         self.included[id(description)] = (path, origin, file_locals, scoped, before)
 
     def new_label(self, base: str) -> str:
@@ -469,16 +469,15 @@ def resolve_deferred(
         if message:
             plan.warnings.append(message)
     # the live context's locals (and planner) are the event's only now
-    saved = context._locals, context._warn, context._planner
-    context._locals, context._warn = dict(saved[0]), plan.warnings.append
+    values = context.get_locals_as_dict_of_scope()
     if isinstance(deferred.captured, LaunchContext):
         # The locals where the body was written (ThisLaunchFileDir, $(dirname) ...), as launch's
         # TimerAction restores the locals it captured: the file visited last is not the body's.
-        context._locals.update(deferred.captured.get_locals_as_dict_of_scope())
+        values.update(deferred.captured.get_locals_as_dict_of_scope())
     if event is not None:
-        context.extend_locals({"event": event})
-    resolver = Resolver(context, plan, labels=labels, options=options)
-    try:
+        values["event"] = event
+    with context.lend(values, plan.warnings.append):
+        resolver = Resolver(context, plan, labels=labels, options=options)
         with _package_search(options, context):
             entities = deferred.entities
             if deferred.callback is not None:
@@ -486,8 +485,6 @@ def resolve_deferred(
 
                 entities = returned_entities(resolver.call_user(deferred.callback, event, context))
             resolver.visit_all(entities)
-    finally:
-        context._locals, context._warn, context._planner = saved
     return plan
 
 
