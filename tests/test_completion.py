@@ -157,7 +157,7 @@ def test_subcommands_and_options(workspace: tuple[Path, dict[str, str]], tmp_pat
     assert complete("mlaunch convert o", here, env, tmp_path) == ["old.launch"]
     assert complete("mlaunch ctl re", here, env, tmp_path) == ["restart"]
     assert complete("mlaunch ctl stop ", here, env, tmp_path) == []
-    line = "python3 -m mlaunch test dev.launch.py --expect-t"
+    line = "python3 -m mlaunch test dev.launch.py --expect-to"
     assert complete(line, here, env, tmp_path, start=3) == ["--expect-topic"]
 
 
