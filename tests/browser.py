@@ -118,7 +118,10 @@ class Browser:
         return parsed
 
     def open(self, url: str) -> Page:
-        target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
+        # A window of its own: a background tab of a window is hidden (and gives its stream up).
+        target = self.send("Target.createTarget", {"url": "about:blank", "newWindow": True})[
+            "targetId"
+        ]
         attached = self.send("Target.attachToTarget", {"targetId": target, "flatten": True})
         page = Page(self, attached["sessionId"])
         page.send("Page.enable")

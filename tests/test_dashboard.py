@@ -349,3 +349,19 @@ def test_the_log_ring_numbers_every_line_and_says_what_it_dropped() -> None:
     assert hub.lines_since("a", 0)[0] == end + 1 - RING  # what a late reader missed
     assert hub.lines_since("other", 3) == (0, [], 3)
     assert hub.last["a"] == "y"
+
+
+@needs_chromium
+@pytest.mark.timeout(120)
+def test_four_tabs_with_their_log_views_open_all_stay_live(run: Run, tmp_path: Path) -> None:
+    # A browser opens at most six connections to one server: a page with a log view holds one
+    # stream, not two, so four such tabs (and a fifth page load) all get their updates.
+    with Browser(tmp_path / "profile") as browser:
+        pages = [browser.open(run.url + "?logs=ticker-1") for _ in range(5)]
+        for page in pages:
+            page.wait(
+                "Number(document.body.dataset.updates) > 1"
+                " && Number(document.getElementById('log').dataset.lines) > 5",
+                60,
+                "a tab's table and log view",
+            )
