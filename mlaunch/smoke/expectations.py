@@ -227,8 +227,9 @@ class Expect(Action):
     """An expectation for ``mlaunch test``, written in a Python launch file.
 
     Exactly one of ``topic`` (with ``rate`` in Hz), ``service``, ``node``, ``lifecycle`` (with
-    ``state``, default active) or ``output`` (a regex, with ``process``: a label or base name)
-    is given; ``within`` overrides the run's ``--timeout`` for it.
+    ``state``, default active), ``output`` or ``forbid`` (a regex, with ``process``: a label or
+    base name), ``tf`` ('PARENT:CHILD'), ``param`` ('/NODE:NAME=VALUE') or ``action`` is given;
+    ``within`` overrides the run's ``--timeout`` for it.
     """
 
     def __init__(
