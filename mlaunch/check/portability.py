@@ -28,7 +28,7 @@ TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.frontends.entity import Attr, Entity
+    from mlaunch.frontends.element import Attr, Element
 
 _YAML_STR = "tag:yaml.org,2002:str"
 _YAML_TYPES = {
@@ -107,15 +107,15 @@ class _Walker:
         self.findings: list[Finding] = []
         self.includes: list[str] = []
 
-    def add(self, e: Entity, message: str, attr: Attr | None = None) -> None:
+    def add(self, e: Element, message: str, attr: Attr | None = None) -> None:
         self.findings.append(Finding(e.where(attr), message))
 
-    def root(self, root: Entity) -> None:
+    def root(self, root: Element) -> None:
         self.attributes(root, jazzy.ROOT)
         for child in root.children or []:
             self.action(child)
 
-    def action(self, e: Entity) -> None:
+    def action(self, e: Element) -> None:
         table = jazzy.ACTIONS.get(e.tag)
         if e.tag in jazzy.NEWER_TAGS:
             self.add(e, jazzy.newer(f"the tag {e.tag!r}", jazzy.NEWER_TAGS[e.tag]))
@@ -147,7 +147,7 @@ class _Walker:
         elif self.fmt == "yaml" and children:
             self.add(e, f"Jazzy's {e.tag} takes no child entities")
 
-    def attributes(self, e: Entity, table: dict[str, str]) -> None:
+    def attributes(self, e: Element, table: dict[str, str]) -> None:
         for name, attr in e.attrs.items():
             kind = table.get(name)
             if kind == "xml-only" and self.fmt == "yaml":
@@ -179,7 +179,7 @@ class _Walker:
                     continue
                 self.attributes(child, jazzy.SUBENTITIES[kind.split(":", 1)[1]])
 
-    def value(self, e: Entity, name: str, attr: Attr, kind: str) -> None:
+    def value(self, e: Element, name: str, attr: Attr, kind: str) -> None:
         node = attr.value
         if not isinstance(node, str):  # a YAML node
             tag = getattr(node, "tag", "")
@@ -220,7 +220,7 @@ class _Walker:
         elif kind == "cmdline" and "$(" in text:
             self.cmdline(e, attr, text)
 
-    def substitutions(self, e: Entity, attr: Attr, text: str) -> None:
+    def substitutions(self, e: Element, attr: Attr, text: str) -> None:
         for match in _SUBSTITUTION.finditer(text):
             broken = jazzy.BROKEN_SUBSTITUTIONS.get(match.group(1))
             newer = jazzy.NEWER_SUBSTITUTIONS.get(match.group(1))
@@ -235,7 +235,7 @@ class _Walker:
                     attr,
                 )
 
-    def cmdline(self, e: Entity, attr: Attr, text: str) -> None:
+    def cmdline(self, e: Element, attr: Attr, text: str) -> None:
         """Jazzy shlex-splits each text piece between substitutions on its own."""
         import shlex
 
@@ -260,7 +260,7 @@ class _Walker:
                 )
                 return
 
-    def include(self, e: Entity) -> None:
+    def include(self, e: Element) -> None:
         attr = e.attrs.get("file")
         text = None if attr is None else attr.value if isinstance(attr.value, str) else None
         if text is None and attr is not None:

@@ -11,7 +11,7 @@ The composition modules are imported only when such a tag appears.
 
 from __future__ import annotations
 
-from mlaunch.frontends.entity import Entity
+from mlaunch.frontends.element import Element
 from mlaunch.frontends.fields import Builder, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item
 from mlaunch.frontends.process_tags import node_kwargs
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from typing import Any
 
 
-def _composable_node(e: Entity) -> Any:
+def _composable_node(e: Element) -> Any:
     from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 
     kwargs: dict[str, Any] = {
@@ -57,7 +57,7 @@ def _composable_node(e: Entity) -> Any:
     return description
 
 
-def _extra_argument(x: Entity) -> dict[Any, Any]:
+def _extra_argument(x: Element) -> dict[Any, Any]:
     """``{name: value}``; the value is a substitution, so it is typed as YAML (as launch_ros)."""
     from mlaunch.launch.substitution import TextSubstitution
 
@@ -67,11 +67,11 @@ def _extra_argument(x: Entity) -> dict[Any, Any]:
     return {as_key(name): TextSubstitution(text=value) if isinstance(value, str) else value}
 
 
-def _descriptions(e: Entity) -> list[Any]:
+def _descriptions(e: Element) -> list[Any]:
     return [_composable_node(c) for c in e.subentities("composable_node")]
 
 
-def _node_container(e: Entity) -> Any:
+def _node_container(e: Element) -> Any:
     from mlaunch.launch_ros.actions.composable_node_container import ComposableNodeContainer
 
     kwargs = node_kwargs(e)
@@ -84,7 +84,7 @@ def _node_container(e: Entity) -> Any:
     return ComposableNodeContainer(**kwargs)
 
 
-def _load_composable_node(e: Entity) -> Any:
+def _load_composable_node(e: Element) -> Any:
     from mlaunch.launch_ros.actions.load_composable_nodes import LoadComposableNodes
 
     target = required_text(e, "target")

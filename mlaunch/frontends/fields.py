@@ -4,26 +4,26 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from mlaunch.frontends.entity import Entity
+from mlaunch.frontends.element import Element
 from mlaunch.launch.frontend.template import Parts
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
     from typing import Any
 
-    Builder = Callable[[Entity], Any]
+    Builder = Callable[[Element], Any]
 else:  # the same at run time, without typing.Any
-    Builder = Callable[[Entity], object]
+    Builder = Callable[[Element], object]
 Value = str | Parts
 
 
-def finish_all(entities: list[Entity]) -> None:
+def finish_all(entities: list[Element]) -> None:
     """Check that each entity's attributes were all read."""
     for entity in entities:
         entity.finish()
 
 
-def required_text(e: Entity, name: str) -> Value:
+def required_text(e: Element, name: str) -> Value:
     """The text of a required attribute (an error names the tag and attribute when missing)."""
     value = e.text(name, required=True)
     assert value is not None
@@ -35,7 +35,7 @@ def as_key(value: Value) -> Any:
     return value if isinstance(value, str) else tuple(value)
 
 
-def pairs(entities: list[Entity], first: str, second: str) -> list[tuple[Value, Value]]:
+def pairs(entities: list[Element], first: str, second: str) -> list[tuple[Value, Value]]:
     """``<x first=.. second=..>`` sub-entities as (first, second) pairs, each checked."""
     out = []
     for sub in entities:
@@ -44,7 +44,7 @@ def pairs(entities: list[Entity], first: str, second: str) -> list[tuple[Value, 
     return out
 
 
-def required_literal(e: Entity, name: str) -> str:
+def required_literal(e: Element, name: str) -> str:
     """A required attribute that must be plain text, without substitutions."""
     value = e.literal(name, required=True)
     assert value is not None

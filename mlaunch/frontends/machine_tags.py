@@ -6,7 +6,7 @@ mlaunch.machines is imported only when such a tag appears.
 
 from __future__ import annotations
 
-from mlaunch.frontends.entity import Entity
+from mlaunch.frontends.element import Element
 from mlaunch.frontends.fields import Builder, required_text
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
@@ -23,7 +23,7 @@ MACHINE_ATTRIBUTES = {
 }
 
 
-def _machine(e: Entity) -> Any:
+def _machine(e: Element) -> Any:
     """``<machine name address user ssh-port env-loader default timeout/>``."""
     from mlaunch.machines.actions import Machine
 
@@ -45,7 +45,7 @@ def _machine(e: Entity) -> Any:
     return Machine(**kwargs)
 
 
-def _push_machine(e: Entity) -> Any:
+def _push_machine(e: Element) -> Any:
     from mlaunch.machines.actions import PushMachine
 
     return PushMachine(required_text(e, "name"))

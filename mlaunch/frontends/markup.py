@@ -14,10 +14,10 @@ from __future__ import annotations
 import importlib
 import os
 
-from mlaunch.frontends.entity import (
-    Entity as ReaderEntity,
+from mlaunch.frontends.element import (
+    Element as ReaderEntity,
 )
-from mlaunch.frontends.entity import (
+from mlaunch.frontends.element import (
     MissingAttributeError,
     UnexpectedEntityError,
 )

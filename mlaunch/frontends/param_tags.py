@@ -6,7 +6,7 @@ does not fit its type is an error at load time, with the file and line of the at
 
 from __future__ import annotations
 
-from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.element import Attr, Element
 from mlaunch.frontends.fields import Value, as_key, required_text
 from mlaunch.launch.substitution import Substitution, TextSubstitution
 from mlaunch.launch.substitutions.boolean_substitution import to_bool
@@ -23,7 +23,7 @@ def _descriptions() -> Any:
     return descriptions
 
 
-def parameter_item(p: Entity) -> Any:
+def parameter_item(p: Element) -> Any:
     """One top-level ``param`` of a node: a ParameterFile (``from``) or its own dict."""
     for name in ("name", "value", "type", "value-sep"):
         p.has(name)
@@ -41,7 +41,7 @@ def parameter_item(p: Entity) -> Any:
     return dict(_parameter_entries(p, None))
 
 
-def _parameter_entries(p: Entity, prefix: Value | None) -> list[tuple[Any, Any]]:
+def _parameter_entries(p: Element, prefix: Value | None) -> list[tuple[Any, Any]]:
     """``name: value`` entries of a param; nested params give dotted names (``a.b.c``)."""
     name = required_text(p, "name")
     key = name if prefix is None else _join(prefix, name)
@@ -87,7 +87,7 @@ PARAM_TYPES: dict[str, tuple[type | None, bool]] = {
 }
 
 
-def parameter_value(p: Entity, *, typed: bool) -> Any:
+def parameter_value(p: Element, *, typed: bool) -> Any:
     """The ``value`` of a param (a ParameterValue) or of set_parameter (the plain value)."""
     type_name = p.literal("type") if typed else None
     if type_name is not None and type_name not in PARAM_TYPES:
@@ -119,7 +119,7 @@ def parameter_value(p: Entity, *, typed: bool) -> Any:
 
 
 def _typed_value(
-    p: Entity, attr: Attr, element: type | None, is_list: bool, sep: str | None, *, keep_text: bool
+    p: Element, attr: Attr, element: type | None, is_list: bool, sep: str | None, *, keep_text: bool
 ) -> Any:
     node = attr.value
     kind = type(node).__name__
@@ -153,7 +153,7 @@ def _is_text(node: Any) -> bool:
     )
 
 
-def _yaml_item(p: Entity, attr: Attr, item: Any, element: type | None) -> Any:
+def _yaml_item(p: Element, attr: Attr, item: Any, element: type | None) -> Any:
     if isinstance(item, str) and "$(" in item:
         return p.template(attr, item)
     if isinstance(item, (dict, list)) or item is None:
@@ -161,7 +161,7 @@ def _yaml_item(p: Entity, attr: Attr, item: Any, element: type | None) -> Any:
     return _coerce(p, attr, item, element, False) if element is not None else item
 
 
-def _text_item(p: Entity, attr: Attr, piece: str, element: type | None) -> Any:
+def _text_item(p: Element, attr: Attr, piece: str, element: type | None) -> Any:
     """One piece of a value split by value-sep: typed by ``type``, else guessed."""
     if "$(" in piece:
         return p.template(attr, piece)
@@ -170,7 +170,7 @@ def _text_item(p: Entity, attr: Attr, piece: str, element: type | None) -> Any:
     return _coerce(p, attr, piece, element, False)
 
 
-def _uniform_list(p: Entity, attr: Attr, items: list[Any]) -> list[Any]:
+def _uniform_list(p: Element, attr: Attr, items: list[Any]) -> list[Any]:
     """ROS 2 parameters are uniform lists (ints and floats may mix, as floats)."""
     static = [i for i in items if not isinstance(i, (list, Substitution))]
     if static and not _uniform(static):
@@ -205,7 +205,7 @@ def _uniform(items: list[Any]) -> bool:
     return kinds <= {int, float} or (len(kinds) == 1 and kinds <= {bool, int, float, str})
 
 
-def _coerce(p: Entity, attr: Attr, value: Any, element: type | None, is_list: bool) -> Any:
+def _coerce(p: Element, attr: Attr, value: Any, element: type | None, is_list: bool) -> Any:
     """A value forced to the param's ``type``; a wrong one is an error at load time."""
     if element is None:
         return _guess(value) if isinstance(value, str) else value
@@ -218,7 +218,7 @@ def _coerce(p: Entity, attr: Attr, value: Any, element: type | None, is_list: bo
         raise p.error(f"parameter value {value!r} is not of type {element.__name__}", attr)
 
 
-def _guess_list(p: Entity, attr: Attr, value: Any) -> list[Any]:
+def _guess_list(p: Element, attr: Attr, value: Any) -> list[Any]:
     if isinstance(value, list):
         return value
     import yaml

@@ -7,7 +7,7 @@ The launch_ros actions are imported only when such a tag appears.
 from __future__ import annotations
 
 import mlaunch.launch.actions as core
-from mlaunch.frontends.entity import Entity
+from mlaunch.frontends.element import Element
 from mlaunch.frontends.fields import Builder, Value, as_key, pairs, required_text
 from mlaunch.frontends.param_tags import parameter_item, parameter_value
 from mlaunch.launch.frontend.cmdline import split_parts
@@ -22,7 +22,7 @@ if TYPE_CHECKING:
 RESPAWN_WORDS = ("always", "on-failure", "on_failure", "never")
 
 
-def _executable(e: Entity) -> Any:
+def _executable(e: Element) -> Any:
     kwargs = _process_kwargs(e, label="name")
     cmd = split_command(e, "cmd")
     if not cmd or cmd == [""]:  # blank: ros2 launch would try to run the program ''
@@ -30,7 +30,7 @@ def _executable(e: Entity) -> Any:
     return core.ExecuteProcess(cmd=cmd, **kwargs)
 
 
-def _process_kwargs(e: Entity, *, label: str | None) -> dict[str, Any]:
+def _process_kwargs(e: Element, *, label: str | None) -> dict[str, Any]:
     """The ExecuteProcess keywords every process tag shares (executable, node, lifecycle_node)."""
     kwargs: dict[str, Any] = {}
 
@@ -68,7 +68,7 @@ def _process_kwargs(e: Entity, *, label: str | None) -> dict[str, Any]:
     return kwargs
 
 
-def _output(e: Entity) -> Value | None:
+def _output(e: Element) -> Value | None:
     value = e.text("output")
     if isinstance(value, str) and value not in OUTPUT_MODES:
         raise e.error(
@@ -78,7 +78,7 @@ def _output(e: Entity) -> Value | None:
     return value
 
 
-def _respawn(e: Entity) -> Any:
+def _respawn(e: Element) -> Any:
     """A bool, mlaunch's always/on-failure/never, or substitutions performed to one of them."""
     attr = e.attrs.get("respawn")
     if attr is not None and e.yaml_native(attr, ("tag:yaml.org,2002:bool",)) is not None:
@@ -97,7 +97,7 @@ def _respawn(e: Entity) -> Any:
         )
 
 
-def split_command(e: Entity, name: str) -> list[Any]:
+def split_command(e: Element, name: str) -> list[Any]:
     """A command-line attribute (``cmd``, ``args``, ``ros_args``) split into argv items.
 
     Whitespace outside quotes separates items; a substitution joins the item it touches (so
@@ -121,7 +121,7 @@ def _ros_actions() -> Any:
     return ros
 
 
-def node_kwargs(e: Entity) -> dict[str, Any]:
+def node_kwargs(e: Element) -> dict[str, Any]:
     kwargs = _process_kwargs(e, label=None)
 
     def put(key: str, value: Any) -> None:
@@ -146,12 +146,12 @@ def node_kwargs(e: Entity) -> dict[str, Any]:
     return kwargs
 
 
-def _node(e: Entity) -> Any:
+def _node(e: Element) -> Any:
     ros = _ros_actions()
     return ros.Node(**node_kwargs(e))
 
 
-def _lifecycle_node(e: Entity) -> Any:
+def _lifecycle_node(e: Element) -> Any:
     ros = _ros_actions()
     autostart = e.flag("autostart")
     kwargs = node_kwargs(e)
@@ -163,36 +163,36 @@ def _lifecycle_node(e: Entity) -> Any:
     return ros.LifecycleNode(**kwargs)
 
 
-def _push_ros_namespace(e: Entity) -> Any:
+def _push_ros_namespace(e: Element) -> Any:
     ros = _ros_actions()
     cls = getattr(ros, "PushRosNamespace", None) or ros.PushROSNamespace
     return cls(required_text(e, "namespace"))
 
 
-def _set_parameter(e: Entity) -> Any:
+def _set_parameter(e: Element) -> Any:
     ros = _ros_actions()
     value = parameter_value(e, typed=False)
     return ros.SetParameter(name=required_text(e, "name"), value=value)
 
 
-def _set_parameters_from_file(e: Entity) -> Any:
+def _set_parameters_from_file(e: Element) -> Any:
     ros = _ros_actions()
     return ros.SetParametersFromFile(required_text(e, "filename"))
 
 
-def _set_remap(e: Entity) -> Any:
+def _set_remap(e: Element) -> Any:
     ros = _ros_actions()
     return ros.SetRemap(src=required_text(e, "from"), dst=required_text(e, "to"))
 
 
-def _set_use_sim_time(e: Entity) -> Any:
+def _set_use_sim_time(e: Element) -> Any:
     ros = _ros_actions()
     if not e.has("value"):
         raise e.error("missing required attribute 'value'")
     return ros.SetUseSimTime(e.flag("value"))
 
 
-def _set_ros_log_dir(e: Entity) -> Any:
+def _set_ros_log_dir(e: Element) -> Any:
     ros = _ros_actions()
     return ros.SetROSLogDir(required_text(e, "new_log_dir"))
 

@@ -1,6 +1,6 @@
 """The tag table shared by the YAML and XML frontends: each tag builds the Python API's action.
 
-A builder reads its Entity through the typed getters (which parse ``$(...)`` once), builds the
+A builder reads its Element through the typed getters (which parse ``$(...)`` once), builds the
 same object a ``.launch.py`` file would (mlaunch.launch.actions, and mlaunch.ros for the launch_ros
 tags, imported only when such a tag appears) and the dispatcher then adds ``if``/``unless``,
 stamps ``origin`` with the tag's file:line and rejects anything left unread.
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import mlaunch.launch.actions as core
 from mlaunch.frontends.composition_tags import COMPOSITION_TAGS
-from mlaunch.frontends.entity import Attr, Entity, did_you_mean
+from mlaunch.frontends.element import Attr, Element, did_you_mean
 from mlaunch.frontends.fields import (
     Builder,
     as_key,
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 # --- the dispatcher --------------------------------------------------------------------------
 
 
-def build_description(root: Entity, parser: Parser | None = None) -> LaunchDescription:
+def build_description(root: Element, parser: Parser | None = None) -> LaunchDescription:
     """The LaunchDescription of a root ``launch`` entity (``parser``: the one tags a package
     exposed are parsed with, when the description is parsed from Python)."""
     if root.tag != "launch":
@@ -53,7 +53,7 @@ def build_description(root: Entity, parser: Parser | None = None) -> LaunchDescr
     return description
 
 
-def build_action(e: Entity, parser: Parser | None = None) -> Any:
+def build_action(e: Element, parser: Parser | None = None) -> Any:
     """One action tag: its builder, then condition, origin and the completeness check.
 
     A tag outside the table is built by the parse method a package exposed for it
@@ -103,7 +103,7 @@ def _unknown_tag(tag: str) -> str:
 # --- core tags -------------------------------------------------------------------------------
 
 
-def _arg(e: Entity) -> Any:
+def _arg(e: Element) -> Any:
     default = e.text("default")
     description_attr = e.attr("description")
     description = None
@@ -119,7 +119,7 @@ def _arg(e: Entity) -> Any:
     )
 
 
-def _yaml_choices(e: Entity) -> list[str]:
+def _yaml_choices(e: Element) -> list[str]:
     """mlaunch extension for YAML: ``choices: [a, b]`` beside ROS 2's ``choice: [{value: a}]``."""
     if e.fmt != "yaml":
         return []
@@ -141,11 +141,11 @@ def _yaml_choices(e: Entity) -> list[str]:
     return out
 
 
-def _let(e: Entity) -> Any:
+def _let(e: Element) -> Any:
     return core.SetLaunchConfiguration(required_text(e, "name"), required_text(e, "value"))
 
 
-def _include(e: Entity) -> Any:
+def _include(e: Element) -> Any:
     from mlaunch.launch.launch_description_sources.any_launch_description_source import (
         AnyLaunchDescriptionSource,
     )
@@ -157,7 +157,7 @@ def _include(e: Entity) -> Any:
     return core.IncludeLaunchDescription(source, launch_arguments=arguments)
 
 
-def _group(e: Entity) -> Any:
+def _group(e: Element) -> Any:
     scoped = e.flag("scoped")
     forwarding = e.flag("forwarding")
     keep = {as_key(k): v for k, v in pairs(e.subentities("keep"), "name", "value")}
@@ -172,7 +172,7 @@ def _group(e: Entity) -> Any:
     return core.GroupAction(actions, **kwargs)
 
 
-def _timer(e: Entity) -> Any:
+def _timer(e: Element) -> Any:
     cancel = e.flag("cancel_on_shutdown")
     actions = [build_action(child) for child in e.actions()]
     if not e.has("period"):
@@ -182,7 +182,7 @@ def _timer(e: Entity) -> Any:
     return core.TimerAction(period=period, actions=actions, **kwargs)
 
 
-def _for_each(e: Entity) -> Any:
+def _for_each(e: Element) -> Any:
     """``<for_each values="...">``, newer than Jazzy: its children once per set of values."""
     children = [build_action(child) for child in e.actions()]
 
@@ -192,7 +192,7 @@ def _for_each(e: Entity) -> Any:
     return core.ForEach(required_text(e, "values"), function=iteration)
 
 
-def _for(e: Entity) -> Any:
+def _for(e: Element) -> Any:
     """``<for len="..." name="...">``, newer than Jazzy: its children ``len`` times."""
     name = required_literal(e, "name")
     children = [build_action(child) for child in e.actions()]
@@ -203,15 +203,15 @@ def _for(e: Entity) -> Any:
     return core.ForLoop(required_text(e, "len"), function=iteration, name=name)
 
 
-def _set_env(e: Entity) -> Any:
+def _set_env(e: Element) -> Any:
     return core.SetEnvironmentVariable(required_text(e, "name"), required_text(e, "value"))
 
 
-def _unset_env(e: Entity) -> Any:
+def _unset_env(e: Element) -> Any:
     return core.UnsetEnvironmentVariable(required_text(e, "name"))
 
 
-def _append_env(e: Entity) -> Any:
+def _append_env(e: Element) -> Any:
     kwargs: dict[str, Any] = {}
     prepend = e.flag("prepend")
     if prepend is not None:
@@ -224,20 +224,20 @@ def _append_env(e: Entity) -> Any:
     )
 
 
-def _reset_env(e: Entity) -> Any:
+def _reset_env(e: Element) -> Any:
     return core.ResetEnvironment()
 
 
-def _log(e: Entity) -> Any:
+def _log(e: Element) -> Any:
     return core.LogInfo(msg=required_text(e, "message"))
 
 
-def _shutdown(e: Entity) -> Any:
+def _shutdown(e: Element) -> Any:
     reason = e.text("reason")
     return core.Shutdown() if reason is None else core.Shutdown(reason=reason)
 
 
-def _reset(e: Entity) -> Any:
+def _reset(e: Element) -> Any:
     keep = {as_key(k): v for k, v in pairs(e.subentities("keep"), "name", "value")}
     return core.ResetLaunchConfigurations(keep)
 

@@ -2,7 +2,7 @@
 
 Parsed with expat directly, so every element knows its line and column and every attribute
 where its value starts (for ``$(...)`` errors pointing at the column). Attributes are strings,
-coerced by the type each tag declares for them (``mlaunch.frontends.entity``).
+coerced by the type each tag declares for them (``mlaunch.frontends.element``).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import re
 from functools import partial
 from xml.parsers import expat
 
-from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.element import Attr, Element
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 from mlaunch.plan.errors import LaunchFileError
@@ -30,8 +30,8 @@ def load(path: str) -> LaunchDescription:
     return build_description(read_root(path))
 
 
-def read_root(path: str) -> Entity:
-    """The root Entity of the XML file at ``path`` (read, not built)."""
+def read_root(path: str) -> Element:
+    """The root Element of the XML file at ``path`` (read, not built)."""
     try:
         with open(path, "rb") as f:
             data = f.read()
@@ -40,8 +40,8 @@ def read_root(path: str) -> Entity:
     return parse_root(data, path)
 
 
-def parse_root(data: bytes, path: str) -> Entity:
-    """The root Entity of XML text, its errors located in ``path``."""
+def parse_root(data: bytes, path: str) -> Element:
+    """The root Element of XML text, its errors located in ``path``."""
     root = _TreeBuilder(path, data).parse()
     for name in [n for n in root.attrs if _ROOT_IGNORED.match(n)]:
         del root.attrs[name]
@@ -60,10 +60,10 @@ class _TreeBuilder:
         self.parser.StartElementHandler = self.start
         self.parser.EndElementHandler = self.end
         self.parser.CharacterDataHandler = self.text
-        self.stack: list[Entity] = []
-        self.root: Entity | None = None
+        self.stack: list[Element] = []
+        self.root: Element | None = None
 
-    def parse(self) -> Entity:
+    def parse(self) -> Element:
         try:
             self.parser.Parse(self.data, True)
         except expat.ExpatError as e:
@@ -86,7 +86,7 @@ class _TreeBuilder:
         line, col = p.CurrentLineNumber, p.CurrentColumnNumber + 1
         if len(self.stack) >= DEPTH_LIMIT:
             raise too_deep(f"{self.path}:{line}:{col}", "XML elements")
-        e = Entity(tag=tag, path=self.path, line=line, col=col, fmt="xml")
+        e = Element(tag=tag, path=self.path, line=line, col=col, fmt="xml")
         index = p.CurrentByteIndex
         for name, value in attributes.items():
             e.attrs[name] = Attr(value, line, col, partial(self.locate, index, line, col, name))

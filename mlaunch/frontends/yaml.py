@@ -13,7 +13,7 @@ from yaml.constructor import SafeConstructor
 from yaml.events import CollectionEndEvent, CollectionStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from mlaunch.frontends.entity import Attr, Entity
+from mlaunch.frontends.element import Attr, Element
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 from mlaunch.plan.errors import LaunchFileError
@@ -40,8 +40,8 @@ def load(path: str) -> LaunchDescription:
     return build_description(read_root(path))
 
 
-def read_root(path: str) -> Entity:
-    """The root ``launch`` Entity of the YAML file at ``path`` (read, not built)."""
+def read_root(path: str) -> Element:
+    """The root ``launch`` Element of the YAML file at ``path`` (read, not built)."""
     try:
         with open(path, "rb") as f:
             data = f.read()
@@ -50,8 +50,8 @@ def read_root(path: str) -> Entity:
     return parse_root(data, path)
 
 
-def parse_root(data: bytes, path: str) -> Entity:
-    """The root ``launch`` Entity of YAML text, its errors located in ``path``."""
+def parse_root(data: bytes, path: str) -> Element:
+    """The root ``launch`` Element of YAML text, its errors located in ``path``."""
     return _Reader(path).root(data)
 
 
@@ -62,7 +62,7 @@ class _Reader:
         self.path = path
         self.constructor = SafeConstructor()
 
-    def root(self, data: bytes) -> Entity:
+    def root(self, data: bytes) -> Element:
         try:
             if bound_of_depth(data) > _NODE_DEPTH_LIMIT:
                 self.check_depth(data)
@@ -116,9 +116,9 @@ class _Reader:
 
     # --- nodes to entities ----------------------------------------------------------------------
 
-    def entity(self, tag: str, key: Node, value: Node) -> Entity:
+    def entity(self, tag: str, key: Node, value: Node) -> Element:
         mark = key.start_mark
-        e = Entity(
+        e = Element(
             tag=tag,
             path=self.path,
             line=mark.line + 1,
@@ -138,7 +138,7 @@ class _Reader:
             )
         return e
 
-    def fill(self, e: Entity, mapping: MappingNode) -> None:
+    def fill(self, e: Element, mapping: MappingNode) -> None:
         for key, value in mapping.value:
             name = self.key_text(key)
             if name in e.attrs or (name == "children" and e.children is not None):
@@ -150,7 +150,7 @@ class _Reader:
                 continue
             e.attrs[name] = self.attr(value)
 
-    def children(self, sequence: SequenceNode) -> list[Entity]:
+    def children(self, sequence: SequenceNode) -> list[Element]:
         out = []
         for item in sequence.value:
             if not isinstance(item, MappingNode) or len(item.value) != 1:
@@ -169,7 +169,7 @@ class _Reader:
             out.append(self.entity(self.key_text(key), key, value))
         return out
 
-    def subentities(self, parent: Entity, name: str, attr: Attr) -> list[Entity]:
+    def subentities(self, parent: Element, name: str, attr: Attr) -> list[Element]:
         """A list-of-maps attribute (``param``, ``remap``, ``env`` ...) as Entities."""
         node = attr.value
         if not isinstance(node, SequenceNode) or not all(
@@ -179,7 +179,7 @@ class _Reader:
         out = []
         for item in node.value:
             mark = item.start_mark
-            e = Entity(
+            e = Element(
                 tag=name,
                 path=self.path,
                 line=mark.line + 1,

@@ -1,9 +1,10 @@
 """One tag of a YAML or XML launch file, read strictly: every attribute and child must be used.
 
-The XML and YAML frontends each turn their parse tree into Entity objects; the tag builders
-(``mlaunch.frontends.tags``) read them through the typed getters below, which parse ``$(...)``
-once and check literal values at load time. ``finish()`` then rejects whatever was not read,
-naming the file, line, tag and the attributes that would have been valid (ROS 2's
+The XML and YAML readers each turn their parse tree into Element objects (what upstream calls
+an entity; ``launch.frontend.Entity`` is upstream's API over one: ``frontends/markup.py``). The
+tag builders (``mlaunch.frontends.tags``) read them through the typed getters below, which parse
+``$(...)`` once and check literal values at load time. ``finish()`` then rejects whatever was
+not read, naming the file, line, tag and the attributes that would have been valid (ROS 2's
 ``assert_entity_completely_parsed``, with positions).
 
 Value typing follows ROS 2: XML attributes are strings coerced to the type the attribute is
@@ -36,7 +37,7 @@ _YAML_NULL = "tag:yaml.org,2002:null"
 
 
 class MissingAttributeError(LaunchFileError, AttributeError):
-    """A required attribute is not there (an AttributeError, as upstream's Entity raises)."""
+    """A required attribute is not there (an AttributeError, as upstream's Element raises)."""
 
 
 # Newer syntax mlaunch knows of and does not run yet: tag -> what it is and what to write.
@@ -83,7 +84,7 @@ class Attr:
         return self.line, self.col
 
 
-class Entity:
+class Element:
     """A tag with its attributes and child entities, in either format."""
 
     __slots__ = (
@@ -111,7 +112,7 @@ class Entity:
         fmt: str,  # "xml" or "yaml"
         attrs: dict[str, Attr] | None = None,
         # XML: the child elements. YAML: the children list (a list value, or `children`).
-        children: list[Entity] | None = None,
+        children: list[Element] | None = None,
         # YAML only: builds Entities for a list-of-maps attribute (param, remap, env ...).
         yaml_subentities: Any = None,
         # YAML only: turns a node into Python data.
@@ -132,7 +133,7 @@ class Entity:
         self._actions_read = False
 
     def __repr__(self) -> str:
-        return f"Entity({self.tag!r}, {self.path}:{self.line}:{self.col})"
+        return f"Element({self.tag!r}, {self.path}:{self.line}:{self.col})"
 
     # --- where and what -------------------------------------------------------------------------
 
@@ -278,7 +279,7 @@ class Entity:
 
     # --- children -------------------------------------------------------------------------------
 
-    def subentities(self, name: str) -> list[Entity]:
+    def subentities(self, name: str) -> list[Element]:
         """The ``name`` sub-entities (XML child tags; YAML a list of maps under key ``name``)."""
         self._sub_tags.setdefault(name, None)
         if self.fmt == "xml":
@@ -288,15 +289,15 @@ class Entity:
             return []
         return self.yaml_subentities(self, name, attr)  # type: ignore[no-any-return]
 
-    def actions(self) -> list[Entity]:
+    def actions(self) -> list[Element]:
         """The child action entities (group, timer, launch)."""
         self._actions_read = True
         if self.fmt == "xml":
             return [c for c in self.children or () if c.tag not in self._sub_tags]
         return list(self.children or ())
 
-    def nested(self) -> list[Entity]:
-        """Every child entity, all of them counted as read (upstream's ``Entity.children``)."""
+    def nested(self) -> list[Element]:
+        """Every child entity, all of them counted as read (upstream's ``Element.children``)."""
         self._actions_read = True
         return list(self.children or ())
 
