@@ -382,7 +382,27 @@ def params_file_text(node_key: str, params: Mapping[str, Any]) -> str:
     document = {node_key: {"ros__parameters": _plain(dict(params))}}
     import yaml
 
-    return yaml.dump(document, Dumper=_dumper(), default_flow_style=False)
+    large = _text_size(params) > LARGE_PARAMS_TEXT
+    return yaml.dump(document, Dumper=_dumper(c=large), default_flow_style=False)
+
+
+# Past this much text in a node's parameters (a URDF from xacro is 0.1-50 MB) the params file is
+# written by libyaml's emitter: the Python one took 58-76 s for 48 MB (libyaml: a few seconds).
+# The values are the same for rcl; libyaml folds long double-quoted text (an indented URDF is
+# written so) at other places. Smaller files keep PyYAML's Python emitter, launch_ros's own,
+# byte for byte.
+LARGE_PARAMS_TEXT = 64 * 1024
+
+
+def _text_size(value: Any) -> int:
+    """The characters of text in ``value`` (keys and string values), to pick the emitter."""
+    if isinstance(value, str):
+        return len(value)
+    if isinstance(value, Mapping):
+        return sum(_text_size(k) + _text_size(v) for k, v in value.items())
+    if isinstance(value, (list, tuple)):
+        return sum(_text_size(v) for v in value)
+    return 0
 
 
 def write_params_file(node_key: str, params: Mapping[str, Any], temp_dir: str | None) -> str:
@@ -428,27 +448,31 @@ def rcl_reads_as_text(text: str) -> bool:
     return text not in _RCL_BOOLS and _RCL_NUMBER.fullmatch(text) is None
 
 
-_DUMPER: list[Any] = []  # the dumper class, once built
+_DUMPERS: dict[bool, Any] = {}  # the dumper classes (Python, C), once built
 
 
-def _dumper() -> Any:
-    """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype.
+def _dumper(*, c: bool = False) -> Any:
+    """yaml.Dumper (as launch_ros uses) that quotes text values rcl would retype; with ``c``,
+    the same on libyaml's emitter (yaml.CDumper) where PyYAML has it.
 
     Built on first use: PyYAML is imported only by launches that write parameters.
     """
-    if _DUMPER:
-        return _DUMPER[0]
     import yaml
+
+    base = getattr(yaml, "CDumper", yaml.Dumper) if c else yaml.Dumper
+    c = base is not yaml.Dumper
+    if c in _DUMPERS:
+        return _DUMPERS[c]
 
     def represent_text(dumper: yaml.Dumper, data: _TextValue) -> yaml.ScalarNode:
         style = None if rcl_reads_as_text(data) else "'"
         return dumper.represent_scalar("tag:yaml.org,2002:str", str(data), style=style)
 
-    class ParamsDumper(yaml.Dumper):
+    class ParamsDumper(base):  # type: ignore[misc,valid-type]
         pass
 
     ParamsDumper.add_representer(_TextValue, represent_text)
-    _DUMPER.append(ParamsDumper)
+    _DUMPERS[c] = ParamsDumper
     return ParamsDumper
 
 

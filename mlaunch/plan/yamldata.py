@@ -65,8 +65,12 @@ def load(text: str | bytes, where: str = "", *, loader: Any = None) -> Any:
         root = reader.get_single_node()
         if root is None:
             return None
-        aliased = b"*" in text if isinstance(text, bytes) else "*" in text
-        if aliased:  # an alias may repeat what it names (no '*', no alias)
+        # An alias needs an anchor ('&'), and '*' alone is common ('/**:' in every params file).
+        if isinstance(text, bytes):
+            aliased = b"&" in text and b"*" in text
+        else:
+            aliased = "&" in text and "*" in text
+        if aliased:
             check_aliases(root, lambda node, message: _error(where, node, message))
         return reader.construct_document(root)
     finally:
@@ -148,10 +152,22 @@ def shape(node: Node) -> str:
 
 
 def bound_of_depth(text: str | bytes) -> int:
-    """An upper bound of the nesting depth: each map or list needs one of these characters."""
+    """An upper bound of the nesting depth, without parsing.
+
+    A block map nested in another is indented deeper; a block list entry is ``-`` and white
+    space (at the same indentation as its map's key too); a flow collection opens with ``[`` or
+    ``{``; a complex key with ``?``. So a URDF's ``:`` and ``-1.57`` count for nothing (counting
+    every ``:`` and ``-`` made a 48 MB URDF take a parse pass of its own).
+    """
+    import re
+
     if isinstance(text, bytes):
-        return text.count(b":") + text.count(b"-") + text.count(b"[") + text.count(b"{")
-    return text.count(":") + text.count("-") + text.count("[") + text.count("{")
+        indents = re.findall(rb"(?m)^ +", text)
+        marks = sum(text.count(m) for m in (b"- ", b"-\n", b"-\r", b"-\t", b"[", b"{", b"?"))
+    else:
+        indents = re.findall(r"(?m)^ +", text)
+        marks = sum(text.count(m) for m in ("- ", "-\n", "-\r", "-\t", "[", "{", "?"))
+    return max(map(len, indents), default=0) + marks + 2  # a '-' that ends the text
 
 
 def _place(where: str, mark: Any) -> str:
