@@ -43,9 +43,10 @@ def test_a_quiet_line_is_half_a_second_behind_a_flood_on_a_30_kb_s_pty(tmp_path:
             delays.append(arrived - float(stamp))
         notices += b"the terminal fell behind" in line
     assert len(delays) == SECONDS, "the quiet child lost lines on the screen"
-    # The first line may come while the reader's pace is still being measured.
-    settled = delays[1:]
+    # The first two lines may come while the reader's pace is measured (its buffer full).
+    settled = delays[2:]
     print(f"quiet lines behind a flood on a 30 KB/s pty: {[round(d, 3) for d in delays]}")
+    assert max(delays) < 1.5, f"a quiet line waited {max(delays):.2f} s behind the flood"
     assert statistics.median(settled) < 0.5, f"quiet lines waited {settled} behind the flood"
     assert max(settled) < 0.8, f"a quiet line waited {max(settled):.2f} s behind the flood"
     assert notices >= 1, "lines were dropped from the screen without a word"

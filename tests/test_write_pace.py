@@ -9,7 +9,17 @@ from collections.abc import Iterator
 
 import pytest
 
-from mlaunch.engine.screen import MAX_AHEAD, UNKNOWN_AHEAD, Screen, WritePace
+from mlaunch.engine.screen import (
+    MAX_AHEAD,
+    MEASURED_SHARE,
+    UNKNOWN_AHEAD,
+    WINDOW,
+    Screen,
+    WritePace,
+)
+
+# Tenths of a second of saturation that make one measuring window (and a little more).
+TENTHS = int(WINDOW * 10) + 1
 
 
 class Clock:
@@ -44,11 +54,15 @@ def test_a_pty_gets_a_write_pace(slave: int) -> None:
 def test_the_pace_is_what_the_pty_took_between_blocked_writes(slave: int) -> None:
     clock = Clock()
     pace = WritePace(slave, os.fstat(slave).st_mode, clock)
-    assert pace.rate is None and pace.room(pace.unread() or 0) > 1 << 20  # measuring: all in
+    assert pace.rate is None and pace.ahead == UNKNOWN_AHEAD
+    for _ in range(8):  # writes it takes whole: it may keep up, and is given more each time
+        pace.wrote(1000)
+    assert pace.ahead == MAX_AHEAD
     pace.wrote(20_000)  # the buffer fills at once
     pace.blocked()
-    saturated(pace, clock, 3000, 7)  # 30 KB/s for 0.7 s
-    assert pace.rate == pytest.approx(0.8 * 30_000)
+    assert pace.ahead == UNKNOWN_AHEAD and pace.room(pace.unread() or 0) > 1 << 20  # measuring
+    saturated(pace, clock, 3000, TENTHS)  # 30 KB/s for a window
+    assert pace.rate == pytest.approx(MEASURED_SHARE * 30_000)
     clock.now += 1.0
     assert pace.unread() == 0  # drained at the pace
     assert pace.room(0) == 4096  # 0.15 s of 24 KB/s, at least a page
@@ -60,7 +74,7 @@ def test_a_raise_that_overshoots_is_taken_back_and_a_slower_reader_measured_agai
     clock = Clock()
     pace = WritePace(slave, os.fstat(slave).st_mode, clock)
     pace.blocked()
-    saturated(pace, clock, 3000, 7)
+    saturated(pace, clock, 3000, TENTHS)
     measured = pace.rate
     assert measured is not None
     for _ in range(11):  # ten seconds of steady writes, never blocked
@@ -80,13 +94,13 @@ def test_an_idle_pty_is_measured_afresh_and_a_fast_one_is_not_paced(slave: int) 
     clock = Clock()
     pace = WritePace(slave, os.fstat(slave).st_mode, clock)
     pace.blocked()
-    saturated(pace, clock, 3000, 7)
+    saturated(pace, clock, 3000, TENTHS)
     assert pace.rate is not None
     clock.now += 5.0
     pace.unread()
-    assert pace.rate is None  # idle: the next burst measures it again
+    assert pace.rate is None and pace.ahead == UNKNOWN_AHEAD  # idle: measured afresh
     pace.blocked()
-    saturated(pace, clock, 500_000, 7)  # 5 MB/s
+    saturated(pace, clock, 500_000, TENTHS)  # 5 MB/s
     for _ in range(5):
         clock.now += 1.0
         pace.wrote(1)

@@ -143,7 +143,7 @@ class ReaderPace:
 # A pty (UNIX98 slaves: majors 136-143) says nothing of what it holds: TIOCOUTQ is always 0.
 PTY_MAJORS = range(136, 144)
 # While the reader's pace is measured from blocked writes: a window lasts at least this long...
-WINDOW = 0.6
+WINDOW = 1.0
 # ... and two blocked writes further apart than this are not one stretch of saturation.
 SATURATED_GAP = 0.5
 # A pace that held PROBE_AFTER seconds without the terminal blocking a write is raised by this
@@ -153,22 +153,26 @@ SATURATED_GAP = 0.5
 PROBE_AFTER = 10.0
 IDLE_RESET = 2.0
 PROBE_FACTOR = 1.25
-MEASURED_SHARE = 0.8
-MAX_PACE = 4_000_000
+MEASURED_SHARE = 0.75
+MAX_PACE = 1_000_000
+# What a pty's buffer holds (Linux: ~20 KB), as the most a full one is assumed to hold.
+PTY_BUFFER = 20 * 1024
 
 
 class WritePace(ReaderPace):
     """The pace of a reader whose kernel buffer says nothing (a pty), from the time of writes.
 
     While the terminal blocks the writes (EAGAIN, a partial write), its buffer is full and it
-    takes bytes exactly as fast as the reader reads them: the pace is the bytes it took between
-    two blocked writes at least WINDOW apart. Until that is known, the terminal gets what it
-    takes (its buffer fills once: ~20 KB, 0.7 s at 30 KB/s). Once it is known, what the buffer
-    holds is estimated (what was written, less the pace times the time since), and writes keep
-    it near KERNEL_SECONDS of the pace, as ReaderPace does with the kernel's own count. A pace
-    that held for PROBE_AFTER seconds is raised a little, so that a reader that sped up is
-    found: a write blocked after that raise goes back to the pace before it; one blocked
-    otherwise means the reader slowed down, and its pace is measured afresh.
+    takes bytes as fast as the reader reads them: the pace is (a share of) the bytes it took
+    between two blocked writes at least WINDOW apart. Until the first block it may keep up, and
+    gets more each time it takes what it was given, as ReaderPace; while the pace is measured
+    it gets what it takes (its buffer fills: ~20 KB, 0.7 s at 30 KB/s). A pace past MAX_PACE is
+    a reader that keeps up (a terminal emulator: a pty's buffer is then a few ms of it). A slower
+    one is paced: what the buffer holds is estimated (what was written, less the pace times the
+    time since), and writes keep it near KERNEL_SECONDS of the pace, as ReaderPace does with the
+    kernel's own count. A pace that held PROBE_AFTER seconds is raised a little, so that a
+    reader that sped up is found: a write blocked after that raise goes back to the pace before
+    it; one blocked otherwise means the reader slowed down, and its pace is measured afresh.
     """
 
     def __init__(self, fd: int, mode: int, clock: Callable[[], float]) -> None:
@@ -180,6 +184,7 @@ class WritePace(ReaderPace):
         self._blocked_at = -math.inf
         self._probed_at = -math.inf
         self._probing = False  # the pace was raised on trust and not blocked since
+        self._fast = False  # measured faster than MAX_PACE: blocked writes are no sign of lag
 
     @property
     def rate(self) -> float | None:
@@ -198,6 +203,7 @@ class WritePace(ReaderPace):
                 self._pace *= PROBE_FACTOR
                 if self._pace > MAX_PACE:  # keeps up: no pacing
                     self._pace = None
+                    self._fast = True
                     self.ahead = MAX_AHEAD
         self._held_at = now
         return int(self._held)
@@ -214,15 +220,20 @@ class WritePace(ReaderPace):
         self.unread()  # the estimate up to now, before adding
         self.written += n
         self._held += n
-        self.progress_at = self.clock()
+        self.progress_at = now = self.clock()
+        if self._pace is None and now - self._blocked_at > SATURATED_GAP:
+            # It took what it was given (blocked() follows at once if not): give it more, as
+            # ReaderPace does, so that a terminal that keeps up (MB/s) is soon not held at all.
+            self.ahead = min(2 * self.ahead, MAX_AHEAD)
 
     def blocked(self) -> None:
-        """The terminal took less than it was given: its buffer is full."""
+        """The terminal took less than it was given: its buffer is full (a pty's holds ~20 KB,
+        so a fast reader behind a faster child blocks writes too: the pace tells them apart)."""
         now = self.clock()
         if self._pace is not None and self._probing:
             # The last raise overshot: back to the pace before it, and the buffer is full.
             self._pace /= PROBE_FACTOR
-            self._held = self._pace * KERNEL_SECONDS * 4
+            self._held = self._full()
             self._held_at = self._blocked_at = now
             self._probed_at = now
             self._probing = False
@@ -230,21 +241,31 @@ class WritePace(ReaderPace):
         if self._pace is not None:  # the reader slowed down: measure it again
             self._pace = None
             self._window = None
-        self.ahead = UNKNOWN_AHEAD  # not a reader that keeps up, whatever was thought
+        if not self._fast:
+            self.ahead = UNKNOWN_AHEAD  # maybe a slow reader, until measured
         if self._window is None or now - self._blocked_at > SATURATED_GAP:
             self._window = (now, self.written)
         else:
             since, written = self._window
             if now - since >= WINDOW:
-                if self.written > written:
-                    # Measured as the kernel frees room, in its own steps: a window over-counts
-                    # by up to a fifth; a pace a little under the reader's keeps its buffer low.
-                    self._pace = MEASURED_SHARE * (self.written - written) / (now - since)
-                    self._held = self._pace * KERNEL_SECONDS * 4  # full: assume the worst
+                # Measured as the kernel frees room, in its own steps: a window over-counts by
+                # up to a fifth; a pace a little under the reader's keeps its buffer low.
+                pace = MEASURED_SHARE * (self.written - written) / (now - since)
+                self._fast = pace > MAX_PACE
+                if self._fast:  # its ~20 KB are a few ms of it: no pacing
+                    self.ahead = MAX_AHEAD
+                elif pace > 0:
+                    self._pace = pace
+                    self._held = self._full()
                     self._held_at = now
                     self._probed_at = now
                 self._window = None
         self._blocked_at = now
+
+    def _full(self) -> float:
+        """What a full pty holds, at most: ~0.6 s of the pace, and a pty takes ~20 KB."""
+        assert self._pace is not None
+        return min(self._pace * KERNEL_SECONDS * 4, PTY_BUFFER)
 
 
 class Screen:
