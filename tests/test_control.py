@@ -13,7 +13,7 @@ from typing import TypeVar
 import pytest
 from test_supervision import Harness, make_spec, plan_from, write_launch
 
-from mlaunch.engine.records import RUNNING, STOPPED
+from mlaunch.engine.process_state import RUNNING, STOPPED
 from mlaunch.parts.control import ControlError, ProcessInfo, UnknownLabel
 from mlaunch.plan.events import Controlled, Event, Exited, RespawnScheduled, Started
 from mlaunch.plan.steps import RespawnPolicy

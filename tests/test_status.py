@@ -13,7 +13,7 @@ import time
 
 from test_supervision import Harness, make_spec
 
-from mlaunch.engine.records import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessRecord
+from mlaunch.engine.process_state import FAILED, FINISHED, GAVE_UP, RUNNING, ProcessState
 from mlaunch.parts.status import StatusView, attach_status_view
 from mlaunch.parts.summary import (
     ExitSummary,
@@ -67,9 +67,9 @@ class Terminal:
         return [line.rstrip() for line in self.lines if line.strip()]
 
 
-def record(label: str, state: str, **kw: object) -> ProcessRecord:
+def record(label: str, state: str, **kw: object) -> ProcessState:
     spec = ProcessSpec(label=label, argv=("x",), env={}, env_changes={})
-    rec = ProcessRecord(label, spec, state=state)
+    rec = ProcessState(label, spec, state=state)
     for key, value in kw.items():
         setattr(rec, key, value)
     return rec

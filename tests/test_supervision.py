@@ -31,7 +31,7 @@ from mlaunch.engine.process import (
     expand_core_pattern,
     utf8_safe_cut,
 )
-from mlaunch.engine.records import FAILED, FINISHED, GAVE_UP
+from mlaunch.engine.process_state import FAILED, FINISHED, GAVE_UP
 from mlaunch.engine.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.engine.screen import Screen
 from mlaunch.engine.supervisor import Supervisor

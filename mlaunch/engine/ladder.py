@@ -12,7 +12,7 @@ import signal
 from collections.abc import Callable
 
 from mlaunch.engine.process import Process
-from mlaunch.engine.records import STOPPING, ProcessRecord
+from mlaunch.engine.process_state import STOPPING, ProcessState
 from mlaunch.plan.events import Escalated, Event
 
 
@@ -23,7 +23,7 @@ class StopLadder:
         self,
         schedule: Callable[[float, Callable[[], None]], object],
         emit: Callable[[Event], None],
-        records: dict[str, ProcessRecord],
+        records: dict[str, ProcessState],
     ) -> None:
         self.schedule = schedule
         self.emit = emit

@@ -7,7 +7,7 @@ within STABLE_UPTIME of starting multiplies the wait by ``respawn_backoff``, up 
 
 from __future__ import annotations
 
-from mlaunch.engine.records import GAVE_UP, RESTARTING, STOPPED, ProcessRecord
+from mlaunch.engine.process_state import GAVE_UP, RESTARTING, STOPPED, ProcessState
 from mlaunch.plan.events import GaveUp, RespawnScheduled
 from mlaunch.plan.steps import RespawnPolicy
 
@@ -42,7 +42,7 @@ def respawn_delay(policy: RespawnPolicy, streak: int) -> float:
     return min(base * policy.backoff ** min(streak, 64), cap)
 
 
-def next_restart(policy: RespawnPolicy, record: ProcessRecord, code: int, uptime: float) -> float:
+def next_restart(policy: RespawnPolicy, record: ProcessState, code: int, uptime: float) -> float:
     """The delay before restarting a process that exited with ``code`` after ``uptime`` seconds.
 
     NO_RESTART when the policy does not restart it, GIVE_UP when its retries are spent (restarts
@@ -71,7 +71,7 @@ class Respawns:
     def __init__(
         self,
         *,
-        records: dict[str, ProcessRecord],
+        records: dict[str, ProcessState],
         timers: Timers,
         events: EventStream,
         clock: Callable[[], float],

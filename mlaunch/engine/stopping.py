@@ -11,7 +11,7 @@ from __future__ import annotations
 import signal
 
 from mlaunch.engine.process import signal_name
-from mlaunch.engine.records import RESTARTING
+from mlaunch.engine.process_state import RESTARTING
 from mlaunch.plan.errors import exit_for_signal
 from mlaunch.plan.events import Interrupted, ShutdownBegun, ShutdownRepeated, StoppingAll
 
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 
     from mlaunch.engine.ladder import StopLadder
     from mlaunch.engine.process import Process
-    from mlaunch.engine.records import ProcessRecord
+    from mlaunch.engine.process_state import ProcessState
     from mlaunch.engine.timers import Timers
     from mlaunch.plan.events import EventStream
 
@@ -38,7 +38,7 @@ class Shutdown:
         *,
         events: EventStream,
         timers: Timers,
-        records: Mapping[str, ProcessRecord],
+        records: Mapping[str, ProcessState],
         ladder: StopLadder,
         processes: list[Process],
         lingering: list[Process],

@@ -17,9 +17,9 @@ mlaunch itself is killed; if the loop itself fails, every group is killed before
 propagates.
 
 The children's pipes and the terminal share the loop's selector (mlaunch.engine.pipes): a slow
-terminal holds the children's pipes unread instead of losing lines. The per-label ProcessRecord
-(mlaunch.engine.records) is what the status view and the exit summary read. Signals are recorded
-by mlaunch.engine.signals, timers are mlaunch.engine.timers, the respawn policy is
+terminal holds the children's pipes unread instead of losing lines. The per-label ProcessState
+(mlaunch.engine.process_state) is what the status view and the exit summary read. Signals are
+recorded by mlaunch.engine.signals, timers are mlaunch.engine.timers, the respawn policy is
 mlaunch.engine.respawn, the launch file's event handlers are mlaunch.engine.handlers, and the
 shutdown is its ``Shutdown`` (mlaunch.engine.stopping), the respawns its ``Respawns``, and the
 plan's steps are carried out by its ``Executor`` (mlaunch.engine.executor).
@@ -43,8 +43,8 @@ from mlaunch.engine.ladder import StopLadder
 from mlaunch.engine.output import Printer
 from mlaunch.engine.pipes import Pipes
 from mlaunch.engine.process import Process, describe_status, wait_child
+from mlaunch.engine.process_state import RESTARTING, RUNNING, STOPPED, ProcessState
 from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
-from mlaunch.engine.records import RESTARTING, RUNNING, STOPPED, ProcessRecord
 from mlaunch.engine.respawn import Respawns
 from mlaunch.engine.signals import SignalWatch
 from mlaunch.engine.stopping import Shutdown, handle_signals
@@ -130,7 +130,7 @@ class Supervisor:
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
-        self.records: dict[str, ProcessRecord] = {}
+        self.records: dict[str, ProcessState] = {}
         self.timers = Timers(clock)
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
@@ -246,7 +246,7 @@ class Supervisor:
             pass  # the original error is the one worth reporting
 
     @property
-    def process_records(self) -> Mapping[str, ProcessRecord]:
+    def process_records(self) -> Mapping[str, ProcessState]:
         """What the run knows of each label, read-only (the status view, the exit summary,
         runtime control and the smoke checks read it; only the supervisor writes it)."""
         return MappingProxyType(self.records)
@@ -408,7 +408,7 @@ class Supervisor:
         process = self.spawner(spec, next(self._index), restarts)
         record = self.records.get(spec.label)
         if record is None:
-            record = self.records[spec.label] = ProcessRecord(spec.label, spec)
+            record = self.records[spec.label] = ProcessState(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
         try:
             try:

@@ -11,7 +11,7 @@ node's ``namespace/name`` (only when the node's name is given), and a file with 
 has no section for the node repeats the entries of the entry before it (the request is compared
 with the reference's, and a repeated value sets the same parameter twice).
 
-Built with nothing but PyYAML: the request is a Record (plain data), turned into the rosidl
+Built with nothing but PyYAML: the request is a Value (plain data), turned into the rosidl
 message only by the driver (``to_message``), so ``--print`` works without rclpy.
 """
 
@@ -25,7 +25,7 @@ from mlaunch.launch_ros import params
 from mlaunch.launch_ros.parameter_descriptions import Parameter, ParameterFile
 from mlaunch.launch_ros.scope import make_namespace_absolute, prefix_namespace
 from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -51,7 +51,7 @@ TYPE_NAMES = {
 }
 
 
-class TypedParameter(Record):
+class TypedParameter(Value):
     """One ``rcl_interfaces/Parameter``: name, ParameterType code and the value."""
 
     _fields = ("name", "type", "value")
@@ -63,7 +63,7 @@ class TypedParameter(Record):
         self.value = value
 
 
-class LoadRequest(Record):
+class LoadRequest(Value):
     """The fields of one ``composition_interfaces/srv/LoadNode`` request."""
 
     _fields = (

@@ -42,7 +42,7 @@ from mlaunch.launch_ros.parameter_descriptions import (
     is_substitution,
 )
 from mlaunch.plan.errors import LaunchFileTypeError, SubstitutionFailure, SubstitutionTypeError
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 from mlaunch.ros.files import write_temp
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -63,7 +63,7 @@ _HINT = (
 # --- normalized values (built with the Node, performed when it is resolved) ---------------------
 
 
-class Plain(Record):
+class Plain(Value):
     """A value that is already typed (bool, int, float, bytes, str, or a uniform tuple)."""
 
     _fields = ("value",)
@@ -73,7 +73,7 @@ class Plain(Record):
         self.value = value
 
 
-class Text(Record):
+class Text(Value):
     """Substitutions performed to one string, then read with YAML."""
 
     _fields = ("subs",)
@@ -83,7 +83,7 @@ class Text(Record):
         self.subs = subs
 
 
-class Items(Record):
+class Items(Value):
     """A list whose items are typed values or substitutions, each read with YAML."""
 
     _fields = ("items",)
@@ -301,7 +301,7 @@ def uniform(items: Sequence[Any], name: str) -> tuple[Any, ...]:
     )
 
 
-class ParamsArgument(Record):
+class ParamsArgument(Value):
     """One params argument of a node, in order: a file (``--params-file``) or a rule (``-p``)."""
 
     _fields = ("flag", "value", "written")

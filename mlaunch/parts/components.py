@@ -29,7 +29,7 @@ from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
 from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Said, ShutdownBegun
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -46,7 +46,7 @@ LOGGER = "launch_ros.actions.load_composable_nodes"
 POLL = 0.1
 
 
-class LoadResult(Record):
+class LoadResult(Value):
     """What a container answered to one request."""
 
     _fields = ("request", "success", "full_node_name", "unique_id", "error_message")

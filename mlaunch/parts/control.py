@@ -43,12 +43,12 @@ from collections.abc import Callable
 
 from mlaunch.engine.part import Part
 from mlaunch.engine.process import Process
-from mlaunch.engine.records import (
+from mlaunch.engine.process_state import (
     RESTARTING,
     RUNNING,
     STOPPING,
     USER_STOPPED,
-    ProcessRecord,
+    ProcessState,
 )
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE, MlaunchError
 from mlaunch.plan.events import Controlled, Event, Exited, FailedToStart, NotStarted, Started
@@ -220,7 +220,7 @@ class Control(Part):
             raise AmbiguousLabel(name, named)
         raise UnknownLabel(name, self.labels())
 
-    def record(self, label: str) -> ProcessRecord:
+    def record(self, label: str) -> ProcessState:
         """The record of the label ``label`` means (``resolve``)."""
         return self.supervisor.process_records[self.resolve(label)]
 
@@ -380,7 +380,7 @@ class Control(Part):
 
     # --- the parts -------------------------------------------------------------------------
 
-    def _acting_on(self, name: str, action: str) -> tuple[str, ProcessRecord, Process | None]:
+    def _acting_on(self, name: str, action: str) -> tuple[str, ProcessState, Process | None]:
         """The label, its record and latest instance, once the launch may still act on it."""
         record = self.record(name)
         label = record.label
@@ -443,7 +443,7 @@ class Control(Part):
                 done(self.info(label))
 
 
-def _names(record: ProcessRecord) -> set[str]:
+def _names(record: ProcessState) -> set[str]:
     """What a label also goes by: without launch's ``-N`` counter, and its node's names."""
     base, _, number = record.label.rpartition("-")
     names = {base} if base and number.isdigit() else set()

@@ -20,14 +20,14 @@ import time
 from collections.abc import Callable, Sequence
 
 from mlaunch.engine.part import Part
-from mlaunch.engine.records import (
+from mlaunch.engine.process_state import (
     FAILED,
     GAVE_UP,
     RESTARTING,
     RUNNING,
     STOPPED,
     STOPPING,
-    ProcessRecord,
+    ProcessState,
 )
 from mlaunch.parts.summary import format_bytes, format_duration
 from mlaunch.plan.events import Event, Output, Said
@@ -250,7 +250,7 @@ class StatusView(Part):
             self._usage = GroupSampler(details=False)
         return {pgid: (u.cpu, u.rss) for pgid, u in self._usage.sample(groups).items()}
 
-    def rows(self) -> list[tuple[ProcessRecord, str, str, str, str, str, str]]:
+    def rows(self) -> list[tuple[ProcessState, str, str, str, str, str, str]]:
         """(record, state, pid, uptime, cpu, memory, last line) for each process, as text."""
         now = self.supervisor.clock()
         out = []
@@ -356,7 +356,7 @@ class StatusView(Part):
         console.print(table)
 
     def _cells(
-        self, rows: list[tuple[ProcessRecord, str, str, str, str, str, str]], selected: str | None
+        self, rows: list[tuple[ProcessState, str, str, str, str, str, str]], selected: str | None
     ) -> tuple[list[tuple[str, ...]], list[tuple[str, str]]]:
         """Each row's cells as text (COLUMNS), and the styles of its label and state."""
         cells: list[tuple[str, ...]] = []
@@ -387,7 +387,7 @@ class StatusView(Part):
             text = _printable(line.encode(), strip=False)
             console.print(Text(text, no_wrap=True, overflow="ellipsis"))
 
-    def _state_text(self, record: ProcessRecord) -> str:
+    def _state_text(self, record: ProcessState) -> str:
         """The state as the table shows it: whether the user stopped or muted it too."""
         state = record.outcome if record.state == STOPPED else record.state
         if self.printer.is_muted(record.label):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
 
-from mlaunch.engine.records import GAVE_UP, ProcessRecord
+from mlaunch.engine.process_state import GAVE_UP, ProcessState
 from mlaunch.plan.events import Event, Summary
 
 
@@ -40,14 +40,14 @@ def format_bytes(size: float) -> str:
     return f"{size / (1 << 30):.1f} GiB"
 
 
-def summary_wanted(records: Iterable[ProcessRecord], *, quiet: bool = False) -> bool:
+def summary_wanted(records: Iterable[ProcessState], *, quiet: bool = False) -> bool:
     """More than one process, or any failure (only a failure with ``quiet``)."""
     records = list(records)
     failed = any(r.failed or r.state == GAVE_UP for r in records)
     return failed if quiet else (len(records) > 1 or failed)
 
 
-def render_summary(records: Iterable[ProcessRecord]) -> str:
+def render_summary(records: Iterable[ProcessState]) -> str:
     """The summary table as plain text (it goes to the screen and into launch.log)."""
     head = ("process", "pid", "result", "restarts", "run time", "peak memory", "cpu time")
     rows = [
@@ -85,7 +85,7 @@ class ExitSummary:
 
     def __init__(
         self,
-        records: Mapping[str, ProcessRecord],
+        records: Mapping[str, ProcessState],
         emit: Callable[[Event], None],
         *,
         quiet: bool = False,

@@ -2,4 +2,4 @@
 
 The resolved plan (``steps``: steps, ``ProcessSpec``, ``Plan``), the event records a run emits
 (``events``), a resolved machine (``machine``), errors with their place (``errors``, ``origin``)
-and the small ``Record`` base (``record``)."""
+and the small ``Value`` base (``value``)."""

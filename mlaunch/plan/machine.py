@@ -5,7 +5,7 @@ from __future__ import annotations
 import itertools
 import os
 
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -15,7 +15,7 @@ if TYPE_CHECKING:
 DEFAULT_TIMEOUT = 10.0
 
 
-class MachineSpec(Record):
+class MachineSpec(Value):
     """Where a process runs: ``address`` over ssh, or this computer when ``local``.
 
     ``user`` and ``ssh_port`` None leave the choice to the ssh configuration; ``env_loader`` is a

@@ -7,14 +7,14 @@ the trigger fires.
 
 The classes are plain classes with ``__slots__``, not dataclasses: importing dataclasses costs
 ~8 ms (it imports inspect, ast, dis and tokenize) and creating each dataclass ~0.4 ms, all before
-the first child starts. ``Record`` (mlaunch.plan.record) gives them a dataclass's equality and repr.
+the first child starts. ``Value`` (mlaunch.plan.value) gives them a dataclass's equality and repr.
 """
 
 from __future__ import annotations
 
 import enum  # re imports it: nothing more on the way to the first child
 
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 # typing is imported by type checkers only (~4 ms at start-up); mypy treats this name as
 # typing.TYPE_CHECKING.
@@ -29,7 +29,7 @@ OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")
 
 
-class RespawnPolicy(Record):
+class RespawnPolicy(Value):
     """When and how a process is started again after it exits (immutable and hashable).
 
     ``mode`` is ``never``, ``always`` (ROS 2's respawn=True: any exit) or ``on-failure``
@@ -81,7 +81,7 @@ class RespawnPolicy(Record):
         return text
 
 
-class NodeInfo(Record):
+class NodeInfo(Value):
     """What the ROS layer knows about a process that is a ROS node."""
 
     _fields = ("name", "namespace", "package", "executable", "lifecycle", "autostart")
@@ -111,7 +111,7 @@ class NodeInfo(Record):
         return f"{ns}/{self.name}"
 
 
-class ProcessSpec(Record):
+class ProcessSpec(Value):
     """Everything needed to start, watch and stop one process. Respawns reuse it unchanged."""
 
     _fields = (
@@ -199,7 +199,7 @@ class ProcessSpec(Record):
         return self.label.rsplit("-", 1)[0]
 
 
-class Deferred(Record):
+class Deferred(Value):
     """Entities to resolve later: with the run's live context when they fire (launch's rule;
     ``captured`` then holds the values where they were written, to warn where those differ),
     or with a ``context`` frozen where they were written (``captured`` None;
@@ -238,7 +238,7 @@ def _entity_name(entity: Any) -> str:
     return describe() if describe else type(entity).__name__
 
 
-class Step(Record):
+class Step(Value):
     """One thing the supervisor does, in plan order."""
 
     _fields: tuple[str, ...] = ("origin",)
@@ -451,7 +451,7 @@ def step_needs(step: Step) -> frozenset[Need]:
     return frozenset(getattr(step, "needs", NO_NEEDS))
 
 
-class ArgumentInfo(Record):
+class ArgumentInfo(Value):
     """A declared launch argument, for --show-args and CLI checks."""
 
     _fields = (
@@ -493,7 +493,7 @@ class ArgumentInfo(Record):
         self.passed_by = ""
 
 
-class Plan(Record):
+class Plan(Value):
     """The resolved launch: its steps in order, its arguments, warnings, and ``needs``: what
     must attach to the run (``"lifecycle"``), noted by resolve as it adds and defers steps."""
 

@@ -22,7 +22,6 @@ from mlaunch.plan.errors import (
     is_own_module,
 )
 from mlaunch.plan.origin import unset_variable_hint, user_location
-from mlaunch.plan.record import Record
 from mlaunch.plan.steps import (
     ArgumentInfo,
     Deferred,
@@ -33,6 +32,7 @@ from mlaunch.plan.steps import (
     Step,
     step_needs,
 )
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -60,7 +60,7 @@ class LabelCounter:
         return f"{base}-{next(self._next)}"
 
 
-class ResolveOptions(Record):
+class ResolveOptions(Value):
     """What the caller decides about resolution, besides the description and its arguments.
 
     ``packages`` is where ROS packages are looked for (a mlaunch.ros.search.PackageSearch,

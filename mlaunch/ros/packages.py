@@ -31,7 +31,7 @@ import re
 import sys
 
 from mlaunch.plan import errors
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 from mlaunch.ros.search import CONTEXT_KEY, PackageSearch, active
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -61,7 +61,7 @@ class PackageNotFoundError(errors.PackageNotFoundError, KeyError):
         return errors.PackageNotFoundError.__str__(self)
 
 
-class Package(Record):
+class Package(Value):
     """Where one package is: its share directory, and the prefix it is installed in."""
 
     _fields = ("name", "share_directory", "prefix", "installed", "standin")

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 CONTEXT_KEY = "mlaunch_package_search"
 
 
-class PackageSearch(Record):
+class PackageSearch(Value):
     """Explicit source-package folders, the top launch file, and the environment lookups use.
 
     ``environ`` None means the process environment at the time of the lookup; ``standins``

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from mlaunch.launch.event import Event
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -16,7 +16,7 @@ else:  # the same at run time, without typing.Any
     ProcessMatcher = Callable[[object], bool]
 
 
-class Shutdown(Record, Event):
+class Shutdown(Value, Event):
     name = "launch.events.Shutdown"
     _fields = ("reason", "due_to_sigint")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from mlaunch.launch.event import Event
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -16,7 +16,7 @@ else:  # the same at run time, without typing.Any
     ProcessMatcher = Callable[[object], bool]
 
 
-class TimerEvent(Record, Event):
+class TimerEvent(Value, Event):
     """A TimerAction's period ran out (launch emits it, then visits the timer's actions)."""
 
     name = "launch.events.TimerEvent"

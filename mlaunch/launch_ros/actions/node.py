@@ -41,8 +41,8 @@ from mlaunch.launch_ros.scope import (
 )
 from mlaunch.launch_ros.substitutions.executable_in_package import ExecutableInPackage
 from mlaunch.plan.errors import LaunchFileError, MlaunchError, SubstitutionFailure, did_you_mean
-from mlaunch.plan.record import Record
 from mlaunch.plan.steps import NodeInfo, ProcessSpec
+from mlaunch.plan.value import Value
 from mlaunch.ros import packages
 from mlaunch.ros.packages import PackageNotFoundError
 
@@ -78,7 +78,7 @@ def same_name_warning(count: int, name: str) -> str:
     )
 
 
-class NodeNames(Record):
+class NodeNames(Value):
     """A node's name and namespace as resolved (None: not given, the node's own default)."""
 
     _fields = ("name", "namespace")
@@ -102,7 +102,7 @@ class NodeNames(Record):
         return "/**"
 
 
-class NodeCommand(Record):
+class NodeCommand(Value):
     """What one resolution of a Node found: its names, what runs, its command line."""
 
     _fields = ("names", "package", "executable", "exe_argv", "standin", "argv", "temp_files")
@@ -127,7 +127,7 @@ class NodeCommand(Record):
         self.temp_files = temp_files  # params files to remove with the process
 
 
-class RosPart(Record):
+class RosPart(Value):
     """The command line of a node after its name and namespace, as launch_ros's
     ``_perform_substitutions`` works it out: the scope's params arguments (SetParameter,
     SetParametersFromFile), the node's own, then the remapping rules."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from mlaunch.launch.event import Event
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -18,7 +18,7 @@ else:  # the same at run time, without typing.Any
     ProcessMatcher = Callable[[object], bool]
 
 
-class ProcessTargetedEvent(Record, Event):
+class ProcessTargetedEvent(Value, Event):
     """An event aimed at the running processes its matcher selects (launch's base class)."""
 
     name = "launch.events.process.ProcessTargetedEvent"

@@ -1,7 +1,7 @@
 """``launch.events.process.running_process_event``: the base of the events of a running process.
 
 Plain classes (not dataclasses, whose import and creation cost start-up time) that compare and
-show themselves as dataclasses do, through ``mlaunch.plan.record.Record``.
+show themselves as dataclasses do, through ``mlaunch.plan.value.Value``.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from mlaunch.launch.event import Event
-from mlaunch.plan.record import Record
+from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -20,7 +20,7 @@ else:  # the same at run time, without typing.Any
     ProcessMatcher = Callable[[object], bool]
 
 
-class ProcessEvent(Record, Event):
+class ProcessEvent(Value, Event):
     """Fields of ROS 2's process events: the action, the label, argv, cwd, env and pid."""
 
     _fields: tuple[str, ...] = ("action", "name", "cmd", "cwd", "env", "pid")

@@ -1,4 +1,4 @@
-"""Record: a dataclass's equality and repr for plain classes with ``__slots__``.
+"""Value: a dataclass's equality and repr for plain classes with ``__slots__``.
 
 Importing dataclasses costs ~8 ms (it imports inspect, ast, dis and tokenize) and creating each
 dataclass ~0.4 ms, all before the first child starts; the classes on the start-up path (the
@@ -12,7 +12,7 @@ if TYPE_CHECKING:
     from typing import Any
 
 
-class Record:
+class Value:
     """Equality and repr over the names in ``_fields``, as a dataclass compares and shows itself.
 
     Equal when of the same class with equal fields; unhashable (defining ``__eq__`` removes the
@@ -26,7 +26,7 @@ class Record:
         return tuple(getattr(self, name) for name in self._fields)
 
     def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Record) or other.__class__ is not self.__class__:
+        if not isinstance(other, Value) or other.__class__ is not self.__class__:
             return NotImplemented
         return self._values() == other._values()
 

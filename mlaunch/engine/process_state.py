@@ -1,6 +1,6 @@
 """What the run knows about each process label over its whole life: for the status view and summary.
 
-A ProcessRecord survives respawns (one per label): its state, last pid, restarts, total run time,
+A ProcessState survives respawns (one per label): its state, last pid, restarts, total run time,
 peak memory and CPU time (from wait4's rusage, so nothing is sampled), and how it ended.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 from mlaunch.engine.process import Process, describe_status, signal_name
 from mlaunch.plan.steps import ProcessSpec
 
-# ProcessRecord.state values.
+# ProcessState.state values.
 RUNNING = "running"
 STOPPING = "stopping"
 RESTARTING = "restarting"
@@ -20,7 +20,7 @@ STOPPED = "stopped"  # by the user (mlaunch.parts.control): it stays down until 
 USER_STOPPED = "stopped by the user"
 
 
-class ProcessRecord:
+class ProcessState:
     """One process label over the whole run (all its respawns): for the status view and summary.
 
     A plain class (dataclass creation is start-up cost); every field is a keyword argument.
@@ -85,7 +85,7 @@ class ProcessRecord:
 
     def __repr__(self) -> str:
         return (
-            f"ProcessRecord(label={self.label!r}, state={self.state!r}, pid={self.pid},"
+            f"ProcessState(label={self.label!r}, state={self.state!r}, pid={self.pid},"
             f" restarts={self.restarts}, outcome={self.outcome!r})"
         )
 
