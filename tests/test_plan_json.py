@@ -80,7 +80,8 @@ def test_argv_is_what_text_print_shows(path: Path, env: dict[str, str]) -> None:
         if lines[i + 1].startswith("  argv:")
     }
     assert set(shown) == set(processes(document))
-    temp = re.compile(r"/tmp/mlaunch-[^/ ]+/launch_params_\w+")
+    # Text --print names the files a run writes <params-file N> / <run-file N>; JSON <run-temp>/N.
+    temp = re.compile(r"<(?:params|run)-file \d+>")
     for label, process in processes(document).items():
         argv = process["argv"]
         shell = " ".join(argv) + "   [via /bin/sh -c]"

@@ -12,14 +12,14 @@ import shlex
 import xml.etree.ElementTree as ET
 
 from ament_index_python.packages import get_packages_with_prefixes
-from launch import LaunchDescription
+from launch import LaunchContext, LaunchDescription
 from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction, Shutdown
 from launch.substitutions import LaunchConfiguration
 
 EXPORT_KEYS = ("gazebo_model_path", "gazebo_media_path")
 
 
-def exported_model_paths():
+def exported_model_paths() -> list[str]:
     """The model folders every package exports for Gazebo, in package order."""
     paths = []
     for name, prefix in sorted(get_packages_with_prefixes().items()):
@@ -38,7 +38,7 @@ def exported_model_paths():
     return paths
 
 
-def start_gz(context):
+def start_gz(context: LaunchContext) -> list[ExecuteProcess]:
     gz_args = LaunchConfiguration("gz_args").perform(context)
     ign_args = LaunchConfiguration("ign_args").perform(context)
     words = shlex.split(gz_args if gz_args or not ign_args else ign_args)
@@ -58,7 +58,7 @@ def start_gz(context):
     ]
 
 
-def generate_launch_description():
+def generate_launch_description() -> LaunchDescription:
     return LaunchDescription(
         [
             DeclareLaunchArgument("gz_args", default_value="", description="Arguments of gz sim"),
