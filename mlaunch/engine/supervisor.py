@@ -466,8 +466,43 @@ class Supervisor:
                     self.guard.forget(process.pid)
                 self.records[process.label].ended(process)
                 self._exited(process)
+                if process in self.lingering and self._replaced(process):
+                    self._end_group(process)
             finally:
                 self.events.release()
+
+    def _replaced(self, process: Process) -> bool:
+        """Whether another instance of ``process``'s label takes its place (a respawn is
+        scheduled, or the user's restart started it)."""
+        if process.user_stop == "restart":
+            return True
+        return self.records[process.label].state == RESTARTING
+
+    def _end_group(self, process: Process) -> None:
+        """End what a dead instance left in its process group, with the instance: SIGTERM now,
+        SIGKILL after ``STRAY_GRACE`` (each respawn used to leave them running until the run
+        ended). Said once, naming the label and the group."""
+        if not process.signal_group(signal.SIGTERM, wake=True):
+            return
+        self.events.emit(
+            Said(
+                "INFO",
+                process.label,
+                f"ending what the exited instance left in its process group {process.pid}"
+                " (SIGTERM, SIGKILL after"
+                f" {STRAY_GRACE:g} s): a new instance takes its place",
+            )
+        )
+
+        def kill() -> None:
+            if process.check_group():
+                process.signal_group(signal.SIGKILL)
+            elif process in self.lingering:  # a crash loop must not grow the list forever
+                self.lingering.remove(process)
+                if self.guard is not None:
+                    self.guard.forget(process.pid)
+
+        self.timers.add(STRAY_GRACE, kill, False, False)
 
     def _exited(self, process: Process) -> None:
         """Where a process's exit becomes a log line, handler calls, a shutdown, a respawn.
