@@ -144,6 +144,35 @@ class Strays:
             found.pop(pid, None)
         return list(found.values())
 
+    def adopted(self, ours: Iterable[int], skip: int | None) -> list[proctable.ProcInfo]:
+        """Orphans re-parented to mlaunch as subreaper (a daemon that double-forked): living
+        direct children that are not ``ours``. A few reads (one per thread of mlaunch)."""
+        if not self.subreaper or not proctable.children_files():
+            return []
+        me = os.getpid()
+        known = set(ours)
+        if skip is not None:
+            known.add(skip)
+        found = []
+        try:
+            tids = os.listdir(f"/proc/{me}/task")
+        except OSError:
+            return []
+        for tid in tids:
+            try:
+                listed = proctable.read_file(f"/proc/{me}/task/{tid}/children").split()
+            except OSError:
+                continue
+            for word in listed:
+                pid = int(word)
+                if pid in known:
+                    continue
+                known.add(pid)
+                info = proctable.proc_info(pid)
+                if info is not None and not info.zombie:
+                    found.append(info)
+        return found
+
     def kill_all(self, ours: Iterable[int], skip: int | None) -> None:
         """SIGKILL every stray at once, looking thoroughly (the loop itself failed)."""
         for proc in self.find(ours, skip, thorough=True):

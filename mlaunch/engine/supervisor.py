@@ -48,7 +48,7 @@ from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
 from mlaunch.engine.respawn import Respawns
 from mlaunch.engine.signals import SignalWatch
 from mlaunch.engine.stopping import Shutdown, handle_signals
-from mlaunch.engine.strays import STRAY_GRACE, Strays
+from mlaunch.engine.strays import STRAY_GRACE, Strays, comm
 from mlaunch.engine.timers import Timer, Timers
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK
 from mlaunch.plan.events import (
@@ -75,6 +75,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from mlaunch.engine.cgroup import RunCgroup
 
+# How often the guard is told the groups of orphans re-parented to mlaunch (escaped daemons).
+ADOPTED_POLL = 1.0
 # How often the loop looks at lingering groups, strays and a blocked terminal while it waits.
 POLL = 0.05
 
@@ -130,6 +132,7 @@ class Supervisor:
         self.by_pid: dict[int, Process] = {}
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
+        self._adopted_groups: set[int] = set()  # groups of adopted orphans the guard watches
         self.records: dict[str, ProcessState] = {}
         self.timers = Timers(clock)
         self.signals = SignalWatch(install=install_signals)
@@ -267,6 +270,8 @@ class Supervisor:
             # After the first spawns, not before: ctypes costs milliseconds and the first child
             # should not wait for it. An orphan from that window is still found by its marker.
             self.strays.adopt_orphans()
+            if self.guard is not None and self.strays.subreaper:
+                self.timers.add(ADOPTED_POLL, self._watch_adopted, False, True)
             while not self._finished():
                 self._loop_once()
             if self.guard is not None:
@@ -470,6 +475,34 @@ class Supervisor:
                     self._end_group(process)
             finally:
                 self.events.release()
+
+    def _watch_adopted(self) -> None:
+        """Tell the guard the groups of orphans re-parented to mlaunch, every ``ADOPTED_POLL``.
+
+        A daemon that double-forks, clears its environment and moves itself out of the run's
+        cgroup carries nothing the guard could find it by after ``kill -9`` of mlaunch; while
+        mlaunch lives it is mlaunch's child (the subreaper's), so its group is watched too.
+        """
+        guard = self.guard
+        if guard is None or self.shutting_down:
+            return
+        watched = {p.pid for p in self.processes} | {p.pid for p in self.lingering}
+        for info in self.strays.adopted(self.by_pid, guard.pid):
+            if info.pgrp not in self._adopted_groups and info.pgrp not in watched:
+                self._adopted_groups.add(info.pgrp)
+                guard.watch(info.pgrp, STRAY_GRACE)
+                guard.flush()  # before it is said: the guard knows it from then on
+                name = comm(info.pid)
+                self.events.emit(
+                    Said(
+                        "INFO",
+                        "launch",
+                        f"{name} [pid {info.pid}] left the process that started it and is now"
+                        f" mlaunch's: its group {info.pgrp} ends with the run, even after"
+                        " kill -9 of mlaunch",
+                    )
+                )
+        self.timers.add(ADOPTED_POLL, self._watch_adopted, False, True)
 
     def _replaced(self, process: Process) -> bool:
         """Whether another instance of ``process``'s label takes its place (a respawn is
