@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import yaml
 from yaml.constructor import SafeConstructor
-from yaml.events import CollectionEndEvent, CollectionStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mlaunch.frontends.element import Attr, Element
 from mlaunch.frontends.limits import DEPTH_LIMIT, too_deep
 from mlaunch.frontends.tags import build_description
 from mlaunch.plan.errors import LaunchFileError
-from mlaunch.plan.yamldata import bound_of_depth, check_aliases, shape
+from mlaunch.plan.yamldata import bound_of_depth, check_aliases, check_depth, shape
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -88,21 +87,14 @@ class _Reader:
         return self.entity(tag, key, value)
 
     def check_depth(self, data: bytes) -> None:
-        """Stop a file nested deeper than the limit before composing it.
-
-        libyaml composes recursively in C: a file nested ~20,000 deep crashes the interpreter
-        (a segmentation fault, not an exception). Parsing events is flat.
-        """
-        depth = 0
-        for event in yaml.parse(data, Loader=_Loader):
-            if isinstance(event, CollectionStartEvent):
-                depth += 1
-                if depth > _NODE_DEPTH_LIMIT:
-                    raise too_deep(
-                        self.where(event.start_mark), "YAML maps and lists", _NODE_DEPTH_LIMIT
-                    )
-            elif isinstance(event, CollectionEndEvent):
-                depth -= 1
+        """Stop a file nested deeper than the limit before composing it (libyaml composes
+        recursively in C: ~20,000 levels crash the interpreter)."""
+        check_depth(
+            data,
+            _Loader,
+            _NODE_DEPTH_LIMIT,
+            lambda mark: too_deep(self.where(mark), "YAML maps and lists", _NODE_DEPTH_LIMIT),
+        )
 
     def check_expansion(self, root: Node) -> None:
         """Stop aliases that expand the file past ``ALIAS_LIMIT`` more nodes, or into itself.

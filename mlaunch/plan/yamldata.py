@@ -57,7 +57,16 @@ def load(text: str | bytes, where: str = "", *, loader: Any = None) -> Any:
         loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
     bound = bound_of_depth(text)
     if bound > DEPTH_LIMIT:
-        check_depth(text, where, loader)
+        check_depth(
+            text,
+            loader,
+            DEPTH_LIMIT,
+            lambda mark: YamlLimitError(
+                f"YAML maps and lists nest deeper than {DEPTH_LIMIT} levels, mlaunch's limit"
+                " (generated nesting?)",
+                where=_place(where, mark),
+            ),
+        )
     if bound > 50 and sys.getrecursionlimit() < _RECURSION_LIMIT:
         sys.setrecursionlimit(_RECURSION_LIMIT)
     reader = loader(text)
@@ -77,8 +86,17 @@ def load(text: str | bytes, where: str = "", *, loader: Any = None) -> Any:
         reader.dispose()
 
 
-def check_depth(text: str | bytes, where: str, loader: Any) -> None:
-    """Refuse text nested deeper than ``DEPTH_LIMIT`` (a flat walk over the parser's events)."""
+def check_depth(
+    text: str | bytes,
+    loader: Any,
+    limit: int,
+    error: Callable[[Any], Exception],
+) -> None:
+    """Raise ``error(mark)`` where ``text`` nests deeper than ``limit`` maps and lists.
+
+    A flat walk over the parser's events: composing is recursive (libyaml's in C crashes the
+    interpreter ~20,000 levels deep, a segmentation fault, not an exception).
+    """
     import yaml
     from yaml.events import CollectionEndEvent, CollectionStartEvent
 
@@ -86,12 +104,8 @@ def check_depth(text: str | bytes, where: str, loader: Any) -> None:
     for event in yaml.parse(text, Loader=loader):
         if isinstance(event, CollectionStartEvent):
             depth += 1
-            if depth > DEPTH_LIMIT:
-                raise YamlLimitError(
-                    f"YAML maps and lists nest deeper than {DEPTH_LIMIT} levels, mlaunch's limit"
-                    " (generated nesting?)",
-                    where=_place(where, event.start_mark),
-                )
+            if depth > limit:
+                raise error(event.start_mark)
         elif isinstance(event, CollectionEndEvent):
             depth -= 1
 
