@@ -277,7 +277,7 @@ def test_large_parameters_are_written_by_libyaml_with_the_same_values(
     from mlaunch.launch_ros import params
 
     python = params.params_file_text("/robot/node", TRICKY)
-    urdf = {"robot_description": TRICKY["robot_description"] * 50}
+    urdf = {"robot_description": str(TRICKY["robot_description"]) * 50}
     python_urdf = params.params_file_text("/robot/node", urdf)
     assert params._text_size(TRICKY) < params.LARGE_PARAMS_TEXT
     monkeypatch.setattr(params, "LARGE_PARAMS_TEXT", 0)
