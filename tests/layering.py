@@ -171,43 +171,13 @@ def back_edges(root: str) -> list[Import]:
 
 
 def package_cycles(root: str) -> list[list[str]]:
-    """Circles between packages (each as the packages in order), by the imports above."""
+    """Circles between packages (each as its packages, sorted), by the imports above."""
     graph: dict[str, set[str]] = {}
     for edge in _all_imports(root):
         a, b = package_of(edge.source), package_of(edge.target)
         if a != b:
             graph.setdefault(a, set()).add(b)
-    cycles: list[list[str]] = []
-    index: dict[str, int] = {}
-    low: dict[str, int] = {}
-    stack: list[str] = []
-    on_stack: set[str] = set()
-
-    def connect(node: str) -> None:  # Tarjan's strongly connected components
-        index[node] = low[node] = len(index)
-        stack.append(node)
-        on_stack.add(node)
-        for nxt in sorted(graph.get(node, ())):
-            if nxt not in index:
-                connect(nxt)
-                low[node] = min(low[node], low[nxt])
-            elif nxt in on_stack:
-                low[node] = min(low[node], index[nxt])
-        if low[node] == index[node]:
-            group = []
-            while True:
-                member = stack.pop()
-                on_stack.discard(member)
-                group.append(member)
-                if member == node:
-                    break
-            if len(group) > 1:
-                cycles.append(sorted(group))
-
-    for node in sorted(graph):
-        if node not in index:
-            connect(node)
-    return cycles
+    return _components(graph)
 
 
 def _components(graph: dict[str, set[str]]) -> list[list[str]]:

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs
 
+from mlaunch.parts.control import OPERATIONS
 from mlaunch.standins.viewer_http import QuietErrors
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
@@ -49,22 +50,8 @@ KEEPALIVE = 15.0  # seconds between comments on a quiet stream (proxies and brow
 FOLLOW_PERIOD = 0.2  # how often a log view looks for new lines
 MAX_BODY = 1024
 MAX_LINES = 5000  # lines a log view starts with, at most
-# What the page may ask of the control layer (``mlaunch ctl``'s operations).
-PAGE_OPERATIONS = (
-    "list",
-    "stop",
-    "start",
-    "restart",
-    "mute",
-    "unmute",
-    "logs",
-    "unload",
-    "load",
-    "configure",
-    "activate",
-    "deactivate",
-    "cleanup",
-)
+# What the page may ask of the control layer: every operation of ``mlaunch ctl``.
+PAGE_OPERATIONS = OPERATIONS
 CONTROL_TIMEOUT = 120.0  # a stop waits for the process's whole stop ladder
 
 
