@@ -145,6 +145,54 @@ def test_a_core_dump_gets_a_backtrace(tmp_path: Path) -> None:
     assert "#0" in text, text
 
 
+def test_without_a_verdict_the_writer_leaves_it_out_and_runs_no_gdb(tmp_path: Path) -> None:
+    """The launch panel's bundle of a live run: no verdict.json, no gdb over a core."""
+    from mlaunch.engine.process import Process
+    from mlaunch.plan.steps import ProcessSpec
+    from mlaunch.smoke import artifacts
+
+    spec = ProcessSpec("dumped-1", ("/bin/false",), {"A": "1"}, {})
+    dumped = Process(spec, 0)
+    dumped.pid, dumped.returncode, dumped.core_dumped = 4321, -6, True
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    (logs / "dumped-1.log").write_text("last words\n")
+    folder = tmp_path / "bundle"
+    bundle = artifacts.write(
+        str(folder),
+        verdict=None,
+        plan_text="{}\n",
+        processes=[dumped],
+        rings={"dumped-1": ["last words"]},
+        log_dir=str(logs),
+        backtraces=False,
+    )
+    assert sorted(bundle.files) == ["logs/dumped-1.log", "plan.json", "processes.json"]
+    (record,) = json.loads((folder / "processes.json").read_text())
+    assert record["core_dumped"] and record["backtrace"].startswith("not taken here")
+    assert not (folder / "backtraces").exists()
+
+
+def test_a_packed_bundle_stops_at_its_size_and_names_what_it_left_out(tmp_path: Path) -> None:
+    import io
+    import tarfile
+
+    from mlaunch.smoke import artifacts
+
+    (tmp_path / "logs").mkdir()
+    (tmp_path / "plan.json").write_text("{}")
+    (tmp_path / "logs" / "big.log").write_bytes(b"x" * 5000)
+    (tmp_path / "logs" / "small.log").write_bytes(b"y" * 10)
+    (tmp_path / "logs" / "elsewhere.log").symlink_to("/etc/hostname")
+    data, left = artifacts.pack(str(tmp_path), "b", limit=1000)
+    assert left == ["logs/big.log (5000 bytes)"]
+    with tarfile.open(fileobj=io.BytesIO(data), mode="r:gz") as tar:
+        names = sorted(tar.getnames())
+        note = tar.extractfile("b/LEFT_OUT.txt")
+        assert note is not None and b"logs/big.log" in note.read()
+    assert names == ["b/LEFT_OUT.txt", "b/logs/small.log", "b/plan.json"]
+
+
 def test_a_message_definition_is_the_ros2msg_schema_a_reader_decodes() -> None:
     mcap_ros2 = pytest.importorskip("mcap_ros2._dynamic")
     pytest.importorskip("geometry_msgs")

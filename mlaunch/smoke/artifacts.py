@@ -12,6 +12,9 @@ failure, into ``artifacts/`` of the run's log folder. It holds:
   installed and the core file is where the kernel's core_pattern puts it;
 - ``recording.mcap``: the last seconds of the topics the checks named (or ``--record``), from
   the recorder (mlaunch.smoke.recorder), readable by ros2 bag and Foxglove.
+
+The launch panel builds the same folder on demand from the running launch (``verdict`` None:
+no verdict.json; no backtraces, since it runs no command) and sends it packed by ``pack``.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ from typing import Any
 LOG_BYTES = 1024 * 1024
 # How long gdb may take over one core file.
 GDB_TIMEOUT = 60.0
+# What ``pack`` puts in one archive at most (bytes of the files, before compression).
+PACK_BYTES = 64 * 1024 * 1024
 
 
 class Bundle:
@@ -65,22 +70,32 @@ class Bundle:
 def write(
     folder: str,
     *,
-    verdict: Mapping[str, Any],
+    verdict: Mapping[str, Any] | None,
     plan_text: str,
     processes: Sequence[Any],
     rings: Mapping[str, Sequence[str]],
     log_dir: str,
     recorder: Any = None,
+    backtraces: bool = True,
 ) -> Bundle:
-    """Write the evidence into ``folder`` (made if missing)."""
+    """Write the evidence into ``folder`` (made if missing).
+
+    ``verdict`` None (a run still going has none) leaves verdict.json out; ``backtraces``
+    False runs no gdb and says so in the record of a process that dumped core.
+    """
     os.makedirs(folder, exist_ok=True)
     bundle = Bundle(folder)
-    bundle.write_text("verdict.json", json.dumps(verdict, indent=2) + "\n")
+    if verdict is not None:
+        bundle.write_text("verdict.json", json.dumps(verdict, indent=2) + "\n")
     bundle.write_text("plan.json", plan_text)
     records = [process_record(p, rings.get(p.label, ())) for p in processes]
     for record, process in zip(records, processes, strict=True):
         if process.core_dumped:
-            record["backtrace"] = backtrace(bundle, process)
+            record["backtrace"] = (
+                backtrace(bundle, process)
+                if backtraces
+                else "not taken here (the failure evidence of mlaunch test takes it)"
+            )
     bundle.write_text("processes.json", json.dumps(records, indent=2) + "\n")
     copy_logs(bundle, log_dir)
     if recorder is not None:
@@ -90,6 +105,41 @@ def write(
         except Exception as e:  # the rest of the evidence stands without it
             bundle.notes.append(f"no recording: {type(e).__name__}: {e}")
     return bundle
+
+
+def pack(folder: str, name: str, limit: int = PACK_BYTES) -> tuple[bytes, list[str]]:
+    """The files of ``folder`` as a .tar.gz below ``name/`` and those left out: a file that
+    would take the archive past ``limit`` bytes is left out (and named in ``name/LEFT_OUT.txt``).
+    Only regular files are packed; a link is never followed."""
+    import io
+    import tarfile
+    import time
+
+    files: list[tuple[str, str]] = []
+    for root, dirs, names in os.walk(folder):
+        dirs.sort()
+        for entry in sorted(names):
+            full = os.path.join(root, entry)
+            if os.path.isfile(full) and not os.path.islink(full):
+                files.append((full, os.path.relpath(full, folder)))
+    data = io.BytesIO()
+    left: list[str] = []
+    total = 0
+    with tarfile.open(fileobj=data, mode="w:gz") as tar:
+        for full, relative in files:
+            size = os.path.getsize(full)
+            if total + size > limit:
+                left.append(f"{relative} ({size} bytes)")
+                continue
+            total += size
+            tar.add(full, arcname=f"{name}/{relative}", recursive=False)
+        if left:
+            text = f"left out: the archive holds at most {limit} bytes\n" + "\n".join(left)
+            info = tarfile.TarInfo(f"{name}/LEFT_OUT.txt")
+            payload = (text + "\n").encode()
+            info.size, info.mtime = len(payload), int(time.time())
+            tar.addfile(info, io.BytesIO(payload))
+    return data.getvalue(), left
 
 
 def process_record(process: Any, lines: Sequence[str]) -> dict[str, Any]:
