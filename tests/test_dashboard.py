@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import csv
 import http.client
+import io
 import itertools
 import json
 import re
 import signal
 import sys
+import tarfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -131,6 +133,12 @@ def test_the_page_shows_every_process_live_and_restarts_the_one_clicked(
             "busy-2 running again",
         )
 
+        # the evidence button: the page asks with its token and hands the browser the archive
+        page.click("#evidence")
+        got = json.loads(page.wait("document.body.dataset.evidence", 30, "the evidence bundle"))
+        assert got["name"].startswith("mlaunch-evidence-") and got["name"].endswith(".tar.gz")
+        assert got["size"] > 1000, got
+
 
 @needs_chromium
 @pytest.mark.timeout(120)
@@ -243,6 +251,56 @@ def test_requests_from_elsewhere_or_without_the_token_are_refused(run: Run) -> N
     said = run.running.wait_for(r"output muted by the user \(the launch panel\)", 10)
     assert run.running.text.count("muted by the user") == 1, said  # the refused ones did not
     assert {p["label"]: p for p in run.ctl("list")["processes"]}["ticker-1"]["muted"]
+
+
+def download_evidence(port: int) -> dict[str, bytes]:
+    """The panel's evidence bundle through ``port``, refused first to all but the page itself
+    (it holds every environment); its files by name below the archive's one folder."""
+    own = f"http://127.0.0.1:{port}"
+    token = token_of(port)
+    assert request(port, "POST", "/launch/evidence", origin=own)[0] == 403
+    assert request(port, "POST", "/launch/evidence", origin=own, token="x" * 32)[0] == 403
+    foreign = request(port, "POST", "/launch/evidence", origin="http://evil.example", token=token)
+    assert foreign[0] == 403
+    rebound = request(
+        port, "POST", "/launch/evidence", host="evil.example:80", origin=own, token=token
+    )
+    assert rebound[0] == 421
+    assert request(port, "GET", "/launch/evidence")[0] == 404
+
+    status, data = request(port, "POST", "/launch/evidence", origin=own, token=token)
+    assert status == 200, data[:300]
+    files: dict[str, bytes] = {}
+    with tarfile.open(fileobj=io.BytesIO(data), mode="r:gz") as tar:
+        for member in tar.getmembers():
+            assert member.isfile(), member.name
+            root, _, name = member.name.partition("/")
+            assert root.startswith("mlaunch-evidence-"), member.name
+            extracted = tar.extractfile(member)
+            assert extracted is not None
+            files[name] = extracted.read()
+    return files
+
+
+def test_the_evidence_bundle_of_the_live_run_downloads_from_the_panel(
+    run: Run, tmp_path: Path
+) -> None:
+    run.running.wait_for(r"tick 3\b", 30)
+    files = download_evidence(run.port)
+    assert "verdict.json" not in files  # a live run has no verdict yet
+    assert "logs/launch.log" in files
+    plan = json.loads(files["plan.json"])
+    records = {r["label"]: r for r in json.loads(files["processes.json"])}
+    assert plan["launch_file"].endswith("panel.launch.py")
+    listed = {p["label"]: p for p in run.ctl("list")["processes"]}
+    assert set(records) == set(listed) and len(records) == 2
+    ticker = records["ticker-1"]
+    assert ticker["pid"] == listed["ticker-1"]["pid"] and ticker["ended"] is None
+    assert ticker["argv"][0] == sys.executable and ticker["environment"]["ROS_LOG_DIR"]
+    assert ticker["last_output"] and all(line.startswith("tick ") for line in ticker["last_output"])
+    assert b"tick 3\n" in files["logs/ticker-1.log"]
+    # the run went on, untouched
+    run.running.wait_for(r"tick 20\b", 30)
 
 
 @pytest.mark.timeout(90)

@@ -15,7 +15,7 @@ import pytest
 from browser import Browser, available
 from conftest import requires_rclpy
 from procutil import REPO, Running, mlaunch, run_mlaunch
-from test_dashboard import assert_refuses_strangers
+from test_dashboard import assert_refuses_strangers, download_evidence
 
 OPEN = r"viewer: open http://127\.0\.0\.1:(\d+)/"
 JTBOT = ("gazebo-1", "robot_state_publisher-2", "spawn_entity.py-3", "rviz2-4")
@@ -74,6 +74,8 @@ def test_the_viewer_page_shows_the_jtbot_run_and_restarts_a_node(
             )
         # through the viewer's address, the same refusals as the panel's own port
         assert_refuses_strangers(port, "robot_state_publisher-2")
+        evidence = json.loads(download_evidence(port)["processes.json"])
+        assert tuple(sorted(r["label"] for r in evidence)) == tuple(sorted(JTBOT))
         run.signal(signal.SIGINT)
         assert run.finish(60) == 130
     finally:

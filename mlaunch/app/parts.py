@@ -8,7 +8,8 @@ is attached.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 from mlaunch.app.options import Options
 from mlaunch.engine.part import Part
@@ -42,6 +43,7 @@ class Run:
         "_control",
         "_metrics",
         "components",
+        "launch_file",
         "lifecycle",
         "opts",
         "plan",
@@ -50,8 +52,16 @@ class Run:
         "supervisor",
     )
 
-    def __init__(self, opts: Options, plan: Plan, supervisor: Supervisor, printer: Printer) -> None:
+    def __init__(
+        self,
+        opts: Options,
+        plan: Plan,
+        supervisor: Supervisor,
+        printer: Printer,
+        launch_file: str = "",
+    ) -> None:
         self.opts = opts
+        self.launch_file = launch_file  # the launch file's path ("" when not told)
         self.plan = plan
         self.supervisor = supervisor
         self.printer = printer
@@ -350,7 +360,33 @@ def dashboard_part(run: Run) -> Dashboard:
         metrics,
         port=run.opts.dashboard_port,
         composable=composable,
+        evidence=lambda processes, rings: live_evidence(run, processes, rings),
     )
+
+
+def live_evidence(run: Run, processes: Sequence[Any], rings: Mapping[str, Sequence[str]]) -> bytes:
+    """The launch panel's evidence bundle: ``mlaunch test``'s evidence writer run on the
+    launch so far (no verdict, no gdb) into a temporary folder, packed as a .tar.gz."""
+    import tempfile
+
+    from mlaunch.resolve.plan_json import plan_json
+    from mlaunch.smoke import artifacts
+    from mlaunch.smoke.watch import RING_LINES
+
+    path = run.launch_file or run.opts.target
+    name = f"mlaunch-evidence-{run.supervisor.run_id}"
+    with tempfile.TemporaryDirectory(prefix="mlaunch-evidence-") as folder:
+        artifacts.write(
+            folder,
+            verdict=None,
+            plan_text=plan_json(run.plan, path, run.opts.arguments),
+            processes=processes,
+            rings={label: list(lines)[-RING_LINES:] for label, lines in rings.items()},
+            log_dir=run.printer.log_dir or "",
+            backtraces=False,
+        )
+        data, _left = artifacts.pack(folder, name)
+    return data
 
 
 class _ViewerWatch(Part):

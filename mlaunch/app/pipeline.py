@@ -210,7 +210,7 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
         if opts.print_plan:
             write_stdout(describe(opts, plan, path))
             return 0
-        return supervise(opts, plan, options, labels, log_dir, life, attach)
+        return supervise(opts, plan, options, labels, log_dir, life, attach, path=path)
 
 
 def streams_back(path: str) -> None:
@@ -240,8 +240,11 @@ def supervise(
     log_dir: str,
     life: Lifeline,
     attach: Sequence[PartMaker],
+    *,
+    path: str = "",
 ) -> int:
-    """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts."""
+    """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts; ``path`` is
+    the launch file (the parts' ``Run.launch_file``)."""
     from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
     from mlaunch.engine.output import Printer, stdout_is_color_terminal
     from mlaunch.engine.process import Process
@@ -278,7 +281,7 @@ def supervise(
         spawner=Process if spawner is None else spawner,
     )
     supervisor.events.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
-    run = Run(opts, plan, supervisor, printer)
+    run = Run(opts, plan, supervisor, printer, launch_file=path)
     try:
         if spawner is not None:
             spawner.connect(plan.processes())

@@ -429,7 +429,7 @@ def supervise(
     checks = PartMaker("the smoke checks", smoke_checks, essential=True)
     parts = [*standard_parts(opts), checks]
 
-    code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts)
+    code = pipeline.supervise(opts, plan, options, labels, log_dir, life, parts, path=path)
     if not runs:
         return code
     smoke = runs[0]

@@ -14,7 +14,9 @@ state (server-sent events, one message a second), the last lines of one process 
 writes next. Every control is a same-origin POST carrying the run's token (which the page gets
 from the server) and goes through mlaunch.parts.control_socket's ``answer_request`` on the
 loop thread, exactly as ``mlaunch ctl``'s requests do. Nothing reads a file but through the
-control layer (the process's own log file in the run's log folder).
+control layer (the process's own log file in the run's log folder), and the evidence bundle:
+the same folder ``mlaunch test`` writes on a failure, built on demand from the running launch by
+``evidence`` (given by the application layer, which owns the evidence writer), one at a time.
 
 What it costs the run: the loop only hands the output lines to a bounded ring per process and
 takes each second's list of processes (mlaunch.parts.metrics does, for both); each browser is
@@ -24,11 +26,13 @@ never queues them) and drops the browser once a write has been blocked for WRITE
 
 from __future__ import annotations
 
+import copy
 import os
 import secrets
 import threading
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 from mlaunch.engine.part import Part
 from mlaunch.plan.events import Event, Output, Said
@@ -49,6 +53,9 @@ HISTORY = 300
 # Browser streams served at once; more are refused (503) rather than given a thread each.
 MAX_STREAMS = 64
 LINE_MAX = 2000  # characters of one output line sent to the page
+
+# Builds the evidence bundle (a .tar.gz) from the processes as they were and their last lines.
+Evidence = Callable[[Sequence[Any], Mapping[str, Sequence[str]]], bytes]
 
 
 def dashboard_socket(run_id: str) -> str:
@@ -143,12 +150,15 @@ class Dashboard(Part):
         *,
         port: int | None,
         composable: Callable[[], list[dict[str, object]]] = lambda: [],
+        evidence: Evidence | None = None,
     ) -> None:
         self.supervisor = supervisor
         self.control = control
         self.metrics = metrics
         self.port = port
         self.composable = composable  # the composable nodes and their state (any thread)
+        self.evidence = evidence
+        self.evidence_busy = threading.Lock()  # one bundle at a time
         self.hub = Hub()
         self.token = secrets.token_urlsafe(24)
         self.servers: list[BaseServer] = []
@@ -273,6 +283,34 @@ class Dashboard(Part):
             reply({"ok": True, "label": resolved, "lines": text, "next": self.hub.end(resolved)})
 
         return self.call(tail, 10.0)
+
+    def evidence_bundle(self) -> tuple[bytes | None, str]:
+        """The evidence of the run so far as a .tar.gz, or why not. The processes are copied on
+        the loop thread (as they are at one moment); the files are written and packed here, in
+        the asking browser's thread, so the run never waits for them."""
+        if self.evidence is None:
+            return None, "this run has no evidence writer"
+        if not self.evidence_busy.acquire(blocking=False):
+            return None, "an evidence bundle is being made; ask again when it is done"
+        try:
+
+            def freeze(reply: Callable[[dict[str, object]], None]) -> None:
+                processes = [copy.copy(p) for p in self.supervisor.processes]
+                reply({"ok": True, "processes": processes})
+
+            taken = self.call(freeze, 10.0)
+            if not taken.get("ok"):
+                return None, str(taken.get("error"))
+            hub = self.hub
+            with hub.lock:
+                rings = {label: list(lines) for label, lines in hub.lines.items()}
+            processes = taken["processes"]
+            assert isinstance(processes, list)
+            return self.evidence(processes, rings), ""
+        except Exception as e:  # a bundle that cannot be made is said, the run goes on
+            return None, f"the evidence bundle could not be made: {type(e).__name__}: {e}"
+        finally:
+            self.evidence_busy.release()
 
     def close(self) -> None:
         self.supervisor.events.unsubscribe(self._on_event)

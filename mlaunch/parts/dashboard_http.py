@@ -14,6 +14,8 @@ label of the run; no request names a file or a command.
                                    server-sent events: ``state`` once a second; with ``follow``,
                                    ``lines`` too: LABEL's last N lines, then each new one
     POST /launch/control           {"op": ..., "label": ...}: the control layer's answer
+    POST /launch/evidence          the evidence bundle of the run so far (.tar.gz): what
+                                   ``mlaunch test`` keeps of a failure, without a verdict
 
 One stream per page (a browser opens at most six connections to a server, and a page's log view
 would otherwise take a second); the page closes it while it is hidden.
@@ -120,10 +122,14 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
         def do_POST(self) -> None:
             if not self.host_allowed():
                 return
-            if self.path.partition("?")[0] != "/launch/control":
+            path = self.path.partition("?")[0]
+            if path not in ("/launch/control", "/launch/evidence"):
                 self._text(404, "not found: controls are POST /launch/control\n")
                 return
             if not self.post_allowed():
+                return
+            if path == "/launch/evidence":
+                self._evidence()
                 return
             request = self._body()
             if request is None:
@@ -135,6 +141,23 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
             answer = dashboard.request(request, CONTROL_TIMEOUT)
             status = 200 if answer.get("ok") else (400 if answer.get("status") == 2 else 409)
             self._json(status, answer)
+
+        def _evidence(self) -> None:
+            """The bundle as a download; the request's body (none is needed) is not read."""
+            self.close_connection = True  # an unread body must not be taken for a request
+            data, error = dashboard.evidence_bundle()
+            if data is None:
+                self._json(409, {"ok": False, "error": error})
+                return
+            name = f"mlaunch-evidence-{dashboard.supervisor.run_id}.tar.gz"
+            self.send_response(200)
+            self.send_header("Content-Type", "application/gzip")
+            self.send_header("Content-Length", str(len(data)))
+            self.send_header("Content-Disposition", f'attachment; filename="{name}"')
+            self.send_header("Cache-Control", "no-store")
+            self.send_header("X-Content-Type-Options", "nosniff")
+            self.end_headers()
+            self.wfile.write(data)
 
         def _body(self) -> dict[str, Any] | None:
             kind = (self.headers.get("Content-Type") or "").split(";")[0].strip().lower()
