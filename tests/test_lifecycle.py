@@ -1,5 +1,6 @@
 """Lifecycle (managed) nodes: sequences resolved from launch files, the loop hand-off, and real
-bring-up, events, respawn, reverse deactivation and failure through the rclpy bridge."""
+bring-up, events, respawn, reverse deactivation and failure through the rclpy bridge; lifecycle
+components (composable_lifecycle_node) brought up once their container loaded them."""
 
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ from pathlib import Path
 import pytest
 from conftest import requires_rclpy
 from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_until
+from test_composition_ros import requires_composition_interfaces
 
 from mlaunch.launch.actions import DeclareLaunchArgument, GroupAction, LaunchDescription
 from mlaunch.launch_ros.lifecycle_sequence import (
@@ -28,6 +30,7 @@ from mlaunch.plan.steps import Need
 from mlaunch.resolve.resolver import resolve
 
 LAUNCHES = Path(__file__).resolve().parent / "launches"
+LIFECYCLE_CONTAINER = Path(__file__).resolve().parent / "nodes" / "lifecycle_container.py"
 
 
 def _plan(*entities: object, arguments: dict[str, str] | None = None):  # type: ignore[no-untyped-def]
@@ -228,3 +231,46 @@ def test_failed_transition_of_a_required_node_ends_the_launch_with_status_1(
     )
     assert "shutting down: lifecycle node /robot/camera: activate failed" in out
     assert "[talker-2]: process has finished cleanly" in out
+
+
+@requires_rclpy
+@requires_composition_interfaces
+def test_a_composable_lifecycle_node_is_brought_up_once_loaded_and_down_at_shutdown(
+    tmp_path: Path, ros_env: dict[str, str]
+) -> None:
+    """It was an error: "<composable_lifecycle_node> is newer than Jazzy ... and mlaunch does
+    not run it yet". Now the component with autostart is configured and activated once its
+    container loaded it, and deactivated before the container is stopped; the one without
+    autostart is loaded and left unconfigured."""
+    plugin = "mlaunch_test::LifecycleComponent"
+    path = tmp_path / "components.launch.xml"
+    path.write_text(
+        f"""<launch>
+<node_container exec="{sys.executable}" args="{LIFECYCLE_CONTAINER}" name="box" namespace=""
+    output="screen">
+  <composable_lifecycle_node pkg="mlaunch_test" plugin="{plugin}" name="cam"
+      namespace="/robot" autostart="true"/>
+  <composable_lifecycle_node pkg="mlaunch_test" plugin="{plugin}" name="idle"/>
+</node_container>
+</launch>
+"""
+    )
+    run = Running(mlaunch(str(path)), env=clean_env(**ros_env))
+    try:
+        run.wait_for(r"Loaded node '/idle' in container '/box'", 30)
+        run.wait_for(r"activate of /robot/cam succeeded; it is now 'active'", 30)
+        run.wait_for(r"/robot/cam transition activate: success", 10)
+        run.signal(signal.SIGINT)
+        code = run.finish(30)
+    finally:
+        run.kill()
+    text = run.text
+    assert code == 130, text
+    assert "transition failed" not in text, text
+    assert "configure of /robot/cam succeeded; it is now 'inactive'" in text
+    assert "/idle transition" not in text, text
+    tail = text[text.index("shutting down: SIGINT received") :]
+    assert "deactivate of /robot/cam succeeded" in tail, tail
+    assert tail.index("/robot/cam transition deactivate: success") < tail.index(
+        "process has finished cleanly"
+    ), tail

@@ -1,10 +1,12 @@
 """Launch syntax newer than Jazzy, which Jazzy users copy from Kilted and Rolling files: ForEach
 and ForLoop (Python, ``<for_each>``, ``<for>``, ``$(for-var)``, ``$(index)``) and
-StringJoinSubstitution (``$(string-join)``) run under mlaunch, the same in the three formats,
-and ``--check`` names each as newer than Jazzy with the release that has it."""
+StringJoinSubstitution (``$(string-join)``) and ComposableLifecycleNode
+(``<composable_lifecycle_node>``) run under mlaunch, the same in the three formats, and
+``--check`` names each as newer than Jazzy with the release that has it."""
 
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
@@ -134,30 +136,66 @@ def test_check_names_the_lifecycle_node_tag_as_newer(tmp_path: Path, env: dict[s
     ), done.stdout
 
 
-@pytest.mark.parametrize("ext", ["xml", "yaml"])
-def test_a_composable_lifecycle_node_says_it_is_newer_and_not_run_yet(
-    tmp_path: Path, env: dict[str, str], ext: str
+LIFECYCLE_COMPONENT = ["lifecycle_component.launch." + ext for ext in ("xml", "yaml", "py")]
+
+
+def _loads(name: str, *args: str) -> list[object]:
+    """The plan's component loads as --print --format json gives them, without their file."""
+    done = run_mlaunch(str(NEWER / name), "--print", "--format", "json", *args, env=clean_env())
+    assert done.returncode == 0, done.stderr
+    steps = json.loads(done.stdout)["steps"]
+    loads = [s for s in steps if s["kind"] == "load_components"]
+    for load in loads:
+        load.pop("origin", None)
+    return loads
+
+
+def test_a_composable_lifecycle_node_is_the_same_plan_in_xml_yaml_and_python() -> None:
+    """It was "<composable_lifecycle_node> is newer than Jazzy ... and mlaunch does not run it
+    yet" (exit 2): now a component to load, after the composable_node ones, marked to be
+    brought up (autostart), the same in the three formats; autostart:=false drops the mark."""
+    xml, yaml, python = (_loads(name) for name in LIFECYCLE_COMPONENT)
+    assert xml == yaml == python
+    (load,) = xml
+    assert isinstance(load, dict) and load["container"] == "/c"
+    nodes = load["nodes"]
+    assert [n["full_name"] for n in nodes] == ["/plain", "/robot/n"]
+    assert "autostart" not in nodes[0] and nodes[1]["autostart"] is True
+    for name in LIFECYCLE_COMPONENT:
+        (off,) = _loads(name, "up:=false")
+        assert isinstance(off, dict) and all("autostart" not in n for n in off["nodes"]), name
+    text = run_mlaunch(str(NEWER / LIFECYCLE_COMPONENT[0]), "--print", env=clean_env()).stdout
+    assert "component /robot/n   (loaded into /c)" in text
+    assert "  lifecycle: autostart (configured and activated once loaded)" in text
+
+
+@pytest.mark.parametrize("name", LIFECYCLE_COMPONENT)
+def test_check_names_the_composable_lifecycle_node_as_newer_and_run(
+    name: str, env: dict[str, str]
 ) -> None:
-    """It was "unexpected tag <composable_lifecycle_node> (did you mean 'composable_node'?)"."""
-    path = tmp_path / f"c.launch.{ext}"
-    if ext == "xml":
-        path.write_text(
-            '<launch>\n<node_container pkg="rclcpp_components" exec="component_container"'
-            ' name="c" namespace="">\n<composable_lifecycle_node pkg="p" plugin="p::N" name="n"'
-            ' autostart="true"/>\n</node_container>\n</launch>\n'
-        )
-    else:
-        path.write_text(
-            "launch:\n- node_container:\n    pkg: rclcpp_components\n"
-            "    exec: component_container\n    name: c\n    namespace: ''\n"
-            "    composable_lifecycle_node:\n    - {pkg: p, plugin: p::N, name: n}\n"
-        )
+    """--check said "mlaunch does not run it yet either"."""
+    done = run_mlaunch(str(NEWER / name), "--check", env=env)
+    assert done.returncode == 1
+    what = {
+        "xml": "<composable_lifecycle_node>",
+        "yaml": "'composable_lifecycle_node'",
+        "py": "launch_ros.descriptions.ComposableLifecycleNode",
+    }[name.rsplit(".", 1)[1]]
+    assert (
+        f"{what} is newer than Jazzy: launch_ros 0.29.3 (Rolling, ros2/launch_ros#480) has it,"
+        " ros2 launch (Jazzy) fails on it; mlaunch runs it" in done.stdout
+    ), done.stdout
+
+
+def test_a_bad_autostart_of_a_composable_lifecycle_node_is_a_located_error(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    path = tmp_path / "c.launch.xml"
+    path.write_text(
+        '<launch>\n<node_container pkg="rclcpp_components" exec="component_container"'
+        ' name="c" namespace="">\n<composable_lifecycle_node pkg="p" plugin="p::N" name="n"'
+        ' autostart="maybe"/>\n</node_container>\n</launch>\n'
+    )
     done = run_mlaunch(str(path), "--print", env=env)
     assert done.returncode == 2
-    assert "composable_lifecycle_node" in done.stderr and (
-        "is newer than Jazzy (launch_ros 0.29.3, Rolling, ros2/launch_ros#480) and mlaunch does"
-        " not run it yet: write a composable_node" in done.stderr
-    ), done.stderr
-    checked = run_mlaunch(str(path), "--check", env=env)
-    assert checked.returncode == 1
-    assert "mlaunch does not run it yet either" in checked.stdout, checked.stdout
+    assert f"{path}:3" in done.stderr and "maybe" in done.stderr, done.stderr

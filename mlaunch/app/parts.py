@@ -193,6 +193,8 @@ def lifecycle_part(
         if isinstance(event, Started):
             node = event.process.spec.node
             return node is not None and node.lifecycle
+        if isinstance(event, HandedOff):  # a load of a lifecycle component to autostart
+            return Need.LIFECYCLE in event.step.needs
         return isinstance(event, LaunchEvent) and bool(getattr(event.event, "needs", None))
 
     return _AttachOnDemand(supervisor, wants, make)

@@ -166,6 +166,7 @@ ON_EXIT_WORDS = ("shutdown",)
 # Newer than Jazzy, and run by mlaunch on Jazzy (--check names the release that has each): a
 # Jazzy ros2 launch rejects the file. Tags, substitutions, and Python names and modules.
 _LAUNCH_3_8 = "launch 3.8 (Kilted, ros2/launch#802)"
+_COMPOSABLE_LIFECYCLE = "launch_ros 0.29.3 (Rolling, ros2/launch_ros#480)"
 NEWER_TAGS = {
     "for_each": _LAUNCH_3_8,
     "for": _LAUNCH_3_8,
@@ -173,7 +174,7 @@ NEWER_TAGS = {
 }
 # Sub-entities newer than Jazzy (inside node_container, load_composable_node).
 NEWER_SUBENTITIES = {
-    "composable_lifecycle_node": "launch_ros 0.29.3 (Rolling, ros2/launch_ros#480)",
+    "composable_lifecycle_node": _COMPOSABLE_LIFECYCLE,
 }
 NEWER_SUBSTITUTIONS = {
     "for-var": _LAUNCH_3_8,
@@ -190,11 +191,14 @@ NEWER_PYTHON = {
     "launch.substitutions.for_loop_var": _LAUNCH_3_8,
     "launch.substitutions.StringJoinSubstitution": _STRING_JOIN,
     "launch.substitutions.string_join_substitution": _STRING_JOIN,
+    "launch_ros.descriptions.ComposableLifecycleNode": _COMPOSABLE_LIFECYCLE,
+    "launch_ros.descriptions.composable_lifecycle_node": _COMPOSABLE_LIFECYCLE,
 }
 
 
-def newer(what: str, release: str, *, runs: bool = True) -> str:
-    """The finding for syntax newer than Jazzy (``runs``: whether mlaunch runs it)."""
-    return f"{what} is newer than Jazzy: {release} has it, ros2 launch (Jazzy) fails on it;" + (
-        " mlaunch runs it" if runs else " mlaunch does not run it yet either"
+def newer(what: str, release: str) -> str:
+    """The finding for syntax newer than Jazzy, which mlaunch runs."""
+    return (
+        f"{what} is newer than Jazzy: {release} has it, ros2 launch (Jazzy) fails on it;"
+        " mlaunch runs it"
     )

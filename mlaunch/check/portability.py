@@ -153,7 +153,7 @@ class _Walker:
             if kind == "xml-only" and self.fmt == "yaml":
                 kind = None
             if kind is None and name in jazzy.NEWER_SUBENTITIES:
-                newer = jazzy.newer(repr(name), jazzy.NEWER_SUBENTITIES[name], runs=False)
+                newer = jazzy.newer(repr(name), jazzy.NEWER_SUBENTITIES[name])
                 self.add(e, newer, attr)
                 continue
             if kind is None:
@@ -172,7 +172,7 @@ class _Walker:
                 kind = table.get(child.tag, "")
                 if child.tag in jazzy.NEWER_SUBENTITIES:
                     release = jazzy.NEWER_SUBENTITIES[child.tag]
-                    self.add(child, jazzy.newer(f"<{child.tag}>", release, runs=False))
+                    self.add(child, jazzy.newer(f"<{child.tag}>", release))
                     continue
                 if not kind.startswith("entities:"):
                     self.add(child, f"Jazzy's {e.tag} takes no <{child.tag}> inside it")

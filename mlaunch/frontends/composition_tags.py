@@ -6,6 +6,9 @@ children; ``load_composable_node`` takes ``target`` (the container's name) and
 ``composable_node`` children. A ``composable_node`` takes ``pkg``, ``plugin`` and ``name``
 (required, as in launch_ros), ``namespace``, ``if``/``unless``, and ``param``, ``remap`` and
 ``extra_arg`` (``name``, ``value``) children; an extra argument's value is typed as YAML.
+A ``composable_lifecycle_node`` (newer than Jazzy: launch_ros 0.29.3, ros2/launch_ros#480)
+takes the same plus ``autostart``; the lifecycle ones are loaded after the ``composable_node``
+ones of the same parent, as upstream's parser lists them.
 The composition modules are imported only when such a tag appears.
 """
 
@@ -23,7 +26,8 @@ if TYPE_CHECKING:
     from typing import Any
 
 
-def _composable_node(e: Element) -> Any:
+def _composable_node(e: Element, lifecycle: bool = False) -> Any:
+    from mlaunch.launch_ros.descriptions.composable_lifecycle_node import ComposableLifecycleNode
     from mlaunch.launch_ros.descriptions.composable_node import ComposableNode
 
     kwargs: dict[str, Any] = {
@@ -31,6 +35,10 @@ def _composable_node(e: Element) -> Any:
         "plugin": required_text(e, "plugin"),
         "name": required_text(e, "name"),
     }
+    if lifecycle:
+        autostart = e.flag("autostart")
+        if autostart is not None:
+            kwargs["autostart"] = autostart
     when = e.condition_text("if")
     unless = e.condition_text("unless")
     if when is not None and unless is not None:
@@ -52,7 +60,7 @@ def _composable_node(e: Element) -> Any:
     if extra:
         kwargs["extra_arguments"] = extra
     e.finish()
-    description = ComposableNode(**kwargs)
+    description = ComposableLifecycleNode(**kwargs) if lifecycle else ComposableNode(**kwargs)
     description.origin = e.origin  # type: ignore[attr-defined]
     return description
 
@@ -68,7 +76,9 @@ def _extra_argument(x: Element) -> dict[Any, Any]:
 
 
 def _descriptions(e: Element) -> list[Any]:
-    return [_composable_node(c) for c in e.subentities("composable_node")]
+    plain = [_composable_node(c) for c in e.subentities("composable_node")]
+    lifecycle = e.subentities("composable_lifecycle_node")
+    return plain + [_composable_node(c, lifecycle=True) for c in lifecycle]
 
 
 def _node_container(e: Element) -> Any:

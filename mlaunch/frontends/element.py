@@ -40,14 +40,6 @@ class MissingAttributeError(LaunchFileError, AttributeError):
     """A required attribute is not there (an AttributeError, as upstream's Element raises)."""
 
 
-# Newer syntax mlaunch knows of and does not run yet: tag -> what it is and what to write.
-NOT_RUN_YET = {
-    "composable_lifecycle_node": "newer than Jazzy (launch_ros 0.29.3, Rolling,"
-    " ros2/launch_ros#480) and mlaunch does not run it yet: write a composable_node and bring"
-    " its lifecycle up with 'ros2 lifecycle set' or a lifecycle manager",
-}
-
-
 class UnexpectedEntityError(LaunchFileError, ValueError):
     """An attribute or nested tag nothing read (a ValueError, as upstream raises it)."""
 
@@ -310,12 +302,6 @@ class Element:
             if self.fmt == "yaml":
                 raise self.error(f"{self.tag} takes no child entities", kind=UnexpectedEntityError)
             for child in self.children:
-                if child.tag in NOT_RUN_YET:
-                    raise UnexpectedEntityError(
-                        f"<{child.tag}> is {NOT_RUN_YET[child.tag]}",
-                        where=child.where(),
-                        what=self.what,
-                    )
                 if child.tag not in self._sub_tags:
                     valid = ", ".join(f"<{t}>" for t in self._sub_tags) or "none"
                     hint = _did_you_mean(child.tag, self._sub_tags)
@@ -332,8 +318,6 @@ class Element:
         hint = _did_you_mean(name, [*known, "if", "unless"])
         if name == "children" and self.fmt == "yaml":
             return f"{self.tag} takes no children"
-        if name in NOT_RUN_YET:
-            return f"{name!r} is {NOT_RUN_YET[name]}"
         valid = ", ".join(known) or "none"
         return f"unknown attribute {name!r}{hint}; valid attributes: {valid}"
 

@@ -15,7 +15,7 @@ container's full name, which exists only once the container was visited."""
 
 from __future__ import annotations
 
-from mlaunch.plan.steps import COMPONENTS, Handoff
+from mlaunch.plan.steps import COMPONENTS, LIFECYCLE, Handoff, Need
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -31,11 +31,10 @@ class LoadComponents(Handoff):
     that, ``'box'`` rather than ``'/box'``); empty means the same as ``target``.
     A Handoff: the supervisor emits it on the event stream when it reaches it (in the plan, a
     timer or an event handler), and the LoadNode driver (mlaunch.parts.components) sends the
-    requests."""
+    requests; a request with ``autostart`` is then brought up by the lifecycle driver."""
 
     __slots__ = ("names", "requests", "target", "written")
     _fields = (*Handoff._fields, "target", "requests", "written")
-    needs = COMPONENTS  # the run attaches the LoadNode driver (Plan.needs)
 
     def __init__(
         self,
@@ -52,6 +51,14 @@ class LoadComponents(Handoff):
         # The run's count of node names (launch_ros's), which a load adds to once it succeeds;
         # not a field: it is the run's shared state, not what the step says.
         self.names = names
+
+    @property
+    def needs(self) -> frozenset[Need]:
+        """The run attaches the LoadNode driver (Plan.needs), and lifecycle driving when a
+        request autostarts (a ComposableLifecycleNode's)."""
+        if any(r.autostart for r in self.requests):
+            return COMPONENTS | LIFECYCLE
+        return COMPONENTS
 
     @property
     def container_name(self) -> str:

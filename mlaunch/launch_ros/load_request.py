@@ -76,7 +76,9 @@ class LoadRequest(Value):
         "parameters",
         "extra_arguments",
     )
-    __slots__ = _fields
+    # autostart: what the launch does once the node is loaded (a ComposableLifecycleNode's: it
+    # configures and activates it), not part of the message, so not a field.
+    __slots__ = (*_fields, "autostart")
 
     def __init__(
         self,
@@ -88,7 +90,9 @@ class LoadRequest(Value):
         remap_rules: tuple[str, ...] = (),
         parameters: tuple[TypedParameter, ...] = (),
         extra_arguments: tuple[TypedParameter, ...] = (),
+        autostart: bool = False,
     ) -> None:
+        self.autostart = autostart
         self.package_name = package_name
         self.plugin_name = plugin_name
         self.node_name = node_name
@@ -132,6 +136,7 @@ def load_request(description: ComposableNode, context: LaunchContext) -> LoadReq
         extra = flatten(
             context, description.extra_arguments, name, namespace, field="extra_arguments"
         )
+    autostarts = getattr(description, "autostarts", None)  # a ComposableLifecycleNode's
     return LoadRequest(
         package_name=package,
         plugin_name=plugin,
@@ -140,6 +145,7 @@ def load_request(description: ComposableNode, context: LaunchContext) -> LoadReq
         remap_rules=tuple(remaps),
         parameters=tuple(typed_params),
         extra_arguments=tuple(extra),
+        autostart=bool(autostarts(context)) if autostarts is not None else False,
     )
 
 
@@ -300,6 +306,8 @@ def describe_request(request: LoadRequest, container: str, origin: str) -> list[
         lines.append(f"  param:   {p.name} = {shorten(value_text(_listed(p.value)), 120)}")
     for p in request.extra_arguments:
         lines.append(f"  extra:   {p.name} = {value_text(_listed(p.value))}")
+    if request.autostart:
+        lines.append("  lifecycle: autostart (configured and activated once loaded)")
     return lines
 
 
@@ -311,7 +319,7 @@ def request_data(request: LoadRequest) -> dict[str, Any]:
         return {"name": p.name, "value": json_safe(p.value), "type": TYPE_NAMES[p.type]}
 
     named = bool(request.node_name)
-    return {
+    data = {
         "package": request.package_name,
         "plugin": request.plugin_name,
         "name": request.node_name if named else None,
@@ -325,6 +333,9 @@ def request_data(request: LoadRequest) -> dict[str, Any]:
         "parameters": [typed(p) for p in request.parameters],
         "extra_arguments": [typed(p) for p in request.extra_arguments],
     }
+    if request.autostart:  # only then, so plans without lifecycle components read as before
+        data["autostart"] = True
+    return data
 
 
 def _listed(value: Any) -> Any:

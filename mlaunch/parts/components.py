@@ -28,7 +28,15 @@ from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
-from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Said, ShutdownBegun
+from mlaunch.plan.events import (
+    ComponentLoaded,
+    Event,
+    Exited,
+    HandedOff,
+    LoadRefused,
+    Said,
+    ShutdownBegun,
+)
 from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -116,14 +124,15 @@ class ComponentLoader:
         context: Any,
         log: Log,
         finished: Callable[[threading.Thread], None] | None = None,
-        loaded: Callable[[LoadComponents, str], None] | None = None,
+        loaded: Callable[[LoadComponents, str, LoadRequest], None] | None = None,
         failed: Callable[[LoadComponents], None] | None = None,
         refused: Callable[[LoadComponents, LoadResult], None] | None = None,
     ) -> None:
         self.context = context  # an initialised rclpy Context
         self.log = log
         self.finished = finished
-        self.loaded = loaded  # (step, the node's full name) after each successful load
+        # (step, the node's full name, the request) after each successful load
+        self.loaded = loaded
         self.failed = failed  # (step) when sending its requests raised
         self.refused = refused  # (step, result) when the container answered it did not load
         self.stop = threading.Event()
@@ -393,7 +402,7 @@ class ComponentLoader:
         name = response.full_node_name or request.node_name
         if response.success:
             if self.loaded is not None and name:
-                self.loaded(step, name)
+                self.loaded(step, name, request)
             self.log(
                 "INFO",
                 f"Loaded node '{response.full_node_name}' in container '{step.container_name}'",
@@ -491,11 +500,14 @@ class ComponentDriver(Part):
             f" '{target}/_container/load_node' service until the launch stops (as launch_ros)",
         )
 
-    def _loaded(self, step: LoadComponents, name: str) -> None:
+    def _loaded(self, step: LoadComponents, name: str, request: LoadRequest) -> None:
         """A component counts among the run's node names, as launch_ros counts it; a second
-        node of the same name is warned about (under the container's name, as launch_ros)."""
+        node of the same name is warned about (under the container's name, as launch_ros).
+        A component to autostart is said on the stream (the lifecycle driver brings it up)."""
 
         def count() -> None:
+            if request.autostart:
+                self.supervisor.events.emit(ComponentLoaded(step, request, name))
             if step.names is None:
                 return
             step.names[name] = step.names.get(name, 0) + 1

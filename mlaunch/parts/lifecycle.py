@@ -6,6 +6,10 @@ What it does, attached to the supervisor by the pipeline when the plan needs it 
   driven to ``active`` once its process starts: its ``get_state``/``change_state`` services are
   awaited with a deadline, then ``configure`` and ``activate`` are asked for, starting from
   whatever state it is in. A respawned node is driven back to ``active`` the same way.
+- A ``ComposableLifecycleNode(..., autostart=True)`` (``composable_lifecycle_node``) is driven
+  the same way once its container answered that it loaded it (``ComponentLoaded``), and again
+  each time it is loaded anew (``mlaunch ctl load``). It lives as long as its container's
+  process; a failed transition is said and ends nothing (it has no ``required``).
 - ``EmitEvent(event=ChangeState(lifecycle_node_matcher=..., transition_id=...))`` asks the matched
   running lifecycle nodes for that transition; ``OnStateTransition`` handlers fire on the
   ``<node>/transition_event`` messages, as in launch_ros.
@@ -44,6 +48,7 @@ from mlaunch.launch_ros.lifecycle_sequence import (
 from mlaunch.parts.handoff import LoopCall, SharedGraph
 from mlaunch.plan.errors import EXIT_FAILURE
 from mlaunch.plan.events import (
+    ComponentLoaded,
     Event,
     Exited,
     LaunchEvent,
@@ -98,10 +103,32 @@ class Managed:
     state: str = "unknown"
     brought_up: bool = False
     subscribed: bool = False
+    # A composable node's: what ChangeState matchers and StateTransition events see (its
+    # spec is its container's).
+    component: ComponentTarget | None = None
 
     @property
     def required(self) -> bool:
-        return self.spec.required
+        return self.spec.required and self.component is None
+
+    @property
+    def action(self) -> Any:
+        """What launch_ros's events name as the node: its action, or the component."""
+        return self.component if self.component is not None else self.spec.action
+
+
+class ComponentTarget:
+    """A loaded lifecycle component as matchers and StateTransition events see it
+    (``matches_node_name`` reads ``node_name``, its full name)."""
+
+    __slots__ = ("container", "node_name")
+
+    def __init__(self, node_name: str, container: str) -> None:
+        self.node_name = node_name
+        self.container = container
+
+    def __repr__(self) -> str:
+        return f"<component {self.node_name} in {self.container}>"
 
 
 class Outcome(Event):
@@ -190,6 +217,8 @@ class LifecycleManager(Part):
             self._on_process(False, event.process)
         elif isinstance(event, Exited):
             self._on_process(True, event.process)
+        elif isinstance(event, ComponentLoaded):
+            self._on_loaded(event)
         elif isinstance(event, ShutdownBegun):
             self._on_shutdown()
         elif isinstance(event, LaunchEvent):
@@ -200,21 +229,60 @@ class LifecycleManager(Part):
                 self._on_change_state(event.event)
 
     def _on_process(self, exited: bool, process: ProcessView) -> None:
+        if exited:
+            # The components it hosted are gone with it (a new container loads none of them).
+            for hosted in self.nodes.values():
+                if hosted.component is not None and hosted.process is process:
+                    self._gone(hosted)
         managed = self._track(process.spec)
         if managed is None:
             return
         if exited:
-            managed.process = None
-            managed.generation += 1
-            managed.state = "gone"
-            if managed.fqn in self.activation_order:
-                self.activation_order.remove(managed.fqn)
+            self._gone(managed)
             return
         managed.process = process
         reason = ""
         if managed.drive == "autostart" or (managed.drive == "sequence" and managed.brought_up):
             reason = "respawn" if process.restarts else "autostart"
         self._spawn(self._started, managed, managed.generation, reason)
+
+    def _gone(self, managed: Managed) -> None:
+        managed.process = None
+        managed.generation += 1
+        managed.state = "gone"
+        if managed.fqn in self.activation_order:
+            self.activation_order.remove(managed.fqn)
+
+    def _on_loaded(self, event: ComponentLoaded) -> None:
+        """A container loaded a component to autostart: bring it up, as an autostart node."""
+        target = getattr(event.step, "target", "")
+        container = next(
+            (
+                p
+                for p in self.supervisor.processes
+                if p.running
+                and p.spec.node is not None
+                and p.spec.node.fully_qualified_name == target
+            ),
+            None,
+        )
+        if container is None:
+            self._say(
+                "WARNING",
+                f"lifecycle component {event.name} was loaded into {target}, which is no process"
+                " of this launch: it is not brought up (start its container in the launch)",
+            )
+            return
+        managed = self.nodes.get(event.name)
+        if managed is None or managed.component is None:
+            managed = Managed(event.name, container.spec, "autostart")
+            managed.component = ComponentTarget(event.name, target)
+            self.nodes[event.name] = managed
+        else:
+            managed.spec = container.spec
+            managed.generation += 1  # a reload: an earlier bring-up's result is stale
+        managed.process = container
+        self._spawn(self._started, managed, managed.generation, "autostart")
 
     def _start_sequences(self) -> None:
         for seq in self.sequences:
@@ -376,7 +444,7 @@ class LifecycleManager(Part):
         elif event.goal_state != "active" and event.node in self.activation_order:
             self.activation_order.remove(event.node)
         transition = StateTransition(
-            action=managed.spec.action,
+            action=managed.action,
             transition=event.transition,
             start_state=event.start_state,
             goal_state=event.goal_state,
@@ -490,7 +558,10 @@ class LifecycleManager(Part):
         from mlaunch.engine.process import Process
 
         # The records name processes by their view; the supervisor holds its own Process objects.
-        held = [m.process for m in targets if isinstance(m.process, Process) and m.process.running]
+        held: list[Process] = []
+        for m in targets:  # a container of several components is held once
+            if isinstance(m.process, Process) and m.process.running and m.process not in held:
+                held.append(m.process)
         if not held or not self.graph.started:
             return
         # They keep running until _release() hands them to the ladder.
@@ -533,7 +604,11 @@ class LifecycleManager(Part):
 def _matches(event: Any, managed: Managed) -> bool:
     """launch_ros matchers take the LifecycleNode action; mlaunch's also take the ProcessSpec."""
     matcher = event.lifecycle_node_matcher
-    for target in (managed.spec, managed.spec.action):
+    if managed.component is not None:
+        targets: tuple[Any, ...] = (managed.component,)
+    else:
+        targets = (managed.spec, managed.spec.action)
+    for target in targets:
         try:
             if matcher(target):
                 return True
@@ -543,11 +618,13 @@ def _matches(event: Any, managed: Managed) -> bool:
 
 
 def _graph_environ(supervisor: Supervisor) -> dict[str, str]:
-    """The environment the managed nodes get (their ROS_DOMAIN_ID), else mlaunch's own."""
-    for spec in supervisor.plan.processes():
+    """The environment the managed nodes get (their ROS_DOMAIN_ID): a lifecycle node's, else
+    the first process's (a container of lifecycle components), else mlaunch's own."""
+    processes = supervisor.plan.processes()
+    for spec in processes:
         if spec.node is not None and spec.node.lifecycle:
             return dict(spec.env)
-    return dict(os.environ)
+    return dict(processes[0].env) if processes else dict(os.environ)
 
 
 # --- attaching -----------------------------------------------------------------------------------

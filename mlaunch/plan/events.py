@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Protocol
+    from typing import Any, Protocol
 
     from mlaunch.plan.steps import Handoff, ProcessSpec
 
@@ -307,6 +307,18 @@ class LoadRefused(Event):
         self.node = node
         self.plugin = plugin
         self.reason = reason
+
+
+class ComponentLoaded(Event):
+    """A container loaded a composable node: ``step`` the LoadComponents it came from,
+    ``request`` what was asked for, ``name`` the node's full name as the container answered."""
+
+    __slots__ = ("name", "request", "step")
+
+    def __init__(self, step: Handoff, request: Any, name: str) -> None:
+        self.step = step
+        self.request = request
+        self.name = name
 
 
 class Transition(Event):

@@ -418,7 +418,10 @@ class Handoff(Step):
     takes is said, never dropped in silence.
     """
 
-    needs: frozenset[Need] = frozenset()
+    @property
+    def needs(self) -> frozenset[Need]:
+        """The part that acts on it (a subclass names it)."""
+        return frozenset()
 
 
 class Need(enum.Enum):

@@ -5,8 +5,12 @@ nodes it loads.
 from __future__ import annotations
 
 from mlaunch.launch_ros.actions.node import Node
-from mlaunch.launch_ros.descriptions.composable_node import ComposableNode, composable_nodes
-from mlaunch.plan.steps import COMPONENTS, NO_NEEDS, Need
+from mlaunch.launch_ros.descriptions.composable_node import (
+    ComposableNode,
+    composable_nodes,
+    load_needs,
+)
+from mlaunch.plan.steps import Need
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -31,8 +35,9 @@ class ComposableNodeContainer(Node):
 
     @property
     def needs(self) -> frozenset[Need]:
-        """The LoadNode driver, when there are nodes to load (seen in a timer or handler too)."""
-        return COMPONENTS if self._descriptions else NO_NEEDS
+        """The LoadNode driver, when there are nodes to load (seen in a timer or handler too),
+        and lifecycle driving when one of them autostarts."""
+        return load_needs(self._descriptions)
 
     # A Node returns nothing; a container also returns the load of its nodes (as launch_ros).
     def execute(self, context: LaunchContext) -> list[Any] | None:  # type: ignore[override]

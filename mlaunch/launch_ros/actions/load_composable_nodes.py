@@ -9,10 +9,14 @@ from mlaunch.launch.substitution import Substitution, describe, normalize, perfo
 from mlaunch.launch_ros.actions.composable_node_container import ComposableNodeContainer
 from mlaunch.launch_ros.actions.node import node_name_counts
 from mlaunch.launch_ros.composition import LoadComponents
-from mlaunch.launch_ros.descriptions.composable_node import ComposableNode, composable_nodes
+from mlaunch.launch_ros.descriptions.composable_node import (
+    ComposableNode,
+    composable_nodes,
+    load_needs,
+)
 from mlaunch.launch_ros.scope import make_namespace_absolute
 from mlaunch.plan.errors import LaunchFileError, MlaunchError
-from mlaunch.plan.steps import COMPONENTS
+from mlaunch.plan.steps import COMPONENTS, Need
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -23,8 +27,6 @@ if TYPE_CHECKING:
 
 class LoadComposableNodes(Action):
     """Load composable nodes into a container, this launch's or one started elsewhere."""
-
-    needs = COMPONENTS  # noted in a timer or a handler body too, before it fires
 
     def __init__(
         self,
@@ -45,6 +47,12 @@ class LoadComposableNodes(Action):
         self._target = target_container
         self._descriptions = composable_nodes(composable_node_descriptions)
         self.final_target_container_name: str | None = None
+
+    @property
+    def needs(self) -> frozenset[Need]:
+        """The LoadNode driver (noted in a timer or a handler body too, before it fires), and
+        lifecycle driving when a node autostarts."""
+        return load_needs(self._descriptions) | COMPONENTS
 
     def execute(self, context: LaunchContext) -> None:
         planner = context.planner

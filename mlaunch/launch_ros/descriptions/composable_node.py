@@ -14,6 +14,7 @@ from collections.abc import Iterable, Mapping
 
 from mlaunch.launch.substitution import normalize
 from mlaunch.plan.errors import LaunchFileError, LaunchFileTypeError
+from mlaunch.plan.steps import COMPONENTS, LIFECYCLE, NO_NEEDS, Need
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -83,6 +84,18 @@ def remap_rules(remappings: Any) -> list[tuple[Subs, Subs]]:
             )
         rules.append((normalize(item[0]), normalize(item[1])))
     return rules
+
+
+def load_needs(descriptions: Iterable[ComposableNode]) -> frozenset[Need]:
+    """What loading ``descriptions`` needs attached to the run: the LoadNode driver, and
+    lifecycle driving when one may autostart (a ComposableLifecycleNode whose autostart is
+    True or substitutions)."""
+    found = list(descriptions)
+    if not found:
+        return NO_NEEDS
+    if any(getattr(d, "autostart", False) is not False for d in found):
+        return COMPONENTS | LIFECYCLE
+    return COMPONENTS
 
 
 def composable_nodes(descriptions: Any) -> list[ComposableNode]:
