@@ -19,6 +19,7 @@ from typing import Any
 
 import pytest
 from browser import Browser, available
+from conftest import requires_rclpy
 from procutil import Running, clean_env, mlaunch, run_mlaunch, wait_for
 
 needs_chromium = pytest.mark.skipif(not available(), reason="chromium not installed (apt chromium)")
@@ -423,3 +424,48 @@ def test_four_tabs_with_their_log_views_open_all_stay_live(run: Run, tmp_path: P
                 60,
                 "a tab's table and log view",
             )
+
+
+NODE_LAUNCH = """from launch import LaunchDescription
+from launch_ros.actions import Node
+def generate_launch_description():
+    return LaunchDescription([Node(package="demo", executable="talker", name="talker")])
+"""
+
+
+def _loads_rcl(pid: int) -> bool:
+    with open(f"/proc/{pid}/maps") as f:
+        return "librcl" in f.read()
+
+
+@requires_rclpy
+def test_the_panel_watches_readiness_only_once_a_page_looks(
+    tmp_path: Path, ros_env: dict[str, str]
+) -> None:
+    """The panel comes with every viewer; the readiness checks it shows cost mlaunch a ROS graph
+    (rclpy and a dozen threads), so they are watched from the first page on, not before."""
+    from procutil import install_package
+
+    prefix = install_package(
+        tmp_path / "install",
+        "demo",
+        {"talker": f"#!{sys.executable}\nimport time\ntime.sleep(600)\n"},
+    )
+    path = tmp_path / "node.launch.py"
+    path.write_text(NODE_LAUNCH)
+    metrics = tmp_path / "cost.csv"
+    env = clean_env(**ros_env, ROS_LOG_DIR=str(tmp_path / "logs"), AMENT_PREFIX_PATH=str(prefix))
+    options = ("--dashboard", "--metrics", str(metrics))
+    running = Running(mlaunch(str(path), *options), env=env, cwd=str(tmp_path))
+    try:
+        port = int(running.wait_for(OPEN, 30).group(2))
+        sampled = lambda: metrics.exists() and metrics.read_text().count('"talker-1"') >= 3  # noqa: E731
+        wait_for(sampled, 60, "three seconds of the panel's samples")
+        assert not _loads_rcl(running.proc.pid)
+        connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+        connection.request("GET", "/launch/events")
+        assert connection.getresponse().status == 200
+        wait_for(lambda: _loads_rcl(running.proc.pid), 60, "the readiness watch once a page looks")
+        connection.close()
+    finally:
+        running.kill()

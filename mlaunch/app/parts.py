@@ -350,13 +350,19 @@ def dashboard_part(run: Run) -> Dashboard:
         driver = run.components
         return [] if driver is None else driver.loader.listed()
 
+    panel: list[Dashboard] = []
+
     def readiness() -> object:
-        return None if run.readiness is None else run.readiness()
+        # Watching the checks costs mlaunch a ROS graph (rclpy, a dozen threads): begun when a
+        # page first looks, not because the viewer stand-in runs (a late watch gets the history).
+        if run.readiness is None or not (panel and panel[0].hub.looked):
+            return None
+        return run.readiness()
 
     metrics = run.metrics()
     metrics.readers["readiness"] = readiness  # mlaunch test's checks, as ctl wait-ready has them
     metrics.readers["lifecycle"] = lambda: run.lifecycle.listed() if run.lifecycle else []
-    return Dashboard(
+    dashboard = Dashboard(
         run.supervisor,
         run.control,
         metrics,
@@ -364,6 +370,8 @@ def dashboard_part(run: Run) -> Dashboard:
         composable=composable,
         evidence=lambda processes, rings: live_evidence(run, processes, rings),
     )
+    panel.append(dashboard)
+    return dashboard
 
 
 def live_evidence(run: Run, processes: Sequence[Any], rings: Mapping[str, Sequence[str]]) -> bytes:

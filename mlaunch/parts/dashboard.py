@@ -86,6 +86,7 @@ class Hub:
         self.history: dict[str, deque[tuple[float, int]]] = {}
         self.closed = False
         self.streams = 0
+        self.looked = False  # a page has opened a stream: the readiness checks are worth watching
 
     def add_output(self, label: str, data: bytes) -> None:
         text = data.decode("utf-8", "replace").splitlines()

@@ -189,6 +189,7 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
                 else:
                     full = False
                     hub.streams += 1
+                    hub.looked = True
             if full:
                 self._text(503, f"at most {MAX_STREAMS} pages at once\n")
                 return
