@@ -9,7 +9,6 @@ is attached.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
 
 from mlaunch.app.options import Options
 from mlaunch.engine.part import Part
@@ -18,6 +17,8 @@ from mlaunch.plan.steps import Need, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from typing import Any
+
     from mlaunch.engine.output import Printer
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.components import ComponentDriver
