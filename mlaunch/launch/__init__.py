@@ -32,9 +32,12 @@ if TYPE_CHECKING:
 
 # name -> (module, attribute in it)
 _NAMES: dict[str, tuple[str, str]] = {
-    "Action": ("mlaunch.launch.launch_description", "Action"),
+    "Action": ("mlaunch.launch.action", "Action"),
     "LaunchDescription": ("mlaunch.launch.launch_description", "LaunchDescription"),
-    "LaunchDescriptionEntity": ("mlaunch.launch.launch_description", "LaunchDescriptionEntity"),
+    "LaunchDescriptionEntity": (
+        "mlaunch.launch.launch_description_entity",
+        "LaunchDescriptionEntity",
+    ),
     "Condition": ("mlaunch.launch.conditions", "Condition"),
     "InvalidLaunchFileError": (
         "mlaunch.launch.invalid_launch_file_error",
