@@ -23,7 +23,7 @@ from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES
 from mlaunch.engine.output import Printer
 from mlaunch.engine.process import Process
 from mlaunch.parts import status
-from mlaunch.plan.events import Output, Started
+from mlaunch.plan.records import Output, Started
 from mlaunch.plan.steps import ArgumentInfo, ProcessSpec
 from mlaunch.resolve import describe
 from mlaunch.standins.viewer_config import PORT_ENV

@@ -1,7 +1,7 @@
 """Composable node loads written in timers and event handlers reach the LoadNode driver.
 
 Pure: the supervisor runs real short-lived children and hands every LoadComponents step over
-on its event stream (HandedOff) as it reaches it, from the plan, a TimerAction or an event
+on its record stream (HandedOff) as it reaches it, from the plan, a TimerAction or an event
 handler alike; a subscriber stands in for the driver. tests/test_composition_deferred_ros.py
 sends them to real rclpy containers.
 """
@@ -15,7 +15,7 @@ import pytest
 from test_supervision import Harness, plan_from, write_launch
 
 from mlaunch.launch_ros.composition import LoadComponents
-from mlaunch.plan.events import Event, HandedOff, ShutdownBegun, Started
+from mlaunch.plan.records import HandedOff, Record, ShutdownBegun, Started
 from mlaunch.plan.steps import Need, Plan
 
 # A process that lives until the test's run is shut down, and one that exits at once.
@@ -56,9 +56,9 @@ class Loads:
         self.count = count
         self.steps: list[LoadComponents] = []
         self.order: list[str] = []
-        harness.sup.events.subscribe(self.on_event)
+        harness.sup.records.subscribe(self.on_event)
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: Record) -> None:
         if isinstance(event, Started):
             self.order.append(f"started {event.process.spec.base_name}")
         if not isinstance(event, HandedOff) or not isinstance(event.step, LoadComponents):
@@ -94,7 +94,7 @@ def test_a_load_keeps_an_idle_launch_running_until_its_work_is_done() -> None:
     seen: list[str] = []
     work = object()
 
-    def on_event(event: Event) -> None:
+    def on_event(event: Record) -> None:
         if isinstance(event, HandedOff):
             event.taken = True
             h.sup.busy(work)
@@ -106,7 +106,7 @@ def test_a_load_keeps_an_idle_launch_running_until_its_work_is_done() -> None:
         seen.append("done")
         h.sup.done(work)
 
-    h.sup.events.subscribe(on_event)
+    h.sup.records.subscribe(on_event)
     assert h.run() == 0
     assert seen == ["done", "shutdown idle"]
 

@@ -268,18 +268,18 @@ def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
     from mlaunch.launch_ros.composition import LoadComponents
     from mlaunch.launch_ros.load_request import LoadRequest
     from mlaunch.parts.components import ComponentDriver
-    from mlaunch.plan.events import Event, HandedOff
+    from mlaunch.plan.records import HandedOff, Record
     from mlaunch.plan.steps import Plan
 
     request = LoadRequest("p", "p::A", "a")
     h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
     driver = ComponentDriver(h.sup)
 
-    def on_event(event: Event) -> None:
+    def on_event(event: Record) -> None:
         if isinstance(event, HandedOff):  # the driver has its thread waiting by now
             h.sup.schedule(0.0, h.shutdown)
 
-    h.sup.events.subscribe(on_event)
+    h.sup.records.subscribe(on_event)
     try:
         assert h.run() == 0
     finally:

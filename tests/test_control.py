@@ -2,7 +2,7 @@
 
 Each request is made from inside the loop when a child says something (the harness's hooks),
 as the control socket and the --status keys make them; the test then reads the records, the
-event stream and the printer's words. No sleeps: children wait for files the test creates.
+record stream and the printer's words. No sleeps: children wait for files the test creates.
 """
 
 from __future__ import annotations
@@ -15,20 +15,20 @@ from test_supervision import Harness, make_spec, plan_from, write_launch
 
 from mlaunch.engine.process_state import RUNNING, STOPPED
 from mlaunch.parts.control import ControlError, ProcessInfo, UnknownLabel
-from mlaunch.plan.events import Controlled, Event, Exited, RespawnScheduled, Started
+from mlaunch.plan.records import Controlled, Exited, Record, RespawnScheduled, Started
 from mlaunch.plan.steps import RespawnPolicy
 
-E = TypeVar("E", bound=Event)
+E = TypeVar("E", bound=Record)
 
 
 class Seen:
-    """The records of the run's event stream that these tests look at."""
+    """The records of the run's record stream that these tests look at."""
 
     def __init__(self, h: Harness) -> None:
-        self.events: list[Event] = []
-        h.sup.events.subscribe(self._on)
+        self.events: list[Record] = []
+        h.sup.records.subscribe(self._on)
 
-    def _on(self, event: Event) -> None:
+    def _on(self, event: Record) -> None:
         if isinstance(event, (Started, Exited, RespawnScheduled, Controlled)):
             self.events.append(event)
 
@@ -68,7 +68,7 @@ def test_stop_is_said_as_a_user_stop_and_respawn_leaves_it_down() -> None:
     assert not any("died" in m for m in worker)
     assert not seen.of(RespawnScheduled)
     assert len([e for e in seen.of(Started) if e.process.label == "worker"]) == 1
-    record = h.sup.records["worker"]
+    record = h.sup.states["worker"]
     assert record.state == STOPPED and record.outcome == "stopped by the user"
     assert not record.failed
     assert stopped and stopped[0].state == STOPPED and stopped[0].pid == 0
@@ -101,7 +101,7 @@ def test_start_after_a_stop_and_restart_keep_the_label_without_backoff() -> None
     assert not seen.of(RespawnScheduled)  # no respawn, so no backoff delay either
     assert [i.restarts for i in infos] == [1, 2, 3]
     assert all(i.state == RUNNING and i.pid for i in infos)
-    record = h.sup.records["worker"]
+    record = h.sup.states["worker"]
     assert record.restarts == 3 and record.user_starts == 3 and record.streak == 0
     words = h.messages("worker")
     assert words.count("restart asked by the user") == 2
@@ -132,7 +132,7 @@ def test_user_restarts_do_not_use_up_respawn_retries() -> None:
 
     h.when(b"ready", on_up)
     assert h.run() == 0
-    record = h.sup.records["w"]
+    record = h.sup.states["w"]
     assert record.restarts == 2 and record.user_starts == 2
     assert "giving up" not in h.text
 
@@ -190,7 +190,7 @@ def test_a_user_stop_of_a_required_process_does_not_end_or_fail_the_run() -> Non
     def check_then_stop() -> None:
         if boss_gone[0]:
             assert not h.sup.shutting_down  # the required process did not end the launch
-            assert h.sup.records["other"].state == RUNNING
+            assert h.sup.states["other"].state == RUNNING
             h.shutdown()
         else:
             h.sup.schedule(0.02, check_then_stop)
@@ -246,7 +246,7 @@ def test_a_stop_cancels_a_pending_respawn() -> None:
     h = Harness([make_spec("crash", "import sys; sys.exit(1)", respawn=policy)])
     infos: list[ProcessInfo] = []
 
-    def on_exit(event: Event) -> None:
+    def on_exit(event: Record) -> None:
         if isinstance(event, RespawnScheduled):
             pending = h.control().info("crash")
             assert pending.restart_in is not None and 29 < pending.restart_in <= 30
@@ -254,11 +254,11 @@ def test_a_stop_cancels_a_pending_respawn() -> None:
             h.control().stop("crash", done=infos.append)
             h.sup.schedule(0.0, h.shutdown)
 
-    h.sup.events.subscribe(on_exit)
+    h.sup.records.subscribe(on_exit)
     assert h.run() == 0
     assert h.elapsed < 5
     assert infos and infos[0].state == STOPPED and infos[0].restart_in is None
-    assert h.sup.records["crash"].state == STOPPED
+    assert h.sup.states["crash"].state == STOPPED
 
 
 def test_bad_requests_are_clear_errors_and_change_nothing() -> None:
@@ -287,7 +287,7 @@ def test_bad_requests_are_clear_errors_and_change_nothing() -> None:
     assert "(processes: talker, listener)" in errors[0]
     assert errors[1].startswith("talker is already running [pid ")
     assert errors[2] == "logs: this run writes no log files: no lines kept"
-    assert h.sup.records["talker"].restarts == 0
+    assert h.sup.states["talker"].restarts == 0
 
 
 def test_an_unknown_label_lists_at_most_twenty() -> None:
@@ -302,7 +302,7 @@ def test_list_shows_every_label() -> None:
     rows: list[dict[str, object]] = []
 
     def listing() -> None:
-        if h.sup.records.get("b") is None or h.sup.records["b"].state == RUNNING:
+        if h.sup.states.get("b") is None or h.sup.states["b"].state == RUNNING:
             h.sup.schedule(0.02, listing)
             return
         rows.extend(info.as_dict() for info in h.control().processes())

@@ -3,7 +3,7 @@
 One mlaunch runs a talker (respawn=True, a numbered tick every 50 ms) and a sleeper; the test
 drives it from "another shell" (``mlaunch ctl`` as a subprocess) and waits on what mlaunch
 prints or what ``ctl`` answers, with deadlines. The in-process tests of the same operations,
-with the event stream in view, are in test_control.py.
+with the record stream in view, are in test_control.py.
 """
 
 from __future__ import annotations

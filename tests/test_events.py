@@ -1,6 +1,6 @@
-"""The engine's event stream: records handled in order, one at a time, after a description's visit.
+"""The engine's record stream: records handled in order, one at a time, after a description's visit.
 
-Pure tests of EventStream, then supervisor runs of real short-lived children whose order of
+Pure tests of RecordStream, then supervisor runs of real short-lived children whose order of
 records and lines is compared with what launch does (and, where the reference ros2 launch is
 built on this machine, with its own output).
 """
@@ -18,12 +18,12 @@ import pytest
 import reference
 from test_supervision import Harness, plan_from
 
-from mlaunch.plan.events import (
-    Event,
-    EventStream,
+from mlaunch.plan.records import (
     Exited,
     HandedOff,
     Output,
+    Record,
+    RecordStream,
     Said,
     ShutdownBegun,
     Started,
@@ -35,10 +35,10 @@ PY = sys.executable
 
 
 def test_records_emitted_while_one_is_handled_wait_for_it_to_finish() -> None:
-    stream = EventStream()
+    stream = RecordStream()
     seen: list[str] = []
 
-    def first(event: Event) -> None:
+    def first(event: Record) -> None:
         seen.append(f"first {event!r}")
         if isinstance(event, Said) and event.text == "a":
             stream.emit(Said("INFO", "t", "b"))  # queued: "a" reaches `second` before "b"
@@ -52,7 +52,7 @@ def test_records_emitted_while_one_is_handled_wait_for_it_to_finish() -> None:
 
 
 def test_a_held_stream_queues_until_released_but_say_now_is_said_at_once() -> None:
-    stream = EventStream()
+    stream = RecordStream()
     seen: list[str] = []
     stream.subscribe(lambda event: seen.append(getattr(event, "text", type(event).__name__)))
     stream.hold()
@@ -66,10 +66,10 @@ def test_a_held_stream_queues_until_released_but_say_now_is_said_at_once() -> No
 
 
 def test_a_subscriber_that_raises_leaves_the_stream_usable() -> None:
-    stream = EventStream()
-    seen: list[Event] = []
+    stream = RecordStream()
+    seen: list[Record] = []
 
-    def fails(event: Event) -> None:
+    def fails(event: Record) -> None:
         if isinstance(event, StoppingAll):
             raise RuntimeError("boom")
 
@@ -89,7 +89,7 @@ def test_a_handoff_is_emitted_and_said_when_nothing_takes_it() -> None:
     step = LoadComponents(origin="c.launch.py:1", target="/container")
     h = Harness(Plan(steps=[step]))
     handed: list[HandedOff] = []
-    h.sup.events.subscribe(lambda e: handed.append(e) if isinstance(e, HandedOff) else None)
+    h.sup.records.subscribe(lambda e: handed.append(e) if isinstance(e, HandedOff) else None)
     assert h.run() == 0
     assert [e.step for e in handed] == [step]
     assert (
@@ -155,7 +155,7 @@ def test_a_handler_registered_after_its_target_sees_the_start(tmp_path: Path) ->
     path.write_text(textwrap.dedent(LATE_HANDLERS))
     h = Harness(plan_from(path, tmp_path))
     records: list[str] = []
-    h.sup.events.subscribe(
+    h.sup.records.subscribe(
         lambda e: (
             records.append(type(e).__name__) if isinstance(e, (Started, Output, Exited)) else None
         )
@@ -210,14 +210,14 @@ def test_a_lifecycle_need_seen_only_at_run_time_attaches_lifecycle_driving() -> 
     from mlaunch.app.options import Options
     from mlaunch.launch_ros.events import ChangeState
     from mlaunch.parts.lifecycle import LifecycleManager
-    from mlaunch.plan.events import LaunchEvent
+    from mlaunch.plan.records import LaunchEvent
 
     h = Harness(Plan())
     run = parts.Run(Options("x.launch.py"), h.sup.plan, h.sup, h.printer)
     watch = parts.lifecycle(run)
     assert run.lifecycle is None
     event = ChangeState(lifecycle_node_matcher=lambda _: True, transition_id=3)
-    h.sup.events.emit(LaunchEvent(event))
+    h.sup.records.emit(LaunchEvent(event))
     try:
         assert isinstance(run.lifecycle, LifecycleManager)
         assert "has no handler" not in h.text

@@ -31,7 +31,7 @@ from mlaunch.engine.output import Printer
 from mlaunch.engine.screen import Screen
 from mlaunch.engine.strays import Strays
 from mlaunch.engine.supervisor import Supervisor
-from mlaunch.plan.events import Event, Output
+from mlaunch.plan.records import Output, Record
 from mlaunch.plan.steps import Plan, Spawn
 
 PY = sys.executable
@@ -253,7 +253,7 @@ def test_guard_lines_are_batched_one_write_per_turn() -> None:
             os.close(guard.fd)
     assert writes_after_start == [1]  # twenty spawns, one write
     lines = got.decode().split("\n")
-    pids = {str(rec.pid) for rec in sup.records.values()}
+    pids = {str(rec.pid) for rec in sup.states.values()}
     assert {line[1:].split()[0] for line in lines if line.startswith("+")} == pids
     assert {line[1:] for line in lines if line.startswith("-")} == pids
     assert lines[-2:] == ["x", ""]  # the goodbye, once the run has ended everything
@@ -314,13 +314,13 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
     h = Harness([make_spec(f"s{i}", "", argv=up) for i in range(3)])
     ups: list[str] = []
 
-    def saw(event: Event) -> None:
+    def saw(event: Record) -> None:
         if isinstance(event, Output):
             ups.extend(event.process.label for line in event.data.splitlines() if line == b"up")
             if len(ups) == 3:
                 h.shutdown()
 
-    h.sup.events.subscribe(saw)
+    h.sup.records.subscribe(saw)
     during_run = count_during_run(h, calls)
     assert h.run() == 0
     assert not h.sup.strays.escaped, "a child of this process had exited before the run began"

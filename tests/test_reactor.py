@@ -19,7 +19,7 @@ from test_supervision import Harness, make_spec
 from mlaunch.engine.part import Part
 from mlaunch.engine.supervisor import Supervisor
 from mlaunch.plan.errors import EXIT_INTERNAL, EXIT_OK
-from mlaunch.plan.events import Event, Exited, Output, Started
+from mlaunch.plan.records import Exited, Output, Record, Started
 
 # Says it is up, then ends by itself a moment later (the run then ends as idle).
 BRIEF = 'import time; print("up", flush=True); time.sleep(0.5)'
@@ -36,9 +36,9 @@ class Recorder(Part):
     """A well-behaved part: notes every record it is handed."""
 
     def __init__(self, supervisor: Supervisor) -> None:
-        self.seen: list[Event] = []
+        self.seen: list[Record] = []
         self.closed = False
-        supervisor.events.subscribe(self.seen.append)
+        supervisor.records.subscribe(self.seen.append)
 
     def close(self) -> None:
         self.closed = True
@@ -47,13 +47,13 @@ class Recorder(Part):
 class Faulty(Part):
     """Raises at the first record of ``kind`` (Started, Output ...) it is handed."""
 
-    def __init__(self, supervisor: Supervisor, kind: type[Event]) -> None:
+    def __init__(self, supervisor: Supervisor, kind: type[Record]) -> None:
         self.kind = kind
         self.calls = 0
         self.closed = False
-        supervisor.events.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_event)
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: Record) -> None:
         self.calls += 1
         if isinstance(event, self.kind):
             raise RuntimeError(f"broken at {type(event).__name__}")
@@ -80,7 +80,7 @@ def test_a_subscriber_that_raises_is_said_detached_and_the_run_goes_on() -> None
         "[ERROR] [launch]: the faulty part failed and was detached: RuntimeError: broken at Started"
     ]
     assert faulty.calls == 1 and faulty.closed  # never called again, closed at once
-    assert faulty.on_event not in h.sup.events.subscribers
+    assert faulty.on_event not in h.sup.records.subscribers
     # The part after it still got the record the faulty one broke at, and everything after.
     kinds = [type(e) for e in after.seen]
     assert Started in kinds and Output in kinds and Exited in kinds
@@ -184,11 +184,11 @@ from mlaunch.app import pipeline
 from mlaunch.app.parts import PartMaker, standard_parts
 from mlaunch.app.options import parse_options
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Started
+from mlaunch.plan.records import Started
 
 class Broken(Part):
     def __init__(self, run):
-        run.supervisor.events.subscribe(self.on_event)
+        run.supervisor.records.subscribe(self.on_event)
 
     def on_event(self, event):
         if isinstance(event, Started):

@@ -132,7 +132,7 @@ def test_exit_summary_after_a_run_reports_each_process() -> None:
         ]
     )
     assert h.run() == 0
-    ExitSummary(h.sup.process_records, h.sup.events.emit).close()
+    ExitSummary(h.sup.process_states, h.sup.records.emit).close()
     text = h.text
     assert "Summary: 2 processes, 1 failed" in text
     ok_row = next(line for line in text.splitlines() if line.startswith("  ok "))
@@ -144,7 +144,7 @@ def test_exit_summary_after_a_run_reports_each_process() -> None:
 def test_one_clean_process_prints_no_summary() -> None:
     h = Harness([make_spec("only", "pass")])
     assert h.run() == 0
-    ExitSummary(h.sup.process_records, h.sup.events.emit).close()
+    ExitSummary(h.sup.process_states, h.sup.records.emit).close()
     assert "Summary" not in h.text
 
 
@@ -210,13 +210,13 @@ def test_status_rows_show_state_usage_and_the_last_line_without_colours() -> Non
 
     def snapshot(what: str, process: object) -> None:
         if what == "started":
-            view.usage = fake_usage({h.sup.records["talker"].pid: []})
+            view.usage = fake_usage({h.sup.states["talker"].pid: []})
             running.append(view.render())
 
     h.listen(snapshot)
     assert h.run() == 0
     row = next(line for line in running[0].splitlines() if line.startswith("talker"))
-    pid = str(h.sup.records["talker"].pid)
+    pid = str(h.sup.states["talker"].pid)
     assert re.search(rf"talker +running +{pid} +\d+\.\d\d s +0 +12% +3\.0 MiB", row), row
     final = view.render()
     assert "bye" in final and "\x1b" not in final  # colour codes of a child never reach the table
@@ -231,8 +231,8 @@ def test_status_view_keeps_failing_rows_when_there_is_no_room() -> None:
         h.sup, h.printer, h.control, size=lambda: (100, 16), color=False, sampler=fake_usage
     )
     for i in range(20):
-        h.sup.records[f"n{i}-{i}"] = record(f"n{i}-{i}", RUNNING, pid=1000 + i)
-    h.sup.records["bad-99"] = record("bad-99", FAILED, failed=True)
+        h.sup.states[f"n{i}-{i}"] = record(f"n{i}-{i}", RUNNING, pid=1000 + i)
+    h.sup.states["bad-99"] = record("bad-99", FAILED, failed=True)
     text = view.render()
     assert "bad-99" in text and "not shown" in text
     assert len(text.splitlines()) <= 16
@@ -250,7 +250,7 @@ def test_status_view_samples_real_processes_with_psutil() -> None:
 
     h.when(b"up", sample_then_stop)
     assert h.run() == 0
-    pid = h.sup.records["worker"].pid
+    pid = h.sup.states["worker"].pid
     assert usage[0][pid][1] > 1 << 20  # a Python child's resident memory
     view.close()
 

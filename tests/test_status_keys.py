@@ -95,7 +95,7 @@ def test_selection_moves_and_the_pane_shows_the_selected_process(tmp_path: Path)
     )
     keys = view.enable_keys()
     for name in ("a-1", "b-2", "c-3"):
-        h.sup.records[name] = record(name, "running", pid=1)
+        h.sup.states[name] = record(name, "running", pid=1)
     (tmp_path / "b-2.log").write_bytes(b"first\n  indented\n")
     table = view.render()
     assert "> a-1" in table and table.splitlines()[-1] == TABLE_HELP
@@ -130,7 +130,7 @@ def test_a_request_that_cannot_be_done_says_why_in_place_of_the_help(tmp_path: P
     keys = view.enable_keys()
     keys.press("x")  # nothing to act on yet: nothing happens
     assert view.render().splitlines()[-1] == TABLE_HELP
-    h.sup.records["a-1"] = record("a-1", "finished", outcome="finished cleanly")
+    h.sup.states["a-1"] = record("a-1", "finished", outcome="finished cleanly")
     keys.press("x")
     assert view.render().splitlines()[-1] == "a-1 is not running (finished cleanly)"
     now[0] += NOTICE_SECONDS
@@ -483,10 +483,10 @@ def test_a_narrow_terminal_drops_whole_columns_instead_of_cutting_numbers() -> N
         h.sup, h.printer, h.control, size=lambda: (width[0], 30), color=False, sampler=fake_usage
     )
     view.enable_keys()
-    h.sup.records["robot_state_publisher-1"] = record(
+    h.sup.states["robot_state_publisher-1"] = record(
         "robot_state_publisher-1", "running", pid=12345
     )
-    h.sup.records["spawner-2"] = record("spawner-2", "stopped", outcome="stopped by the user")
+    h.sup.states["spawner-2"] = record("spawner-2", "stopped", outcome="stopped by the user")
     view.usage = fake_usage({12345: []})
     view.last_line["robot_state_publisher-1"] = b"publishing the robot description"
     wide = view.render().splitlines()

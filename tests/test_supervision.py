@@ -36,11 +36,11 @@ from mlaunch.engine.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.engine.screen import Screen
 from mlaunch.engine.supervisor import Supervisor
 from mlaunch.parts.control import Control
-from mlaunch.plan.events import Event, Exited, Output, Started
+from mlaunch.plan.records import Exited, Output, Record, Started
 from mlaunch.plan.steps import Plan, ProcessSpec, RespawnPolicy, Spawn
 
 if TYPE_CHECKING:
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
 
 PY = sys.executable
 
@@ -99,7 +99,7 @@ class Harness:
         )
         self.lines: list[tuple[str, bytes]] = []
         self._triggers: list[tuple[bytes, Callable[[str, bytes], None]]] = []
-        self.sup.events.subscribe(self._saw)
+        self.sup.records.subscribe(self._saw)
         self.elapsed = 0.0
         self.timed_out = False
         self._control: Control | None = None
@@ -115,17 +115,17 @@ class Harness:
         self._triggers.append((needle, action))
 
     def listen(self, listener: Callable[[str, ProcessView], object]) -> None:
-        """Call ``listener("started" | "exited", process)`` from the supervisor's event stream."""
+        """Call ``listener("started" | "exited", process)`` from the supervisor's record stream."""
 
-        def on_event(event: Event) -> None:
+        def on_event(event: Record) -> None:
             if isinstance(event, Started):
                 listener("started", event.process)
             elif isinstance(event, Exited):
                 listener("exited", event.process)
 
-        self.sup.events.subscribe(on_event)
+        self.sup.records.subscribe(on_event)
 
-    def _saw(self, event: Event) -> None:
+    def _saw(self, event: Record) -> None:
         if not isinstance(event, Output):
             return
         label = event.process.label
@@ -138,11 +138,11 @@ class Harness:
 
     def label(self, base: str) -> str:
         """The full label (``talker-3``) of the process named ``base`` in a launch file."""
-        (label,) = [k for k in self.sup.records if k.rsplit("-", 1)[0] == base]
+        (label,) = [k for k in self.sup.states if k.rsplit("-", 1)[0] == base]
         return label
 
     def pid(self, label: str) -> int:
-        return self.sup.records[label].pid
+        return self.sup.states[label].pid
 
     def shutdown(self, *_: object) -> None:
         self.sup.begin_shutdown("test")
@@ -221,7 +221,7 @@ def test_clean_run_keeps_last_words_and_unterminated_line(tmp_path: Path) -> Non
     assert text.index("last words without newline") < text.index("process has finished cleanly")
     own = (tmp_path / "talker.log").read_text()
     assert "last words without newline\n" in own and "first\n" in own
-    record = h.sup.records["talker"]
+    record = h.sup.states["talker"]
     assert record.outcome == "finished cleanly" and not record.failed
     assert record.peak_rss > 1 << 20  # wait4's rusage: a Python child uses megabytes
 
@@ -232,7 +232,7 @@ def test_kill_9_of_a_child_is_reported_and_nothing_is_left() -> None:
     assert h.run() == 0  # not required: the launch goes on and ends idle
     died = [m for m in h.messages("victim") if m.startswith("process has died")]
     assert died and died[0].endswith("killed by SIGKILL")
-    assert h.sup.records["victim"].state == FAILED
+    assert h.sup.states["victim"].state == FAILED
     assert "[bystander] fine" in h.text
 
 
@@ -267,7 +267,7 @@ def test_a_child_that_exits_on_mlaunchs_signal_is_stopped_not_dead(status: int) 
     msgs = h.messages("handler")
     assert f"process stopped after SIGINT [pid {h.pid('handler')}, exit code {status}]" in msgs
     assert "[ERROR]" not in h.text and not any("has died" in m for m in msgs)
-    assert h.sup.records["handler"].state == FINISHED
+    assert h.sup.states["handler"].state == FINISHED
     assert h.elapsed < 5
 
 
@@ -414,7 +414,7 @@ def test_crash_loop_backs_off_and_gives_up(tmp_path: Path) -> None:
     ]
     assert msgs[-1] == "giving up after 3 restarts (exited with status 1)"
     assert len(starts) == 4 and len(set(starts)) == 1  # same label and argv every time
-    record = h.sup.records[h.label("crasher")]
+    record = h.sup.states[h.label("crasher")]
     assert record.state == GAVE_UP and record.restarts == 3
     assert len(h.sup.processes) <= 2  # old instances are not kept forever
 
@@ -476,7 +476,7 @@ def test_respawn_delay_is_interrupted_by_shutdown() -> None:
     assert h.elapsed < 5
     assert "restart 1 in 30.0 s" in h.text
     assert sum(m.startswith("process started") for m in h.messages("slow")) == 1
-    assert h.sup.records["slow"].state == FAILED
+    assert h.sup.states["slow"].state == FAILED
 
 
 @pytest.mark.parametrize(
@@ -505,7 +505,7 @@ def test_required_process_ends_the_launch_and_decides_its_status(
     h = Harness(plan_from(path, tmp_path))
     assert h.run() == expected
     assert "shutting down" in h.text
-    assert h.sup.records[h.label("other")].outcome.startswith("stopped")
+    assert h.sup.states[h.label("other")].outcome.startswith("stopped")
     assert h.elapsed < 8
 
 

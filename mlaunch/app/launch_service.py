@@ -30,7 +30,7 @@ from collections import deque
 from mlaunch.launch.launch_context import LaunchContext
 from mlaunch.launch.launch_description import LaunchDescription
 from mlaunch.plan.errors import MlaunchError
-from mlaunch.plan.events import Said
+from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -323,7 +323,7 @@ class LaunchService:
                 gentle_on_error=True,
             )
             said = Said("INFO", "launch", f"All log files can be found below {log_dir}")
-            supervisor.events.emit(said)
+            supervisor.records.emit(said)
             wake_r, self._wake_w = os.pipe()
             os.set_blocking(wake_r, False)
             os.set_blocking(self._wake_w, False)
@@ -438,12 +438,12 @@ class LaunchService:
         try:
             plan = self._resolve(description)
         except MlaunchError as e:
-            supervisor.events.emit(Said("ERROR", "launch", str(e)))
+            supervisor.records.emit(Said("ERROR", "launch", str(e)))
             self._error = True
             supervisor.begin_shutdown("an included launch description failed")
             return
         for warning in plan.warnings:
-            supervisor.events.emit(Said("WARNING", "launch", warning))
+            supervisor.records.emit(Said("WARNING", "launch", warning))
         supervisor.execute(plan.steps)
 
     def _request_shutdown(self, reason: str) -> None:

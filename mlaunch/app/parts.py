@@ -12,7 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 from mlaunch.app.options import Options
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, HandedOff, LaunchEvent, Said, SimTimeWait, Started
+from mlaunch.plan.records import HandedOff, LaunchEvent, Record, Said, SimTimeWait, Started
 from mlaunch.plan.steps import Need, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -190,7 +190,7 @@ def lifecycle_part(
     ):
         return make()
 
-    def wants(event: Event) -> bool:
+    def wants(event: Record) -> bool:
         if isinstance(event, Started):
             node = event.process.spec.node
             return node is not None and node.lifecycle
@@ -235,7 +235,7 @@ def components_part(
     if Need.COMPONENTS in plan.needs:
         return driver()
 
-    def wants(event: Event) -> bool:
+    def wants(event: Record) -> bool:
         return isinstance(event, HandedOff) and Need.COMPONENTS in event.step.needs
 
     return _AttachOnDemand(supervisor, wants, driver)
@@ -269,24 +269,24 @@ class _AttachOnDemand(Part):
     def __init__(
         self,
         supervisor: Supervisor,
-        wants: Callable[[Event], bool],
+        wants: Callable[[Record], bool],
         make: Callable[[], ComponentDriver | RosClock | LifecycleManager],
     ) -> None:
         self.supervisor = supervisor
         self.wants = wants
         self.make = make
         self.driver: ComponentDriver | RosClock | LifecycleManager | None = None
-        supervisor.events.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_event)
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         if not self.wants(event):
             return
-        self.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_event)
         driver = self.driver = self.make()
         driver.on_event(event)
 
     def close(self) -> None:
-        self.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_event)
         if self.driver is not None:
             self.driver.close()
 
@@ -321,7 +321,7 @@ class _ControlSocketPart(Part):
             self.server = server
         else:
             text = f"{server.error}; mlaunch ctl cannot reach this run"
-            supervisor.events.emit(Said("WARNING", "launch", text))
+            supervisor.records.emit(Said("WARNING", "launch", text))
 
     def close(self) -> None:
         if self.server is not None:
@@ -406,16 +406,16 @@ class _ViewerWatch(Part):
     def __init__(self, run: Run) -> None:
         self.run = run
         self.panel: Dashboard | None = None
-        run.supervisor.events.subscribe(self._on_event)
+        run.supervisor.records.subscribe(self._on_event)
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         if not isinstance(event, Started) or VIEWER_MODULE not in event.process.spec.argv:
             return
-        self.run.supervisor.events.unsubscribe(self._on_event)
+        self.run.supervisor.records.unsubscribe(self._on_event)
         self.panel = dashboard_part(self.run)
 
     def close(self) -> None:
-        self.run.supervisor.events.unsubscribe(self._on_event)
+        self.run.supervisor.records.unsubscribe(self._on_event)
         if self.panel is not None:
             self.panel.close()
 
@@ -442,7 +442,7 @@ class _ExitSummary(Part):
         from mlaunch.parts.summary import ExitSummary
 
         supervisor = self.supervisor
-        ExitSummary(supervisor.process_records, supervisor.events.emit, quiet=self.quiet).close()
+        ExitSummary(supervisor.process_states, supervisor.records.emit, quiet=self.quiet).close()
 
 
 def exit_summary(run: Run) -> Part:

@@ -4,7 +4,7 @@
 into another. What attaches to a run is a list of functions the caller passes to ``launch`` or
 ``supervise``: a ``PartMaker`` names a part and makes it from the Run (after the supervisor
 exists, before it starts); the part (mlaunch.engine.reactor.Part) subscribes to the supervisor's
-event stream, and is closed, in list order, when the run ends. Each part is behind a wall: if it
+record stream, and is closed, in list order, when the run ends. Each part is behind a wall: if it
 raises, the run says so, detaches it and goes on (mlaunch.engine.reactor). The Run, the
 PartMaker and what every run attaches (``standard_parts``) are mlaunch.app.parts'. Nothing here
 imports rclpy, rich or psutil unless a part that needs them is attached.
@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 from mlaunch.app.options import Options, own_log_level
 from mlaunch.app.parts import PartMaker, Run
-from mlaunch.plan.events import Said
+from mlaunch.plan.records import Said
 from mlaunch.plan.steps import Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -280,7 +280,7 @@ def supervise(
         run_id=run_id,
         spawner=Process if spawner is None else spawner,
     )
-    supervisor.events.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
+    supervisor.records.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
     run = Run(opts, plan, supervisor, printer, launch_file=path)
     try:
         if spawner is not None:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Said
+from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -39,7 +39,7 @@ def attach(run: Run) -> Part:
     try:
         notifier = Notifier.from_environ(os.environ)
     except ValueError as e:
-        run.supervisor.events.emit(Said("WARNING", "launch", f"{e}; systemd is not notified"))
+        run.supervisor.records.emit(Said("WARNING", "launch", f"{e}; systemd is not notified"))
         notifier = None
     if notifier is not None:
         run.supervisor.schedule(0.0, lambda: part.start(notifier), keeps_alive=False)

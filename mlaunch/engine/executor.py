@@ -2,7 +2,7 @@
 
 ``Executor`` is one object of the Supervisor (mlaunch.engine.supervisor): it carries out the
 steps of the plan, and of every timer's and handler's body when it fires (resolved with the same
-resolve code, ``resolve``), in plan order. What the steps cause is queued on the event stream
+resolve code, ``resolve``), in plan order. What the steps cause is queued on the record stream
 until a description's steps have all been carried out, as launch handles events only after the
 description was visited.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from mlaunch.engine.stopping import handle_stop_signals
 from mlaunch.plan.errors import EXIT_USAGE, MlaunchError
-from mlaunch.plan.events import (
+from mlaunch.plan.records import (
     Completed,
     HandedOff,
     LaunchEvent,
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.signals import SignalWatch
     from mlaunch.engine.stopping import Shutdown
     from mlaunch.engine.timers import Timers
-    from mlaunch.plan.events import EventStream
+    from mlaunch.plan.records import RecordStream
     from mlaunch.plan.steps import Deferred, Plan, ProcessSpec, Step
 
 
@@ -54,7 +54,7 @@ class Executor:
     def __init__(
         self,
         *,
-        events: EventStream,
+        records: RecordStream,
         timers: Timers,
         handlers: LaunchHandlers,
         shutdown: Shutdown,
@@ -63,7 +63,7 @@ class Executor:
         resolve: Callable[[Deferred, object, bool | None], Plan],
         exit_status: Callable[[int], None],
     ) -> None:
-        self.events = events
+        self.records = records
         self.timers = timers
         self.handlers = handlers
         self.shutdown = shutdown
@@ -78,14 +78,14 @@ class Executor:
     def execute(self, steps: list[Step], warnings: list[str] | tuple[str, ...] = ()) -> None:
         """Carry out a visited description's steps.
 
-        What they cause is queued on the event stream until every step has been carried out,
+        What they cause is queued on the record stream until every step has been carried out,
         as launch handles events only after the description was visited: a handler
         registered after a process in the same description still sees it start.
         """
-        self.events.hold()
+        self.records.hold()
         try:
             for warning in warnings:
-                self.events.say_now(Said("WARNING", "launch", warning))
+                self.records.say_now(Said("WARNING", "launch", warning))
             for step in steps:
                 if self.signals.pending:
                     # Hundreds of spawns take seconds: Ctrl-C (and a second one) act now, not
@@ -93,10 +93,10 @@ class Executor:
                     handle_stop_signals(self.signals.pending, self.shutdown.pressed)
                 self._step(step)
             if self._skipped:
-                self.events.emit(StartsSkipped(self._skipped))  # once, not once per process
+                self.records.emit(StartsSkipped(self._skipped))  # once, not once per process
                 self._skipped = 0
         finally:
-            self.events.release()
+            self.records.release()
 
     def _step(self, step: Step) -> None:
         if isinstance(step, Spawn):
@@ -108,7 +108,7 @@ class Executor:
                 self.start(step.spec)
         elif isinstance(step, Log):
             # LogInfo is no event in launch: it is said as it is visited.
-            self.events.say_now(Said(step.level, step.source, step.message))
+            self.records.say_now(Said(step.level, step.source, step.message))
         elif isinstance(step, StartTimer):
             self._start_timer(step)
         elif isinstance(step, AddHandler):
@@ -124,13 +124,13 @@ class Executor:
                 send_sigint=step.send_sigint,
             )
         elif isinstance(step, EmitEvent):
-            self.events.emit(LaunchEvent(step.event))
+            self.records.emit(LaunchEvent(step.event))
         elif isinstance(step, Handoff):
             # For the part that carries it out (the LoadNode driver): from the plan, a timer
             # or a handler alike, in the order the steps are reached.
             handed = HandedOff(step)
-            self.events.emit(handed)
-            self.events.emit(Unclaimed(handed))
+            self.records.emit(handed)
+            self.records.emit(Unclaimed(handed))
         elif not isinstance(step, Note):
             raise TypeError(
                 f"the supervisor cannot carry out a {type(step).__name__} step ({step.origin});"
@@ -147,7 +147,7 @@ class Executor:
             if body is not None:
                 self.fire(body, None)
             if awaited:
-                self.events.emit(Completed(action))
+                self.records.emit(Completed(action))
 
         if step.on_sim_time:
             self._wait_sim_time(step, expire)
@@ -162,7 +162,7 @@ class Executor:
         """Hand a ROSTimer on simulated time to the ROS clock part; if none took it (looked at
         once the stream has handed it to every subscriber), say so and count wall-clock time."""
         handed = SimTimeWait(step.origin, step.period, expire, step.cancel_on_shutdown)
-        self.events.emit(handed)
+        self.records.emit(handed)
 
         def unless_taken() -> None:
             if handed.taken:
@@ -171,7 +171,7 @@ class Executor:
                 f"{step.origin}: ROSTimer counts its period in wall-clock time: launch's ROS"
                 " clock uses simulated time (SetUseSimTime) but nothing in this run reads /clock"
             )
-            self.events.emit(Said("WARNING", "launch", text))
+            self.records.emit(Said("WARNING", "launch", text))
             self._wall_timer(step, expire)
 
         self.timers.add(0.0, unless_taken, cancel_on_shutdown=step.cancel_on_shutdown)
@@ -180,7 +180,7 @@ class Executor:
         """``spec``'s process exited and will not restart: ExecutionComplete, if awaited."""
         if id(spec) in self._awaited:
             self._awaited.discard(id(spec))
-            self.events.emit(Completed(spec.action))
+            self.records.emit(Completed(spec.action))
 
     def fire(self, body: Deferred, event: object, shutting_down: bool | None = None) -> None:
         """Resolve deferred entities now (timer, handler, on_exit) and run what they give."""
@@ -193,6 +193,6 @@ class Executor:
 
     def handler_failed(self, message: str) -> None:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
-        self.events.emit(Said("ERROR", "launch", message))
+        self.records.emit(Said("ERROR", "launch", message))
         self.exit_status(EXIT_USAGE)
         self.shutdown.begin("an event handler failed")

@@ -1,6 +1,6 @@
 """The launch file's event handlers (RegisterEventHandler, on_exit, OnProcessIO) while it runs.
 
-LaunchHandlers subscribes to the supervisor's EventStream: each record of a process starting,
+LaunchHandlers subscribes to the supervisor's RecordStream: each record of a process starting,
 printing or exiting, of the launch shutting down, or of a managed node's transition becomes
 the launch event launch_ros's handlers expect (mlaunch.launch.events), and every matching
 handler fires; a handler of no kind dispatched here (``EventHandler(matcher=...)``) is offered
@@ -18,12 +18,12 @@ from mlaunch.engine.process import Process
 from mlaunch.launch import events as ev
 from mlaunch.launch.event_handler import MATCHER_KIND, returned_entities
 from mlaunch.launch.events.matchers import SEES_PROCESS
-from mlaunch.plan.events import (
+from mlaunch.plan.records import (
     Completed,
-    Event,
     Exited,
     LaunchEvent,
     Output,
+    Record,
     ShutdownBegun,
     ShutdownRepeated,
     Started,
@@ -36,7 +36,7 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any, Protocol
 
-    from mlaunch.plan.events import EventStream, ProcessView
+    from mlaunch.plan.records import ProcessView, RecordStream
 
     class HandledRun(Protocol):
         """What the launch file's handlers use of the run (the Supervisor is one): its
@@ -49,7 +49,7 @@ if TYPE_CHECKING:
         def shutting_down(self) -> bool: ...
 
         @property
-        def events(self) -> EventStream: ...
+        def records(self) -> RecordStream: ...
 
         def fire(self, body: Deferred, event: object, shutting_down: bool | None = None) -> None:
             """Resolve and carry out ``body`` for ``event``."""
@@ -74,7 +74,7 @@ class LaunchHandlers:
     def remove(self, handler: object) -> None:
         self.handlers[:] = [h for h in self.handlers if h.handler is not handler]
 
-    def __call__(self, event: Event) -> None:
+    def __call__(self, event: Record) -> None:
         """The subscription: the records launch has events for."""
         if isinstance(event, Output):
             if self.handlers:
@@ -157,7 +157,7 @@ class LaunchHandlers:
         else:
             acted = self._act_on_processes(event)
             if not self.general(event) and not acted:
-                supervisor.events.emit(Unclaimed(record))
+                supervisor.records.emit(Unclaimed(record))
                 return
         record.taken = True
 

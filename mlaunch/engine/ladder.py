@@ -2,7 +2,7 @@
 
 SIGINT first (with SIGCONT, so a stopped process wakes up to die), SIGTERM after the process's
 ``sigterm_timeout``, SIGKILL after its ``sigkill_timeout``; each escalation is an Escalated record
-on the event stream (the printer says it). The whole process group is signalled, as every child
+on the record stream (the printer says it). The whole process group is signalled, as every child
 runs in its own session.
 """
 
@@ -13,7 +13,7 @@ from collections.abc import Callable
 
 from mlaunch.engine.process import Process
 from mlaunch.engine.process_state import STOPPING, ProcessState
-from mlaunch.plan.events import Escalated, Event
+from mlaunch.plan.records import Escalated, Record
 
 
 class StopLadder:
@@ -22,12 +22,12 @@ class StopLadder:
     def __init__(
         self,
         schedule: Callable[[float, Callable[[], None]], object],
-        emit: Callable[[Event], None],
-        records: dict[str, ProcessState],
+        emit: Callable[[Record], None],
+        states: dict[str, ProcessState],
     ) -> None:
         self.schedule = schedule
         self.emit = emit
-        self.records = records
+        self.states = states
 
     def stop(self, process: Process, *, sigint: bool = True) -> None:
         """SIGINT now (unless not ``sigint``), then SIGTERM and SIGKILL while the group lives on."""
@@ -35,7 +35,7 @@ class StopLadder:
             return
         process.stopping = True
         if process.running:
-            self.records[process.label].state = STOPPING
+            self.states[process.label].state = STOPPING
         spec = process.spec
         if sigint:
             if not process.signal_group(signal.SIGINT, wake=True):

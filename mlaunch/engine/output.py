@@ -26,13 +26,13 @@ from mlaunch.engine.logfiles import (
 )
 from mlaunch.engine.sayings import Sayings
 from mlaunch.engine.screen import Screen
-from mlaunch.plan.events import Event, Output, Summary
+from mlaunch.plan.records import Output, Record, Summary
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from typing import Any
 
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
 
 # Which targets each output mode sends a stream to (ROS 2's table; "own" = the process's file,
 # which mlaunch always writes so every process has its log).
@@ -96,7 +96,7 @@ def prefix_lines(prefix: bytes, data: bytes) -> bytes:
 class Printer:
     """Owns the terminal and the log files of a run: every byte mlaunch writes goes here.
 
-    A Printer is a subscriber of the supervisor's EventStream (``__call__``): a process's output
+    A Printer is a subscriber of the supervisor's RecordStream (``__call__``): a process's output
     and the exit summary are its own (``_SAYS`` at the end of this module), every other record
     its ``sayings`` put in words (mlaunch.engine.sayings).
 
@@ -330,8 +330,8 @@ class Printer:
 
     # --- the run's events, in words -------------------------------------------------------------
 
-    def __call__(self, event: Event) -> None:
-        """The printer's subscription to the supervisor's EventStream: each record in words."""
+    def __call__(self, event: Record) -> None:
+        """The printer's subscription to the supervisor's RecordStream: each record in words."""
         method = _SAYS.get(type(event))
         if method is not None:
             method(self, event)
@@ -386,7 +386,7 @@ def stdout_is_color_terminal(environ: Mapping[str, str]) -> bool:
     return sys.stdout.isatty() and environ.get("TERM") != "dumb"
 
 
-# Which words each record of the event stream becomes (records not listed are not said): a
+# Which words each record of the record stream becomes (records not listed are not said): a
 # process's output here, everything else mlaunch.engine.sayings'.
 _SAYS: dict[type, Callable[[Printer, Any], None]] = {
     Output: Printer._output,

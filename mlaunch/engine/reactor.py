@@ -2,7 +2,7 @@
 
 A part (the status view, the control socket, lifecycle driving, the LoadNode driver, the smoke
 checks, the exit summary ...) is attached to a run before its loop starts and from then on only
-reacts: to the records on the event stream, to timers, to files in the loop's selector. What a
+reacts: to the records on the record stream, to timers, to files in the loop's selector. What a
 part subscribes, schedules or registers while it is being attached, or while one of its own
 callbacks runs, belongs to it (``Reactor.own``). When any of those raises, or its ``close()``
 does, the run says so in one line naming the part, detaches it (its subscriptions, timers and
@@ -19,7 +19,7 @@ from __future__ import annotations
 import selectors
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import EventStream
+from mlaunch.plan.records import RecordStream
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
     from _typeshed import FileDescriptorLike
 
-    from mlaunch.plan.events import Subscriber
+    from mlaunch.plan.records import Subscriber
 
 
 class Attachment:
@@ -81,11 +81,11 @@ class Reactor:
 
     def __init__(
         self,
-        events: EventStream,
+        records: RecordStream,
         selector: selectors.BaseSelector,
         on_failure: Callable[[str, BaseException, bool], None],
     ) -> None:
-        self.events = events
+        self.records = records
         self.selector = selector
         self.on_failure = on_failure
         self.attachments: list[Attachment] = []
@@ -141,9 +141,9 @@ class Reactor:
         """Remove what the part holds in the run: subscriptions, files, timers (which no longer
         fire), then call its ``close()``."""
         attachment.detached = True
-        mine = [s for s in self.events.subscribers if _owned_by(s, attachment)]
+        mine = [s for s in self.records.subscribers if _owned_by(s, attachment)]
         for subscriber in mine:
-            self.events.subscribers.remove(subscriber)
+            self.records.subscribers.remove(subscriber)
         try:
             keys = list(self.selector.get_map().values())
         except (AttributeError, RuntimeError):  # the loop's selector is closed: the run ended
@@ -171,8 +171,8 @@ class Reactor:
             self.on_failure(attachment.name, e, False)
 
 
-class RunEvents(EventStream):
-    """The supervisor's event stream: a subscriber that a part adds is the part's."""
+class RunRecords(RecordStream):
+    """The supervisor's record stream: a subscriber that a part adds is the part's."""
 
     def __init__(self) -> None:
         super().__init__()

@@ -8,7 +8,7 @@ within STABLE_UPTIME of starting multiplies the wait by ``respawn_backoff``, up 
 from __future__ import annotations
 
 from mlaunch.engine.process_state import GAVE_UP, RESTARTING, STOPPED, ProcessState
-from mlaunch.plan.events import GaveUp, RespawnScheduled
+from mlaunch.plan.records import GaveUp, RespawnScheduled
 from mlaunch.plan.steps import RespawnPolicy
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 
     from mlaunch.engine.process import Process
     from mlaunch.engine.timers import Timer, Timers
-    from mlaunch.plan.events import EventStream
+    from mlaunch.plan.records import RecordStream
     from mlaunch.plan.steps import ProcessSpec
 
 # A crash loop's backoff starts over once a process has stayed up this long.
@@ -71,16 +71,16 @@ class Respawns:
     def __init__(
         self,
         *,
-        records: dict[str, ProcessState],
+        states: dict[str, ProcessState],
         timers: Timers,
-        events: EventStream,
+        records: RecordStream,
         clock: Callable[[], float],
         start: Callable[[ProcessSpec, int], object],
         forget: Callable[[Process], None],
     ) -> None:
-        self.records = records
+        self.states = states
         self.timers = timers
-        self.events = events
+        self.records = records
         self.clock = clock
         self.start = start
         self.forget = forget
@@ -92,13 +92,13 @@ class Respawns:
         (after its delay), or give up on it."""
         if process.user_stop == "restart":
             if shutting_down:
-                self.records[process.label].not_restarting()
+                self.states[process.label].not_restarting()
             else:
                 self.start_again(process)  # at once: no backoff, the user asked for it
             return
         if shutting_down or process.stopping:
             return
-        record = self.records[process.label]
+        record = self.states[process.label]
         uptime = process.ended_at - process.started_at
         policy = process.spec.respawn
         delay = next_restart(policy, record, code, uptime)
@@ -107,10 +107,10 @@ class Respawns:
         if delay == GIVE_UP:
             record.state = GAVE_UP
             record.outcome = f"gave up after {record.restarts} restarts: {record.outcome}"
-            self.events.emit(GaveUp(process, code, record.restarts))
+            self.records.emit(GaveUp(process, code, record.restarts))
             return
         attempt = record.restarts + 1
-        self.events.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
+        self.records.emit(RespawnScheduled(process, code, attempt, policy.max_retries, delay))
         record.state, record.restart_at = RESTARTING, self.clock() + delay
         self.waiting[process.label] = self.timers.add(delay, lambda: self._due(process, attempt))
 
@@ -123,7 +123,7 @@ class Respawns:
     def cancel(self, label: str, outcome: str) -> None:
         """The respawn ``label`` waits for does not happen: it stays down, ``outcome`` says why."""
         self._cancel_timer(label)
-        record = self.records[label]
+        record = self.states[label]
         record.state, record.restart_at, record.outcome = STOPPED, None, outcome
 
     def start_again(self, old: Process) -> object:
@@ -134,7 +134,7 @@ class Respawns:
         still waiting for its delay is cancelled.
         """
         self._cancel_timer(old.label)
-        record = self.records[old.label]
+        record = self.states[old.label]
         record.user_starts += 1
         record.streak = 0
         self.forget(old)

@@ -12,16 +12,16 @@ import os
 
 from mlaunch.engine.logfiles import log_file_name
 from mlaunch.engine.process import describe_status, signal_name
-from mlaunch.plan.events import (
+from mlaunch.plan.records import (
     Controlled,
     Escalated,
-    Event,
     Exited,
     FailedToStart,
     GaveUp,
     HandedOff,
     Interrupted,
     NotStarted,
+    Record,
     RespawnScheduled,
     Said,
     ShutdownBegun,
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from typing import Any, Protocol
 
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
 
     class Saying(Protocol):
         """What the sayings write through (the run's Printer, mlaunch.engine.output)."""
@@ -60,7 +60,7 @@ class Sayings:
         self.message = printer.message
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
 
-    def __call__(self, event: Event) -> None:
+    def __call__(self, event: Record) -> None:
         """Say ``event`` (records not in SAYINGS are not said)."""
         method = SAYINGS.get(type(event))
         if method is not None:

@@ -13,7 +13,7 @@ import signal
 from mlaunch.engine.process import signal_name
 from mlaunch.engine.process_state import RESTARTING
 from mlaunch.plan.errors import exit_for_signal
-from mlaunch.plan.events import Interrupted, ShutdownBegun, ShutdownRepeated, StoppingAll
+from mlaunch.plan.records import Interrupted, ShutdownBegun, ShutdownRepeated, StoppingAll
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.process import Process
     from mlaunch.engine.process_state import ProcessState
     from mlaunch.engine.timers import Timers
-    from mlaunch.plan.events import EventStream
+    from mlaunch.plan.records import RecordStream
 
 
 class Shutdown:
@@ -36,17 +36,17 @@ class Shutdown:
     def __init__(
         self,
         *,
-        events: EventStream,
+        records: RecordStream,
         timers: Timers,
-        records: Mapping[str, ProcessState],
+        states: Mapping[str, ProcessState],
         ladder: StopLadder,
         processes: list[Process],
         lingering: list[Process],
         exit_status: Callable[[int], None],
     ) -> None:
-        self.events = events
-        self.timers = timers
         self.records = records
+        self.timers = timers
+        self.states = states
         self.ladder = ladder
         self.processes = processes
         self.lingering = lingering
@@ -75,11 +75,11 @@ class Shutdown:
         self.reason = reason
         self.send_sigint = send_sigint
         self.timers.shutting_down()  # pending respawns and TimerActions included
-        for record in self.records.values():
+        for record in self.states.values():
             if record.state == RESTARTING:
                 record.not_restarting()
-        self.events.emit(ShutdownBegun(reason, due_to_signal))
-        self.events.emit(StoppingAll())
+        self.records.emit(ShutdownBegun(reason, due_to_signal))
+        self.records.emit(StoppingAll())
 
     def request(
         self, reason: str, *, due_to_signal: int | None = None, send_sigint: bool = True
@@ -87,7 +87,7 @@ class Shutdown:
         """A Shutdown of the launch file (action or event): it begins the shutdown or, while
         one is under way, goes to the OnShutdown handlers alone (ShutdownRepeated)."""
         if self.active:
-            self.events.emit(ShutdownRepeated(reason, due_to_signal))
+            self.records.emit(ShutdownRepeated(reason, due_to_signal))
         else:
             self.begin(reason, due_to_signal=due_to_signal, send_sigint=send_sigint)
 
@@ -119,7 +119,7 @@ class Shutdown:
         """A second Ctrl-C: SIGKILL every group and every stray at once."""
         self.kill_now = True
         self.ladder.kill(self.processes + self.lingering)
-        self.events.emit(StoppingAll(kill=True))
+        self.records.emit(StoppingAll(kill=True))
         self.begin("killed")
 
     def pressed(self, sig: int) -> None:
@@ -127,7 +127,7 @@ class Shutdown:
         self._presses += 1
         if self._presses == 1:
             self.exit_status(exit_for_signal(sig))
-            self.events.emit(Interrupted(sig))
+            self.records.emit(Interrupted(sig))
             self.begin(f"{signal_name(sig)} received", due_to_signal=sig)
         else:
             self.kill_everything()

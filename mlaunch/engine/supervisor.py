@@ -5,7 +5,7 @@ through ``signal.set_wakeup_fd``); the loop acts on them. Every child runs in it
 the stop ladder (mlaunch.engine.ladder) reaches its whole process group.
 
 The supervisor writes no words. It emits a record of everything that happens on its
-EventStream (mlaunch.plan.events) and acts on policy: this module is where a process's exit
+RecordStream (mlaunch.plan.records) and acts on policy: this module is where a process's exit
 becomes, in order, an ``Exited`` record (the printer turns it into the log line, the launch
 file's handlers fire on it, lifecycle driving and smoke checks see it), the required-process
 shutdown, and the respawn decision (``_exited``). Its own reaction to the stream is starting the
@@ -44,19 +44,19 @@ from mlaunch.engine.output import Printer
 from mlaunch.engine.pipes import Pipes
 from mlaunch.engine.process import Process, describe_status, wait_child
 from mlaunch.engine.process_state import RESTARTING, RUNNING, STOPPED, ProcessState
-from mlaunch.engine.reactor import PartSelector, Reactor, RunEvents
+from mlaunch.engine.reactor import PartSelector, Reactor, RunRecords
 from mlaunch.engine.respawn import Respawns
 from mlaunch.engine.signals import SignalWatch
 from mlaunch.engine.stopping import Shutdown, handle_signals
 from mlaunch.engine.strays import STRAY_GRACE, Strays, comm
 from mlaunch.engine.timers import Timer, Timers
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK
-from mlaunch.plan.events import (
-    Event,
+from mlaunch.plan.records import (
     Exited,
     FailedToStart,
     NotStarted,
     Output,
+    Record,
     Said,
     Started,
     StoppingAll,
@@ -133,7 +133,7 @@ class Supervisor:
         self.processes: list[Process] = []
         self.lingering: list[Process] = []
         self._adopted_groups: set[int] = set()  # groups of adopted orphans the guard watches
-        self.records: dict[str, ProcessState] = {}
+        self.states: dict[str, ProcessState] = {}
         self.timers = Timers(clock)
         self.signals = SignalWatch(install=install_signals)
         self.strays = Strays(
@@ -141,41 +141,41 @@ class Supervisor:
         )
         self.pipes = Pipes(self._selector, printer, self._deliver)
         self.launch_handlers = LaunchHandlers(self)
-        self.events = RunEvents()
+        self.records = RunRecords()
         # Its steps outlive the shutdown's cancellation of timers.
         self.ladder = StopLadder(
             lambda delay, step: self.timers.add(delay, step, cancel_on_shutdown=False),
-            self.events.emit,
-            self.records,
+            self.records.emit,
+            self.states,
         )
-        self.events.subscribe(self._react)
-        self.events.subscribe(printer)
-        self.events.subscribe(self.launch_handlers)
+        self.records.subscribe(self._react)
+        self.records.subscribe(printer)
+        self.records.subscribe(self.launch_handlers)
         # What attaches to the run from here on is a part, behind a wall (reactor.py).
-        self.reactor = Reactor(self.events, self._selector, self.part_failed)
-        self.events.reactor = self.reactor
+        self.reactor = Reactor(self.records, self._selector, self.part_failed)
+        self.records.reactor = self.reactor
         self.selector = PartSelector(self._selector, self.reactor)
         self._index = itertools.count()
         self.exit_code = EXIT_OK
         self.shutdown = Shutdown(
-            events=self.events,
-            timers=self.timers,
             records=self.records,
+            timers=self.timers,
+            states=self.states,
             ladder=self.ladder,
             processes=self.processes,
             lingering=self.lingering,
             exit_status=self.exit_status,
         )
         self.respawns = Respawns(
-            records=self.records,
+            states=self.states,
             timers=self.timers,
-            events=self.events,
+            records=self.records,
             clock=clock,
             start=self.start,
             forget=self._forget,
         )
         self.executor = Executor(
-            events=self.events,
+            records=self.records,
             timers=self.timers,
             handlers=self.launch_handlers,
             shutdown=self.shutdown,
@@ -249,10 +249,10 @@ class Supervisor:
             pass  # the original error is the one worth reporting
 
     @property
-    def process_records(self) -> Mapping[str, ProcessState]:
+    def process_states(self) -> Mapping[str, ProcessState]:
         """What the run knows of each label, read-only (the status view, the exit summary,
         runtime control and the smoke checks read it; only the supervisor writes it)."""
-        return MappingProxyType(self.records)
+        return MappingProxyType(self.states)
 
     @property
     def handlers(self) -> list[AddHandler]:
@@ -310,7 +310,7 @@ class Supervisor:
         if not self.shutting_down:
             if self.timers.keep_alive() or self._work:
                 return False
-            if any(r.state == STOPPED for r in self.records.values()):
+            if any(r.state == STOPPED for r in self.states.values()):
                 return False  # stopped by the user, who may start it again: not idle
             # Idle: nothing runs and nothing is pending, as ROS 2's idle shutdown.
             self.begin_shutdown("idle")
@@ -345,7 +345,7 @@ class Supervisor:
         skip = self.guard.pid if self.guard is not None else None
         alive, sent = self.strays.sweep(self.by_pid, skip, now_kill=self.shutdown.kill_now)
         for name, pid, sig in sent:
-            self.events.emit(StrayEnded(name, pid, sig))
+            self.records.emit(StrayEnded(name, pid, sig))
         return alive
 
     def _next_timeout(self) -> float | None:
@@ -378,7 +378,7 @@ class Supervisor:
         if essential:
             text += "; the run cannot go on without it"
             self.exit_status(EXIT_INTERNAL)
-        self.events.emit(Said("ERROR", "launch", text))
+        self.records.emit(Said("ERROR", "launch", text))
         if essential:
             self.begin_shutdown(f"{name} failed")
 
@@ -397,7 +397,7 @@ class Supervisor:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
         self.executor.handler_failed(message)
 
-    def _react(self, event: Event) -> None:
+    def _react(self, event: Record) -> None:
         """The supervisor's own subscription: the stop ladder begins at StoppingAll."""
         if isinstance(event, StoppingAll) and not event.kill:
             self.shutdown.stop_all()
@@ -406,14 +406,14 @@ class Supervisor:
 
     def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
         if self.shutting_down:
-            self.events.emit(NotStarted(spec))
+            self.records.emit(NotStarted(spec))
             return None
         if spec.prepare is not None:  # a stand-in's page keeps its port on a restart
             spec.prepare(spec)
         process = self.spawner(spec, next(self._index), restarts)
-        record = self.records.get(spec.label)
+        record = self.states.get(spec.label)
         if record is None:
-            record = self.records[spec.label] = ProcessState(spec.label, spec)
+            record = self.states[spec.label] = ProcessState(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
         try:
             try:
@@ -427,12 +427,12 @@ class Supervisor:
             process.returncode = 127
             self.processes.append(process)
             record.failed_to_start(reason)
-            self.events.hold()
+            self.records.hold()
             try:
-                self.events.emit(FailedToStart(process, reason))
+                self.records.emit(FailedToStart(process, reason))
                 self._exited(process)
             finally:
-                self.events.release()
+                self.records.release()
             return process
         if self.guard is not None:
             self.guard.watch(process.pid, spec.sigkill_timeout)
@@ -440,12 +440,12 @@ class Supervisor:
         self.by_pid[process.pid] = process
         record.state, record.pid, record.started_at = RUNNING, process.pid, process.started_at
         self.pipes.watch(process)
-        self.events.emit(Started(process))
+        self.records.emit(Started(process))
         return process
 
     def _deliver(self, process: Process, stream: str, data: bytes) -> None:
         """Complete lines of a child, onto the stream (the printer, then OnProcessIO handlers)."""
-        self.events.emit(Output(process, stream, data))
+        self.records.emit(Output(process, stream, data))
 
     def _reap(self) -> None:
         # A subreaper waits for any child (adopted orphans too); an embedder's supervisor only
@@ -462,19 +462,19 @@ class Supervisor:
             process.reaped(status, self.clock, rusage)
             # One record after another, handled once all are queued: its last words first
             # (what is still in the pipes, then the partial last line), then its exit.
-            self.events.hold()
+            self.records.hold()
             try:
                 self.pipes.drain(process)
                 if process.check_group():
                     self.lingering.append(process)
                 elif self.guard is not None:
                     self.guard.forget(process.pid)
-                self.records[process.label].ended(process)
+                self.states[process.label].ended(process)
                 self._exited(process)
                 if process in self.lingering and self._replaced(process):
                     self._end_group(process)
             finally:
-                self.events.release()
+                self.records.release()
 
     def _watch_adopted(self) -> None:
         """Tell the guard the groups of orphans re-parented to mlaunch, every ``ADOPTED_POLL``.
@@ -493,7 +493,7 @@ class Supervisor:
                 guard.watch(info.pgrp, STRAY_GRACE)
                 guard.flush()  # before it is said: the guard knows it from then on
                 name = comm(info.pid)
-                self.events.emit(
+                self.records.emit(
                     Said(
                         "INFO",
                         "launch",
@@ -509,7 +509,7 @@ class Supervisor:
         scheduled, or the user's restart started it)."""
         if process.user_stop == "restart":
             return True
-        return self.records[process.label].state == RESTARTING
+        return self.states[process.label].state == RESTARTING
 
     def _end_group(self, process: Process) -> None:
         """End what a dead instance left in its process group, with the instance: SIGTERM now,
@@ -517,7 +517,7 @@ class Supervisor:
         ended). Said once, naming the label and the group."""
         if not process.signal_group(signal.SIGTERM, wake=True):
             return
-        self.events.emit(
+        self.records.emit(
             Said(
                 "INFO",
                 process.label,
@@ -548,14 +548,14 @@ class Supervisor:
         """
         spec = process.spec
         code = process.returncode if process.returncode is not None else 0
-        self.events.emit(Exited(process, code))
+        self.records.emit(Exited(process, code))
         if spec.required and not process.stopping:
             # A required process decides the run: it ends it, and its failure is the run's.
             if code != 0:
                 self.exit_status(EXIT_FAILURE)
             self.begin_shutdown(f"required process {spec.label} {describe_status(code)}")
         self.respawns.after_exit(process, code, shutting_down=self.shutting_down)
-        if self.records[spec.label].state != RESTARTING:
+        if self.states[spec.label].state != RESTARTING:
             self.executor.ended_for_good(spec)
 
     def cancel_respawn(self, label: str, outcome: str) -> None:

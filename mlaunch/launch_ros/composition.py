@@ -29,7 +29,7 @@ class LoadComponents(Handoff):
 
     ``written`` is the container's name as the launch file gave it (launch_ros's log lines show
     that, ``'box'`` rather than ``'/box'``); empty means the same as ``target``.
-    A Handoff: the supervisor emits it on the event stream when it reaches it (in the plan, a
+    A Handoff: the supervisor emits it on the record stream when it reaches it (in the plan, a
     timer or an event handler), and the LoadNode driver (mlaunch.parts.components) sends the
     requests; a request with ``autostart`` is then brought up by the lifecycle driver."""
 

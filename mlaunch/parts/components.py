@@ -1,6 +1,6 @@
 """The LoadNode driver: sends every ``LoadComponents`` step of a run to its container.
 
-The supervisor hands each LoadComponents step over on the event stream (``HandedOff``) when it
+The supervisor hands each LoadComponents step over on the record stream (``HandedOff``) when it
 reaches it: in the plan, in a timer's body, in an event handler's (a ComposableNodeContainer
 started by OnProcessStart, a LoadComposableNodes in a TimerAction), so every load goes through
 this one path, in the order the steps are reached.
@@ -28,12 +28,12 @@ from mlaunch.launch_ros.composition import LoadComponents
 from mlaunch.launch_ros.load_request import LoadRequest, to_message
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
-from mlaunch.plan.events import (
+from mlaunch.plan.records import (
     ComponentLoaded,
-    Event,
     Exited,
     HandedOff,
     LoadRefused,
+    Record,
     Said,
     ShutdownBegun,
 )
@@ -441,7 +441,7 @@ def _note(component: Component, result: LoadResult) -> None:
 class ComponentDriver(Part):
     """The pipeline's components part: loads each LoadComponents step the supervisor hands over.
 
-    It subscribes to the run's event stream: a ``HandedOff`` LoadComponents starts its loads,
+    It subscribes to the run's record stream: a ``HandedOff`` LoadComponents starts its loads,
     ``ShutdownBegun`` abandons every wait (as launch_ros at shutdown), the ``Exited`` of a
     container with loads pending is said. Lines go to the run's output from the supervisor's
     loop thread (the printer is not shared across threads).
@@ -471,9 +471,9 @@ class ComponentDriver(Part):
         )
         # Who waits for a load thread to end (a ``load`` asked through runtime control).
         self.waiting: list[Callable[[threading.Thread], None]] = []
-        supervisor.events.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_event)
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: Record) -> None:
         if isinstance(event, HandedOff) and isinstance(event.step, LoadComponents):
             event.taken = True
             # Keeps an idle launch running until the loads are done (or the launch stops).
@@ -507,13 +507,13 @@ class ComponentDriver(Part):
 
         def count() -> None:
             if request.autostart:
-                self.supervisor.events.emit(ComponentLoaded(step, request, name))
+                self.supervisor.records.emit(ComponentLoaded(step, request, name))
             if step.names is None:
                 return
             step.names[name] = step.names.get(name, 0) + 1
             if step.names[name] > 1:
                 warning = same_name_warning(step.names[name], name)
-                self.supervisor.events.emit(Said("WARNING", step.container_name, warning))
+                self.supervisor.records.emit(Said("WARNING", step.container_name, warning))
 
         self.loop.call_soon(count)  # the count is the loop thread's, as resolve's
 
@@ -534,7 +534,7 @@ class ComponentDriver(Part):
         request = result.request
         node = request.full_name if request.node_name else request.plugin_name
         event = LoadRefused(step.target, node, request.plugin_name, result.error_message)
-        self.loop.call_soon(lambda: self.supervisor.events.emit(event))
+        self.loop.call_soon(lambda: self.supervisor.records.emit(event))
 
     # --- runtime control (mlaunch.parts.control, loop thread) ----------------------------------
 
@@ -592,13 +592,13 @@ class ComponentDriver(Part):
         self.loop.call_soon(lambda: self._say(level, message))
 
     def _say(self, level: str, message: str) -> None:
-        self.supervisor.events.emit(Said(level, LOGGER, message))
+        self.supervisor.records.emit(Said(level, LOGGER, message))
 
     def close(self) -> None:
         """At the end of the run: abandon what still waits, end the threads, say their lines."""
         self.loader.stop.set()
         self.loader.join(3.0)
         self.loop.run_pending()  # the loop is over: the abandoned loads' lines are said here
-        self.supervisor.events.unsubscribe(self.on_event)
+        self.supervisor.records.unsubscribe(self.on_event)
         self.loader.context.try_shutdown()
         self.loop.close()

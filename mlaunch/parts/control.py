@@ -7,7 +7,7 @@ runs on the supervisor's loop thread and never blocks: call it from a selector c
 (``Supervisor.schedule``) or an event subscriber. Another thread must hand its request to the
 loop (the control socket is read by the loop's own selector, so it needs no hand-over).
 
-What the user does reaches everything else through the event stream, as the launch's own
+What the user does reaches everything else through the record stream, as the launch's own
 stops do:
 
 - ``stop``: a ``Controlled`` record (the printer says the request), then the process's own stop
@@ -51,7 +51,7 @@ from mlaunch.engine.process_state import (
     ProcessState,
 )
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE, MlaunchError
-from mlaunch.plan.events import Controlled, Event, Exited, FailedToStart, NotStarted, Started
+from mlaunch.plan.records import Controlled, Exited, FailedToStart, NotStarted, Record, Started
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -59,7 +59,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.components import ComponentDriver
     from mlaunch.parts.lifecycle import LifecycleManager
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
 
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
 OPERATIONS = (
@@ -196,13 +196,13 @@ class Control(Part):
         # (process, what, callback): "exit" calls back when it exits, "restart" when its
         # label's next instance has started.
         self._waits: list[tuple[Process, str, Done]] = []
-        supervisor.events.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_event)
 
     # --- reading ---------------------------------------------------------------------------
 
     def labels(self) -> list[str]:
         """Every process label of the run so far, in the order they first started."""
-        return list(self.supervisor.process_records)
+        return list(self.supervisor.process_states)
 
     def resolve(self, name: str) -> str:
         """The label ``name`` means: a label, else the one label of that name (``talker`` for
@@ -210,7 +210,7 @@ class Control(Part):
 
         UnknownLabel (with the valid labels and the close ones) or AmbiguousLabel otherwise.
         """
-        records = self.supervisor.process_records
+        records = self.supervisor.process_states
         if name in records:
             return name
         named = [label for label, record in records.items() if name in _names(record)]
@@ -222,7 +222,7 @@ class Control(Part):
 
     def record(self, label: str) -> ProcessState:
         """The record of the label ``label`` means (``resolve``)."""
-        return self.supervisor.process_records[self.resolve(label)]
+        return self.supervisor.process_states[self.resolve(label)]
 
     def info(self, label: str) -> ProcessInfo:
         record = self.record(label)
@@ -270,7 +270,7 @@ class Control(Part):
                 current.user_stop = "stop"  # a restart under way becomes a stop
             else:
                 self._not_stopping(current, "stop")
-                supervisor.events.emit(Controlled(label, "stop", by))
+                supervisor.records.emit(Controlled(label, "stop", by))
                 current.user_stop = "stop"
                 supervisor.stop(current)
             if done is not None:
@@ -279,7 +279,7 @@ class Control(Part):
         if record.state != RESTARTING:
             raise ControlError(f"{label} is not running ({record.outcome or record.state})")
         # Crashed and waiting for its respawn: the respawn is cancelled.
-        supervisor.events.emit(Controlled(label, "stop", by))
+        supervisor.records.emit(Controlled(label, "stop", by))
         supervisor.cancel_respawn(label, USER_STOPPED)
         if done is not None:
             done(self.info(label))
@@ -303,7 +303,7 @@ class Control(Part):
             return
         if not current.user_stop:
             self._not_stopping(current, "restart")
-            supervisor.events.emit(Controlled(label, "restart", by))
+            supervisor.records.emit(Controlled(label, "restart", by))
             supervisor.stop(current)
         current.user_stop = "restart"
         if done is not None:
@@ -314,7 +314,7 @@ class Control(Part):
         label = self.resolve(label)
         if not self.is_muted(label):
             self.printer.mute(label)
-            self.supervisor.events.emit(Controlled(label, "mute", by))
+            self.supervisor.records.emit(Controlled(label, "mute", by))
         return self.info(label)
 
     def unmute(self, label: str, *, by: str = "") -> ProcessInfo:
@@ -322,7 +322,7 @@ class Control(Part):
         label = self.resolve(label)
         if self.is_muted(label):
             self.printer.mute(label, False)
-            self.supervisor.events.emit(Controlled(label, "unmute", by))
+            self.supervisor.records.emit(Controlled(label, "unmute", by))
         return self.info(label)
 
     # --- composable nodes ------------------------------------------------------------------
@@ -336,13 +336,13 @@ class Control(Part):
         """Ask its container to unload the composable node ``name`` (its full name, or its
         name when only one has it); ``done(its state)`` once the container answered."""
         self._driver("unload").unload(name, done)
-        self.supervisor.events.emit(Controlled(name, "unload", by))
+        self.supervisor.records.emit(Controlled(name, "unload", by))
 
     def load(self, name: str, *, by: str = "", done: ComponentDone) -> None:
         """Load the composable node ``name`` into its container again (after an unload, or a
         failed load); ``done(its state)`` once the container answered."""
         self._driver("load").load(name, done)
-        self.supervisor.events.emit(Controlled(name, "load", by))
+        self.supervisor.records.emit(Controlled(name, "load", by))
 
     def _driver(self, action: str) -> ComponentDriver:
         driver = self.components()
@@ -376,7 +376,7 @@ class Control(Part):
         if managed.process is None:
             raise ControlError(f"cannot {label} {managed.fqn}: its process is not running")
         manager.request(managed, label, done)
-        self.supervisor.events.emit(Controlled(managed.fqn, label, by))
+        self.supervisor.records.emit(Controlled(managed.fqn, label, by))
 
     # --- the parts -------------------------------------------------------------------------
 
@@ -403,17 +403,17 @@ class Control(Part):
     ) -> None:
         if current is None:  # every record comes from a start: a bug if this happens
             raise ControlError(f"cannot {action} {label}: no instance of it is known")
-        self.supervisor.events.emit(Controlled(label, action, by))
+        self.supervisor.records.emit(Controlled(label, action, by))
         self.supervisor.start_again(current)
         if done is not None:
             done(self.info(label))
 
     def close(self) -> None:
         """Stop following the run (its waiting callbacks are dropped)."""
-        self.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_event)
         self._waits.clear()
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         """Calls back those waiting for an exit, or for the start that follows a restart."""
         if not self._waits:
             return
@@ -431,7 +431,7 @@ class Control(Part):
                 continue
             # A restart's new instance is started before this record is handed out (the exit
             # is held until the supervisor has acted on it); else it is still to come.
-            if what == "exit" or self.supervisor.process_records[process.label].state != RESTARTING:
+            if what == "exit" or self.supervisor.process_states[process.label].state != RESTARTING:
                 self._waits.remove(wait)
                 done(self.info(process.label))
 

@@ -40,7 +40,7 @@ import time
 from collections.abc import Callable, Mapping
 
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_USAGE
-from mlaunch.plan.events import Said
+from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -510,7 +510,7 @@ class _Client:
             self.out = b""
             self.server.forget(self)
             text = f"control socket: a request failed: {type(e).__name__}: {e}"
-            self.server.supervisor.events.emit(Said("WARNING", "launch", text))
+            self.server.supervisor.records.emit(Said("WARNING", "launch", text))
 
     def _on_ready(self) -> None:
         if self.out:

@@ -35,7 +35,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, Output, Said
+from mlaunch.plan.records import Output, Record, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -165,7 +165,7 @@ class Dashboard(Part):
         self.servers: list[BaseServer] = []
         self.loop: LoopCall | None = None
         self.url = ""
-        supervisor.events.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_event)
         metrics.listeners.append(self._sampled)
         supervisor.schedule(0.0, self._open, keeps_alive=False)
 
@@ -178,7 +178,7 @@ class Dashboard(Part):
             self.servers.append(serve_unix(self, dashboard_socket(self.supervisor.run_id)))
         except OSError as e:
             text = f"dashboard: the viewer's page cannot reach the launch panel: {e.strerror or e}"
-            self.supervisor.events.emit(Said("WARNING", "launch", text))
+            self.supervisor.records.emit(Said("WARNING", "launch", text))
         if self.port is not None:
             try:
                 server = serve_tcp(self, self.port)
@@ -187,15 +187,15 @@ class Dashboard(Part):
                     f"dashboard: cannot listen on 127.0.0.1:{self.port}: {e.strerror or e};"
                     " valid: a free port, or 0 for any free port (--dashboard-port)"
                 )
-                self.supervisor.events.emit(Said("ERROR", "launch", text))
+                self.supervisor.records.emit(Said("ERROR", "launch", text))
                 return
             self.servers.append(server)
             self.url = f"http://127.0.0.1:{server.server_address[1]}/launch/"
-            self.supervisor.events.emit(Said("INFO", "launch", f"dashboard: open {self.url}"))
+            self.supervisor.records.emit(Said("INFO", "launch", f"dashboard: open {self.url}"))
 
     # --- fed by the run ---------------------------------------------------------------------
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         if type(event) is Output:
             self.hub.add_output(event.process.label, event.data)
 
@@ -314,7 +314,7 @@ class Dashboard(Part):
             self.evidence_busy.release()
 
     def close(self) -> None:
-        self.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_event)
         if self._sampled in self.metrics.listeners:
             self.metrics.listeners.remove(self._sampled)
         self.hub.close()

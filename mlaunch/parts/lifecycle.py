@@ -47,11 +47,11 @@ from mlaunch.launch_ros.lifecycle_sequence import (
 )
 from mlaunch.parts.handoff import LoopCall, SharedGraph
 from mlaunch.plan.errors import EXIT_FAILURE
-from mlaunch.plan.events import (
+from mlaunch.plan.records import (
     ComponentLoaded,
-    Event,
     Exited,
     LaunchEvent,
+    Record,
     Said,
     ShutdownBegun,
     Started,
@@ -63,7 +63,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.process import Process
     from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.bridge import RosGraph, TransitionResult
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
 
 # get_state is asked again this often while waiting for a node (a lost request is not fatal).
 STATE_ATTEMPT = 2.0
@@ -131,7 +131,7 @@ class ComponentTarget:
         return f"<component {self.node_name} in {self.container}>"
 
 
-class Outcome(Event):
+class Outcome(Record):
     """A transition result, with why it was asked for: a record on the supervisor's stream."""
 
     __slots__ = ("reason", "result", "shutdown_on_failure")
@@ -170,7 +170,7 @@ class LifecycleManager(Part):
         self._in_sequence = {name for seq in self.sequences for name in seq.nodes}
         for spec in supervisor.plan.processes():
             self._track(spec)
-        supervisor.events.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_event)
         self._check_sequences()
         if self.sequences:
             # First thing in the loop, after the plan's processes are started.
@@ -190,7 +190,7 @@ class LifecycleManager(Part):
                     )
 
     def _say(self, level: str, text: str) -> None:
-        self.supervisor.events.emit(Said(level, SOURCE, text))
+        self.supervisor.records.emit(Said(level, SOURCE, text))
 
     def _track(self, spec: ProcessSpec) -> Managed | None:
         info = spec.node
@@ -208,7 +208,7 @@ class LifecycleManager(Part):
 
     # --- the supervisor's events (loop thread) -------------------------------------------------
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: Record) -> None:
         """The subscription: processes starting and exiting, ChangeState, the shutdown.
 
         A manager attached during the run is handed the record that showed it was needed.
@@ -419,7 +419,7 @@ class LifecycleManager(Part):
                 self.supervisor.begin_shutdown(
                     f"lifecycle node {result.node}: {result.transition} failed"
                 )
-        self.supervisor.events.emit(outcome)  # the smoke checks see each result
+        self.supervisor.records.emit(outcome)  # the smoke checks see each result
 
     def _up(self, fqn: str, generation: int) -> None:
         managed = self.nodes.get(fqn)
@@ -450,7 +450,7 @@ class LifecycleManager(Part):
             goal_state=event.goal_state,
         )
         # OnStateTransition handlers fire on it (mlaunch.engine.handlers).
-        self.supervisor.events.emit(Transition(managed.spec, transition))
+        self.supervisor.records.emit(Transition(managed.spec, transition))
 
     def _on_change_state(self, event: Any) -> None:
         """``EmitEvent(event=ChangeState(...))``: the transition, for each matched running node."""

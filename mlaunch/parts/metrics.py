@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 from mlaunch.engine.part import Part
 from mlaunch.parts.usage import GroupSampler, Usage, group_members
-from mlaunch.plan.events import Said
+from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -112,7 +112,7 @@ class Metrics(Part):
         if self._closed:
             return
         if self._failure:
-            self.supervisor.events.emit(Said("WARNING", "launch", self._failure))
+            self.supervisor.records.emit(Said("WARNING", "launch", self._failure))
             self._failure = ""
         if not self._queue.full():
             item = (self.wall_clock(), self.control().processes(), self._read())
@@ -182,10 +182,10 @@ class Metrics(Part):
             write_report(path, self.history)
         except OSError as e:
             text = f"metrics: cannot write the report {path}: {e.strerror or e}"
-            self.supervisor.events.emit(Said("WARNING", "launch", text))
+            self.supervisor.records.emit(Said("WARNING", "launch", text))
             return
         text = f"metrics: {self.csv_path}, report {path}"
-        self.supervisor.events.emit(Said("INFO", "launch", text))
+        self.supervisor.records.emit(Said("INFO", "launch", text))
 
 
 def _open_csv(path: str) -> IO[str]:

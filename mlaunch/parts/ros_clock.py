@@ -22,7 +22,7 @@ import threading
 
 from mlaunch.engine.part import Part
 from mlaunch.parts.handoff import LoopCall, SharedGraph
-from mlaunch.plan.events import Event, Said, ShutdownBegun, SimTimeWait
+from mlaunch.plan.records import Record, Said, ShutdownBegun, SimTimeWait
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -55,9 +55,9 @@ class RosClock(Part):
         self._next_due = math.inf
         self._watch: TopicWatch | None = None
         self._starting = False
-        supervisor.events.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_event)
 
-    def on_event(self, event: Event) -> None:
+    def on_event(self, event: Record) -> None:
         if isinstance(event, SimTimeWait):
             event.taken = True
             self._begin(event)
@@ -121,7 +121,7 @@ class RosClock(Part):
 
     def _unreadable(self, error: BaseException) -> None:
         """Loop thread: /clock cannot be read; the waits left count wall-clock time."""
-        self.supervisor.events.emit(
+        self.supervisor.records.emit(
             Said(
                 "WARNING",
                 "launch",
@@ -134,7 +134,7 @@ class RosClock(Part):
             self.supervisor.schedule(wait.step.period, wait.step.expire)
 
     def close(self) -> None:
-        self.supervisor.events.unsubscribe(self.on_event)
+        self.supervisor.records.unsubscribe(self.on_event)
         for wait in list(self._waits):
             self._forget(wait)
         self.loop.close()

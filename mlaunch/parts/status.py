@@ -30,7 +30,7 @@ from mlaunch.engine.process_state import (
     ProcessState,
 )
 from mlaunch.parts.summary import format_bytes, format_duration
-from mlaunch.plan.events import Event, Output, Said
+from mlaunch.plan.records import Output, Record, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -122,7 +122,7 @@ class StatusView(Part):
         self.keys: StatusKeys | None = None
         self.keyboard: Keyboard | None = None
         self.screen = self.printer.set_screen(self)
-        supervisor.events.subscribe(self._saw_output)
+        supervisor.records.subscribe(self._saw_output)
         supervisor.schedule(0.0, self._tick, keeps_alive=False, cancel_on_shutdown=False)
 
     # --- the screen, as the Printer sees it ----------------------------------------------------
@@ -175,7 +175,7 @@ class StatusView(Part):
         self._redraw = True
         self.flush()
         self.printer.set_screen(self.screen)
-        self.supervisor.events.unsubscribe(self._saw_output)
+        self.supervisor.records.unsubscribe(self._saw_output)
 
     # --- what it shows --------------------------------------------------------------------------
 
@@ -186,7 +186,7 @@ class StatusView(Part):
 
         supervisor = self.supervisor
         self.keys = StatusKeys(
-            lambda: list(supervisor.process_records),
+            lambda: list(supervisor.process_states),
             self.redraw,
             self.control,
             supervisor.clock,
@@ -214,7 +214,7 @@ class StatusView(Part):
             self._footer = self.render().encode("utf-8", "replace")
             self._redraw = True
 
-    def _saw_output(self, event: Event) -> None:
+    def _saw_output(self, event: Record) -> None:
         if not isinstance(event, Output):
             return
         data = event.data
@@ -254,7 +254,7 @@ class StatusView(Part):
         """(record, state, pid, uptime, cpu, memory, last line) for each process, as text."""
         now = self.supervisor.clock()
         out = []
-        for record in self.supervisor.process_records.values():
+        for record in self.supervisor.process_states.values():
             running = record.state in (RUNNING, STOPPING)
             cpu, rss = self.usage.get(record.pid, (0.0, 0)) if running else (0.0, 0)
             if running:
@@ -326,7 +326,7 @@ class StatusView(Part):
             hidden = len(rows) - room
             rows = [row for i, row in enumerate(rows) if i in kept]
         counts: dict[str, int] = {}
-        for record in self.supervisor.process_records.values():
+        for record in self.supervisor.process_states.values():
             counts[record.state] = counts.get(record.state, 0) + 1
         title = "mlaunch: " + ", ".join(f"{n} {state}" for state, n in counts.items())
         if hidden:
@@ -378,7 +378,7 @@ class StatusView(Part):
         from rich.text import Text
 
         assert self.keys is not None
-        record = self.supervisor.process_records.get(label)
+        record = self.supervisor.process_states.get(label)
         state = self._state_text(record) if record is not None else "-"
         shown, problem = self.keys.last_lines(label, max(1, int(lines * MAX_SHARE) - 2))
         what = f"its last {len(shown)} lines" if shown else problem or "no output yet"
@@ -431,7 +431,7 @@ def attach_status_view(
     """
     if not os.isatty(1):
         text = "--status needs a terminal on stdout; no status view"
-        supervisor.events.emit(Said("WARNING", "launch", text))
+        supervisor.records.emit(Said("WARNING", "launch", text))
         return None
     view = StatusView(supervisor, printer, control, color=printer.color)
     if os.isatty(0):

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping
 
 from mlaunch.engine.process_state import GAVE_UP, ProcessState
-from mlaunch.plan.events import Event, Summary
+from mlaunch.plan.records import Record, Summary
 
 
 def format_duration(seconds: float) -> str:
@@ -40,14 +40,14 @@ def format_bytes(size: float) -> str:
     return f"{size / (1 << 30):.1f} GiB"
 
 
-def summary_wanted(records: Iterable[ProcessState], *, quiet: bool = False) -> bool:
+def summary_wanted(states: Iterable[ProcessState], *, quiet: bool = False) -> bool:
     """More than one process, or any failure (only a failure with ``quiet``)."""
-    records = list(records)
-    failed = any(r.failed or r.state == GAVE_UP for r in records)
-    return failed if quiet else (len(records) > 1 or failed)
+    states = list(states)
+    failed = any(r.failed or r.state == GAVE_UP for r in states)
+    return failed if quiet else (len(states) > 1 or failed)
 
 
-def render_summary(records: Iterable[ProcessState]) -> str:
+def render_summary(states: Iterable[ProcessState]) -> str:
     """The summary table as plain text (it goes to the screen and into launch.log)."""
     head = ("process", "pid", "result", "restarts", "run time", "peak memory", "cpu time")
     rows = [
@@ -60,7 +60,7 @@ def render_summary(records: Iterable[ProcessState]) -> str:
             format_bytes(r.peak_rss),
             f"{r.cpu_time:.2f} s",
         )
-        for r in records
+        for r in states
     ]
     widths = [max(len(row[i]) for row in [head, *rows]) for i in range(len(head))]
     right = {1, 3, 4, 5, 6}
@@ -72,7 +72,7 @@ def render_summary(records: Iterable[ProcessState]) -> str:
         ]
         return "  " + "  ".join(parts).rstrip()
 
-    failed = sum(1 for r in records if r.failed or r.state == GAVE_UP)
+    failed = sum(1 for r in states if r.failed or r.state == GAVE_UP)
     title = f"Summary: {len(rows)} process{'es' if len(rows) != 1 else ''}"
     if failed:
         title += f", {failed} failed"
@@ -80,21 +80,21 @@ def render_summary(records: Iterable[ProcessState]) -> str:
 
 
 class ExitSummary:
-    """The summary of a run's processes, said when the run ends (``close``): ``records`` is the
-    run's read-only view of them, ``emit`` its event stream's (the printer says the table)."""
+    """The summary of a run's processes, said when the run ends (``close``): ``states`` is the
+    run's read-only view of them, ``emit`` its record stream's (the printer says the table)."""
 
     def __init__(
         self,
-        records: Mapping[str, ProcessState],
-        emit: Callable[[Event], None],
+        states: Mapping[str, ProcessState],
+        emit: Callable[[Record], None],
         *,
         quiet: bool = False,
     ) -> None:
-        self.records = records
+        self.states = states
         self.emit = emit
         self.quiet = quiet
 
     def close(self) -> None:
-        records = list(self.records.values())
-        if records and summary_wanted(records, quiet=self.quiet):
-            self.emit(Summary(render_summary(records)))
+        states = list(self.states.values())
+        if states and summary_wanted(states, quiet=self.quiet):
+            self.emit(Summary(render_summary(states)))

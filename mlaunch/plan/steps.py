@@ -412,7 +412,7 @@ class Note(Step):
 class Handoff(Step):
     """A step carried out by a part attached to the run, whenever it is reached.
 
-    The supervisor emits it on the event stream (``HandedOff``) as it carries out the plan, a
+    The supervisor emits it on the record stream (``HandedOff``) as it carries out the plan, a
     timer's or a handler's steps alike, so the part acting on it (``needs`` names it: the
     LoadNode driver for LoadComponents) sees every such step once, in order. A handoff no part
     takes is said, never dropped in silence.

@@ -14,7 +14,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, ShutdownBegun
+from mlaunch.plan.records import Record, ShutdownBegun
 from mlaunch.smoke.settings import Settings
 from mlaunch.smoke.watch import SmokeRun
 
@@ -137,7 +137,7 @@ class Readiness(Part):
             supervisor, expectations, lifecycle=lifecycle, on_change=self._changed
         )
         self.watch.seed(logs)
-        supervisor.events.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_event)
         if notifier is not None:
             self._status()
             supervisor.schedule(STATUS_PERIOD, self._tick, keeps_alive=False)
@@ -183,14 +183,14 @@ class Readiness(Part):
         self.notifier.watchdog()
         self.supervisor.schedule(self._watchdog_period(), self._watchdog, keeps_alive=False)
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         if isinstance(event, ShutdownBegun) and self.notifier is not None:
             reason = event.reason or "shutting down"
             self.notifier.stopping(f"stopping: {reason}")
             self._last_status = "stopping"
 
     def close(self) -> None:
-        self.supervisor.events.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_event)
         self.watch.close()
         if self.notifier is not None:
             self.notifier.close()

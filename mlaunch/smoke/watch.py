@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.engine.part import Part
-from mlaunch.plan.events import Event, Exited, HandedOff, LoadRefused, Output, Said, Started
+from mlaunch.plan.records import Exited, HandedOff, LoadRefused, Output, Record, Said, Started
 from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from mlaunch.parts.handoff import SharedGraph
     from mlaunch.parts.lifecycle import LifecycleManager, Outcome
     from mlaunch.parts.ros1_graph import SharedMaster
-    from mlaunch.plan.events import ProcessView
+    from mlaunch.plan.records import ProcessView
     from mlaunch.plan.steps import Plan, ProcessSpec
     from mlaunch.smoke.recorder import Recorder
     from mlaunch.smoke.report import Window
@@ -60,7 +60,7 @@ _ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 class SmokeRun(Part):
     """Attached to the supervisor: decides ready / failed, then shuts the launch down.
 
-    Process and output checks run in the supervisor's loop thread (its event stream);
+    Process and output checks run in the supervisor's loop thread (its record stream);
     ROS graph checks run in one checker thread that hands its findings to the loop.
     """
 
@@ -107,7 +107,7 @@ class SmokeRun(Part):
         # The last seconds of the named topics, for the evidence of a failure: fed by the graph.
         self.recorder = recorder if graph is None else None
         self._recording = False
-        supervisor.events.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_event)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
         if any(e.kind in GRAPH_KINDS for e in expectations) or self.recorder is not None:
             self._start_checker()
@@ -117,7 +117,7 @@ class SmokeRun(Part):
 
     # --- loop thread ---------------------------------------------------------------------------
 
-    def _on_event(self, event: Event) -> None:
+    def _on_event(self, event: Record) -> None:
         """The subscription: output, starts and exits, and the lifecycle manager's results."""
         from mlaunch.parts.lifecycle import Outcome
 
@@ -358,7 +358,7 @@ class SmokeRun(Part):
             return  # stopping at a failure (the youngest process may still finish starting)
         self.phase = "holding"
         self.ready_at = self.elapsed()
-        emit = self.supervisor.events.emit
+        emit = self.supervisor.records.emit
         count = sum(1 for e in self.expectations if e.status == "met")
         emit(Said("INFO", self.SOURCE, f"ready after {self.elapsed():.1f} s ({count} checks met)"))
         if self.settings.hold > 0:
@@ -459,7 +459,7 @@ class SmokeRun(Part):
                 self._mark(e, "failed", f"{e.seen}; the launch shut down first ({reason})")
 
     def _conclude_shutdown(self, e: Expectation) -> None:
-        records = self.supervisor.process_records
+        records = self.supervisor.process_states
         killed = [r.label for r in records.values() if signal.SIGKILL in r.signals]
         e.labels = killed
         if killed:

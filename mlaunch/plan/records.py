@@ -1,8 +1,8 @@
-"""The engine's one event stream: typed records of what happens in a run, handled in order.
+"""The engine's one record stream: typed records of what happens in a run, handled in order.
 
 The supervisor emits a record for everything that happens (a process started, printed, exited;
 a stop signal escalated; a respawn was scheduled; the launch began shutting down ...) and writes
-no words of its own. Everything that reacts subscribes to the same EventStream, in this order:
+no words of its own. Everything that reacts subscribes to the same RecordStream, in this order:
 the supervisor's own reactions (starting the stop ladder), the printer (every log line), the
 launch file's event handlers (mlaunch.engine.handlers), then what the pipeline attaches (status
 view, lifecycle driving, smoke checks).
@@ -56,7 +56,7 @@ if TYPE_CHECKING:
         def running(self) -> bool: ...
 
 
-class Event:
+class Record:
     """A record on the stream. Subscribers tell them apart by class."""
 
     __slots__ = ()
@@ -70,7 +70,7 @@ class Event:
 # --- processes ----------------------------------------------------------------------------------
 
 
-class Started(Event):
+class Started(Record):
     """A process is running (``process.restarts`` > 0: a respawn)."""
 
     __slots__ = ("process",)
@@ -79,7 +79,7 @@ class Started(Event):
         self.process = process
 
 
-class FailedToStart(Event):
+class FailedToStart(Record):
     """The program could not be executed (``reason``: the OS's words). An Exited follows."""
 
     __slots__ = ("process", "reason")
@@ -89,7 +89,7 @@ class FailedToStart(Event):
         self.reason = reason
 
 
-class NotStarted(Event):
+class NotStarted(Record):
     """A start asked for while the launch was shutting down; nothing was spawned."""
 
     __slots__ = ("spec",)
@@ -98,7 +98,7 @@ class NotStarted(Event):
         self.spec = spec
 
 
-class StartsSkipped(Event):
+class StartsSkipped(Record):
     """A description being carried out asked for ``count`` starts while shutting down."""
 
     __slots__ = ("count",)
@@ -107,7 +107,7 @@ class StartsSkipped(Event):
         self.count = count
 
 
-class Output(Event):
+class Output(Record):
     """Complete lines (bytes ending in a newline) of a process's ``stream`` (stdout, stderr)."""
 
     __slots__ = ("data", "process", "stream")
@@ -118,7 +118,7 @@ class Output(Event):
         self.data = data
 
 
-class Exited(Event):
+class Exited(Record):
     """A process ended (reaped, or failed to start) with ``code``: its status or -signal."""
 
     __slots__ = ("code", "process")
@@ -128,7 +128,7 @@ class Exited(Event):
         self.code = code
 
 
-class Escalated(Event):
+class Escalated(Record):
     """A step of the stop ladder: ``signal`` sent, as ``previous`` went unheeded ``waited`` s
     (``previous`` 0: none was sent, the shutdown began ``waited`` s ago)."""
 
@@ -141,7 +141,7 @@ class Escalated(Event):
         self.waited = waited
 
 
-class RespawnScheduled(Event):
+class RespawnScheduled(Record):
     """A process that exited with ``code`` starts again in ``delay`` s (restart ``attempt``)."""
 
     __slots__ = ("attempt", "code", "delay", "max_retries", "process")
@@ -156,7 +156,7 @@ class RespawnScheduled(Event):
         self.delay = delay
 
 
-class GaveUp(Event):
+class GaveUp(Record):
     """A respawning process used up its retries; it stays down."""
 
     __slots__ = ("code", "process", "restarts")
@@ -167,7 +167,7 @@ class GaveUp(Event):
         self.restarts = restarts
 
 
-class StrayEnded(Event):
+class StrayEnded(Record):
     """A process of the run outside every watched group (an escaped descendant) was signalled."""
 
     __slots__ = ("name", "pid", "signal")
@@ -178,7 +178,7 @@ class StrayEnded(Event):
         self.signal = signal
 
 
-class Controlled(Event):
+class Controlled(Record):
     """The user asked for ``action`` on the process ``label`` (mlaunch.parts.control).
 
     ``action``: "stop", "start", "restart", "mute" or "unmute". Emitted before the action is
@@ -198,7 +198,7 @@ class Controlled(Event):
 # --- the launch as a whole ------------------------------------------------------------------------
 
 
-class Interrupted(Event):
+class Interrupted(Record):
     """The user (or the system) sent a stop signal: the launch stops (a second one kills)."""
 
     __slots__ = ("signal",)
@@ -207,7 +207,7 @@ class Interrupted(Event):
         self.signal = signal
 
 
-class ShutdownBegun(Event):
+class ShutdownBegun(Record):
     """The first shutdown phase: the launch stops. OnShutdown handlers run now.
 
     ``due_to_signal``: the signal number when a signal caused it, else None. A handler that
@@ -222,7 +222,7 @@ class ShutdownBegun(Event):
         self.due_to_signal = due_to_signal
 
 
-class ShutdownRepeated(Event):
+class ShutdownRepeated(Record):
     """Another Shutdown of the launch file while the launch already stops: its OnShutdown
     handlers see it, as launch hands them every Shutdown event; nothing else changes."""
 
@@ -233,7 +233,7 @@ class ShutdownRepeated(Event):
         self.due_to_signal = due_to_signal
 
 
-class StoppingAll(Event):
+class StoppingAll(Record):
     """The second shutdown phase: every process not held gets its stop ladder.
 
     With ``kill`` (a second Ctrl-C), every group was sent SIGKILL already.
@@ -245,7 +245,7 @@ class StoppingAll(Event):
         self.kill = kill  # a second Ctrl-C: SIGKILL to every group at once
 
 
-class LaunchEvent(Event):
+class LaunchEvent(Record):
     """The launch file emitted ``event`` (EmitEvent); who acts on it sets ``taken``."""
 
     __slots__ = ("event", "taken")
@@ -255,7 +255,7 @@ class LaunchEvent(Event):
         self.taken = False
 
 
-class HandedOff(Event):
+class HandedOff(Record):
     """A plan step for a part of the run (``step``: a ``Handoff``, e.g. LoadComponents) was
     reached; the part that carries it out sets ``taken``."""
 
@@ -266,7 +266,7 @@ class HandedOff(Event):
         self.taken = False
 
 
-class SimTimeWait(Event):
+class SimTimeWait(Record):
     """A ROSTimer's ``period`` counted on simulated time: the engine hands it to the ROS clock
     part (mlaunch.parts.ros_clock), which sets ``taken`` and calls ``expire`` from the loop
     once /clock has advanced ``period`` seconds past the time it had when the wait began (0
@@ -286,7 +286,7 @@ class SimTimeWait(Event):
         self.taken = False
 
 
-class Unclaimed(Event):
+class Unclaimed(Record):
     """Follows a LaunchEvent or a HandedOff once every subscriber has seen it; said if nobody
     took it."""
 
@@ -296,7 +296,7 @@ class Unclaimed(Event):
         self.launch_event = launch_event
 
 
-class LoadRefused(Event):
+class LoadRefused(Record):
     """A container answered that it did not load a composable node: ``node`` its full name as
     requested (or its plugin when unnamed), ``reason`` the container's error message."""
 
@@ -309,7 +309,7 @@ class LoadRefused(Event):
         self.reason = reason
 
 
-class ComponentLoaded(Event):
+class ComponentLoaded(Record):
     """A container loaded a composable node: ``step`` the LoadComponents it came from,
     ``request`` what was asked for, ``name`` the node's full name as the container answered."""
 
@@ -321,7 +321,7 @@ class ComponentLoaded(Event):
         self.name = name
 
 
-class Transition(Event):
+class Transition(Record):
     """A managed node changed state: ``event`` is launch_ros's StateTransition for ``spec``."""
 
     __slots__ = ("event", "spec")
@@ -331,7 +331,7 @@ class Transition(Event):
         self.event = event
 
 
-class Completed(Event):
+class Completed(Record):
     """An action a handler waited for when it was visited finished executing (ExecutionComplete)."""
 
     __slots__ = ("action",)
@@ -340,7 +340,7 @@ class Completed(Event):
         self.action = action
 
 
-class Said(Event):
+class Said(Record):
     """A line whose words come from elsewhere: the plan's warnings, LogInfo, a handler's error."""
 
     __slots__ = ("level", "source", "text")
@@ -351,7 +351,7 @@ class Said(Event):
         self.text = text
 
 
-class Summary(Event):
+class Summary(Record):
     """Lines said as they are, not as one message (the exit summary's table)."""
 
     __slots__ = ("text",)
@@ -362,15 +362,15 @@ class Summary(Event):
 
 # --- the stream -----------------------------------------------------------------------------------
 
-Subscriber = Callable[[Event], object]
+Subscriber = Callable[[Record], object]
 
 
-class EventStream:
+class RecordStream:
     """Subscribers, and a queue that hands them each record in order, one record at a time."""
 
     def __init__(self) -> None:
         self.subscribers: list[Subscriber] = []
-        self._queue: deque[Event] = deque()
+        self._queue: deque[Record] = deque()
         self._dispatching = False
         self._held = 0
 
@@ -382,13 +382,13 @@ class EventStream:
         if subscriber in self.subscribers:
             self.subscribers.remove(subscriber)
 
-    def emit(self, event: Event) -> None:
+    def emit(self, event: Record) -> None:
         """Queue ``event``; dispatch the queue now unless a dispatch or a visit is under way."""
         self._queue.append(event)
         if not self._dispatching and not self._held:
             self._drain()
 
-    def say_now(self, event: Event) -> None:
+    def say_now(self, event: Record) -> None:
         """Hand ``event`` to every subscriber at once, ahead of what is queued.
 
         Only for lines that are not events in launch (LogInfo is said while its description is
