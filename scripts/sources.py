@@ -11,11 +11,14 @@ packs it as `ARCHIVE` (one top folder named like it) into a folder with a MANIFE
 the builders take, as CI's offline copy is. Archives already there with the pinned content are
 kept, so a second setup downloads nothing.
 
-    scripts/sources.py fetch PINS DEST      get, check and pack; prints DEST
-    scripts/sources.py content ARCHIVE...   the content sha256 of archives (to write pins)
+    scripts/sources.py fetch PINS DEST [--git DIR]  get, check and pack; prints DEST
+    scripts/sources.py content ARCHIVE...           the content sha256 of archives (to write pins)
 
 The download address is `$MLAUNCH_SOURCES_URL/OWNER/REPO/archive/COMMIT.tar.gz`, by default
-GitHub's; the tests point it at a server on 127.0.0.1.
+GitHub's; the tests point it at a server on 127.0.0.1. With `--git DIR`, nothing is downloaded:
+each repository is a git clone (bare or not) in DIR, as `OWNER/REPO`, `OWNER/REPO.git`,
+`OWNER+REPO` or `OWNER+REPO/repo`, and the pinned paths at the commit are taken from it with
+`git archive` (a clone that lacks some large files still serves the paths that do not need them).
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import hashlib
 import io
 import os
 import shutil
+import subprocess
 import sys
 import tarfile
 import tempfile
@@ -115,6 +119,7 @@ def keep_paths(tarball: bytes, paths: list[str], dest: Path) -> None:
             elif source.is_dir():
                 shutil.copytree(source, dest / kept, symlinks=True)
             else:
+                (dest / kept).parent.mkdir(parents=True, exist_ok=True)
                 shutil.copy2(source, dest / kept)
 
 
@@ -141,14 +146,45 @@ def pack(folder: Path, archive: Path) -> None:
     tmp.replace(archive)
 
 
-def fetch(pins_file: Path, dest: Path, base_url: str) -> Path:
+def git_clone(mirrors: Path, repo: str) -> Path:
+    """The clone of ``repo`` (OWNER/REPO) in the folder ``mirrors``, in one of its layouts."""
+    owner, name = repo.split("/", 1)
+    candidates = [
+        mirrors / owner / name,
+        mirrors / owner / f"{name}.git",
+        mirrors / f"{owner}+{name}",
+        mirrors / f"{owner}+{name}" / "repo",
+    ]
+    for path in candidates:
+        if (path / "HEAD").is_file() or (path / ".git").exists():
+            return path
+    raise SourcesError(
+        f"no git clone of {repo} in {mirrors} (looked for {owner}/{name}[.git] and"
+        f" {owner}+{name}[/repo])"
+    )
+
+
+def git_tarball(clone: Path, commit: str, paths: list[str]) -> bytes:
+    """The pinned paths of ``clone`` at ``commit`` as a tarball with one top folder."""
+    command = ["git", "-C", str(clone), "archive", "--format=tar", f"--prefix=src-{commit}/"]
+    command += [commit, "--", *paths]
+    done = subprocess.run(command, capture_output=True, check=False)
+    if done.returncode != 0:
+        reason = done.stderr.decode(errors="replace").strip().splitlines()
+        raise SourcesError(
+            f"git archive of {commit} in {clone} failed: {reason[-1] if reason else 'no reason'}"
+        )
+    return done.stdout
+
+
+def fetch(pins_file: Path, dest: Path, base_url: str, mirrors: Path | None = None) -> Path:
     pins = read_pins(pins_file)
     dest.mkdir(parents=True, exist_ok=True)
     rows = []
     for pin in pins:
         archive = dest / pin["archive"]
         if not (archive.is_file() and _has_content(archive, pin["content"])):
-            _fetch_one(pin, archive, base_url)
+            _fetch_one(pin, archive, base_url, mirrors)
         sha = hashlib.sha256(archive.read_bytes()).hexdigest()
         rows.append({**{c: pin[c] for c in COLUMNS if c != "content"}, "sha256": sha})
     with (dest / "MANIFEST.tsv").open("w", newline="") as handle:
@@ -166,10 +202,16 @@ def _has_content(archive: Path, content: str) -> bool:
         return False
 
 
-def _fetch_one(pin: dict[str, str], archive: Path, base_url: str) -> None:
-    url = f"{base_url.rstrip('/')}/{pin['repo']}/archive/{pin['commit']}.tar.gz"
+def _fetch_one(pin: dict[str, str], archive: Path, base_url: str, mirrors: Path | None) -> None:
     print(f"sources: {pin['archive']}: {pin['repo']} at {pin['commit'][:12]}", file=sys.stderr)
-    tarball = download(url)
+    if mirrors is None:
+        url = f"{base_url.rstrip('/')}/{pin['repo']}/archive/{pin['commit']}.tar.gz"
+        tarball = download(url)
+    else:
+        clone = git_clone(mirrors, pin["repo"])
+        url = f"{clone} at {pin['commit']}"
+        paths = [p for p in pin["paths"].split() if p != "."]
+        tarball = git_tarball(clone, pin["commit"], paths)
     stem = pin["archive"].removesuffix(".tar.gz")
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp) / stem
@@ -188,9 +230,10 @@ def _fetch_one(pin: dict[str, str], archive: Path, base_url: str) -> None:
 
 def main(argv: list[str]) -> int:
     try:
-        if len(argv) == 3 and argv[0] == "fetch":
+        if argv[:1] == ["fetch"] and (len(argv) == 3 or (len(argv) == 5 and argv[3] == "--git")):
             base = os.environ.get("MLAUNCH_SOURCES_URL") or DEFAULT_URL
-            print(fetch(Path(argv[1]), Path(argv[2]), base))
+            mirrors = Path(argv[4]) if len(argv) == 5 else None
+            print(fetch(Path(argv[1]), Path(argv[2]), base, mirrors))
             return 0
         if len(argv) >= 2 and argv[0] == "content":
             for name in argv[1:]:
@@ -199,7 +242,10 @@ def main(argv: list[str]) -> int:
     except SourcesError as exc:
         print(f"sources: {exc}", file=sys.stderr)
         return 1
-    print("usage: scripts/sources.py fetch PINS DEST | content ARCHIVE...", file=sys.stderr)
+    print(
+        "usage: scripts/sources.py fetch PINS DEST [--git DIR] | content ARCHIVE...",
+        file=sys.stderr,
+    )
     return 2
 
 

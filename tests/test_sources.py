@@ -175,3 +175,38 @@ def test_the_pins_match_the_archives_ci_builds_from(name: str) -> None:
             row["paths"],
         )
         assert sources.archive_content(ci / pin["archive"]) == pin["content"], pin["archive"]
+
+
+def git_clone_of(tmp: Path, files: dict[str, str]) -> tuple[Path, str]:
+    """A bare clone named OWNER+REPO (one layout --git takes) holding ``files`` in one commit."""
+    work = tmp / "work"
+    for name, text in files.items():
+        (work / name).parent.mkdir(parents=True, exist_ok=True)
+        (work / name).write_text(text)
+    env = {"GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t", "GIT_COMMITTER_NAME": "t",
+           "GIT_COMMITTER_EMAIL": "t@t", "PATH": "/usr/bin:/bin", "HOME": str(tmp)}  # fmt: skip
+    for step in (["init", "-q"], ["add", "."], ["commit", "-qm", "one"]):
+        subprocess.run(["git", "-C", str(work), *step], check=True, env=env)
+    commit = subprocess.run(["git", "-C", str(work), "rev-parse", "HEAD"], capture_output=True,
+                            text=True, check=True).stdout.strip()  # fmt: skip
+    mirrors = tmp / "mirrors"
+    subprocess.run(["git", "clone", "-q", "--bare", str(work), str(mirrors / "owner+demo" / "repo")],
+                   check=True, env=env)  # fmt: skip
+    return mirrors, commit
+
+
+def test_fetch_takes_the_pinned_paths_from_a_git_clone(tmp_path: Path) -> None:
+    mirrors, commit = git_clone_of(tmp_path, FILES)
+    content = expected_content(tmp_path)
+    pin = pins(tmp_path, content, "pkg/package.xml pkg/src LICENSE")  # a file inside a folder too
+    pin.write_text(pin.read_text().replace(COMMIT, commit))
+    dest = sources.fetch(pin, tmp_path / "dest", "http://127.0.0.1:9/unused", mirrors)
+    assert sources.archive_content(dest / "demo.tar.gz") == content
+    with tarfile.open(dest / "demo.tar.gz") as tar:
+        assert "demo/x/y" not in tar.getnames()  # only the pinned paths
+    # A commit the clone lacks, or no clone of the repository, is said.
+    pin.write_text(pin.read_text().replace(commit, "f" * 40))
+    with pytest.raises(sources.SourcesError, match=f"git archive of {'f' * 40} in .*owner"):
+        sources.fetch(pin, tmp_path / "d2", "http://127.0.0.1:9/unused", mirrors)
+    with pytest.raises(sources.SourcesError, match="no git clone of owner/demo in"):
+        sources.fetch(pin, tmp_path / "d3", "http://127.0.0.1:9/unused", tmp_path / "none")
