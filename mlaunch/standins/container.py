@@ -18,7 +18,7 @@ rclpy is imported inside main() only, so importing this module stays cheap.
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from mlaunch.standins.common import EXIT_FAILURE, init_ros, spin_until_shutdown
@@ -36,7 +36,8 @@ def _robot_state_publisher(node: Node) -> object:
 
 
 # (package, plugin) -> (the default node name of the real component, what starts it on a node).
-PLUGINS: dict[tuple[str, str], tuple[str, Callable[[Node], object]]] = {
+Plugins = Mapping[tuple[str, str], tuple[str, Callable[["Node"], object]]]
+PLUGINS: Plugins = {
     ("robot_state_publisher", "robot_state_publisher::RobotStatePublisher"): (
         "robot_state_publisher",
         _robot_state_publisher,
@@ -87,10 +88,11 @@ def forward_global_arguments(extra_arguments: Sequence[Any]) -> bool:
 class Container:
     """The component manager: loaded components by unique id, and the three services."""
 
-    def __init__(self, node: Node) -> None:
+    def __init__(self, node: Node, plugins: Plugins = PLUGINS) -> None:
         from composition_interfaces.srv import ListNodes, LoadNode, UnloadNode
 
         self.node = node
+        self.plugins = plugins
         self.components: dict[int, tuple[str, Node, object]] = {}
         self.next_id = 1
         node.create_service(LoadNode, "~/_container/load_node", self.on_load)
@@ -99,7 +101,7 @@ class Container:
 
     def on_load(self, request: Any, response: Any) -> Any:
         key = (request.package_name, request.plugin_name)
-        entry = PLUGINS.get(key)
+        entry = self.plugins.get(key)
         if entry is None:
             response.success = False
             response.error_message = refusal(*key)
@@ -188,8 +190,11 @@ class Container:
         return executor
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Serve the container until shutdown; 1 with one line when composition_interfaces lacks."""
+def main(argv: Sequence[str] | None = None, plugins: Plugins = PLUGINS) -> int:
+    """Serve the container until shutdown; 1 with one line when composition_interfaces lacks.
+
+    ``plugins`` is what it hosts (a benchmark's container hosts every plugin as a bare node).
+    """
     from rclpy.node import Node
 
     args = [sys.argv[0], *(sys.argv[1:] if argv is None else argv)]
@@ -205,7 +210,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             " the interfaces) or source a ROS 2 installation"
         )
         return EXIT_FAILURE
-    return spin_until_shutdown(node, lambda: Container(node), {}, stop)
+    return spin_until_shutdown(node, lambda: Container(node, plugins), {}, stop)
 
 
 if __name__ == "__main__":
