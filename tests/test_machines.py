@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -393,3 +394,66 @@ def test_cwd_is_a_directory_of_the_remote(sshd: Server, tmp_path: Path, token: s
     assert "[sh-1] in /proc" in out, out
     assert "failed to start 'sh' on this computer" in out, out
     assert "exited with status 127" in out, out
+
+
+SAYER = """#!/bin/sh
+echo "program $0"
+echo "loader=$FROM_LOADER launch=$SET_BY_LAUNCH domain=$ROS_DOMAIN_ID"
+for a in "$@"; do
+  if [ "$prev" = "--params-file" ]; then echo "arg <params>"; sed 's/^/params: /' "$a"
+  else echo "arg $a"; fi
+  prev=$a
+done
+"""
+
+
+def test_a_machines_share_run_there_gives_its_node_what_ssh_gives_it(
+    sshd: Server, tmp_path: Path, token: str
+) -> None:
+    # mlaunch FILE --machine robot, run on the robot, starts the robot's node as the launcher's
+    # ssh agent does: the same program, arguments, parameters and environment.
+    prefix = tmp_path / "robot-prefix"
+    program = prefix / "lib" / "mlaunch_demo" / "talker"
+    program.parent.mkdir(parents=True)
+    program.write_text(SAYER)
+    program.chmod(0o755)
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "mlaunch_demo").write_text("")  # an installed package, as on the robot
+    loader = tmp_path / "env.sh"
+    loader.write_text(
+        f'#!/bin/sh\nexport FROM_LOADER=yes AMENT_PREFIX_PATH="{prefix}"\nexec "$@"\n'
+    )
+    loader.chmod(0o755)
+    path = tmp_path / "node.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import SetEnvironmentVariable\n"
+        "from launch_ros.actions import Node\n"
+        "from mlaunch.actions import Machine\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        f"        Machine(name='robot', address='{HOST_ALIAS}', env_loader='{loader}'),\n"
+        "        SetEnvironmentVariable('SET_BY_LAUNCH', 'set'),\n"
+        "        Node(package='mlaunch_demo', executable='talker', name='talker',\n"
+        "             namespace='r', machine='robot', output='screen',\n"
+        "             parameters=[{'rate': 5, 'frame': 'base'}], remappings=[('a', 'b')],\n"
+        f"             arguments=['x y'], additional_env={{'MLTEST_REMOTE': '{token}'}}),\n"
+        "    ])\n"
+    )
+
+    def said(done: subprocess.CompletedProcess[str]) -> list[str]:
+        out = done.stdout + done.stderr
+        lines = out.splitlines()
+        return [line.split("] ", 1)[1] for line in lines if line.startswith("[talker-1] ")]
+
+    env = env_for(sshd, token)
+    env.pop("AMENT_PREFIX_PATH", None)
+    over_ssh = said(run_mlaunch(str(path), env=env))  # the package is the robot's (env-loader)
+    here = said(run_mlaunch(str(path), "--machine", "robot",
+                            env={**env, "AMENT_PREFIX_PATH": str(prefix)}))  # fmt: skip
+    assert over_ssh[0] == f"program {program}", over_ssh
+    assert "loader=yes launch=set domain=57" in over_ssh, over_ssh
+    assert "params:     rate: 5" in over_ssh and "arg x y" in over_ssh, over_ssh
+    assert here == over_ssh
+    assert_nothing_left(token)

@@ -70,6 +70,8 @@ class Options:
         self.metrics: str | None = None  # --metrics FILE.csv
         # --log-level [NAME:=]LEVEL, each given to every ROS process as --log-level
         self.log_levels: list[str] = []
+        # --machine NAME: run only that machine's share (docs/machines.md); None: all of it
+        self.machine: str | None = None
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -210,6 +212,13 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="keep an include's ThisLaunchFileDir/$(dirname) to the included file: its"
         " arguments and the actions after it get the includer's (ros2 launch, as ros2/launch#618,"
         " gives the included file's); per file: a comment 'mlaunch: scoped-file-locals'",
+    )
+    parser.add_argument(
+        "--machine",
+        metavar="NAME",
+        help="run only the processes of machine NAME (a <machine>/Machine of the file) here,"
+        " without ssh, as on that computer; 'local': those given no machine; the rest is left"
+        " to the runs on the other machines (a fleet split, docs/machines.md)",
     )
     parser.add_argument(
         "--package-path",
@@ -402,6 +411,13 @@ def parse_options(argv: Sequence[str]) -> Options:
     opts.scoped_parameters = ns.scoped_parameters
     opts.scoped_file_locals = ns.scoped_file_locals
     opts.ros = ns.ros
+    if ns.machine is not None:
+        from mlaunch.plan.machine import check_name
+
+        problem = check_name(ns.machine)
+        if problem is not None:
+            raise UsageError(f"--machine {ns.machine!r}: {problem}")
+        opts.machine = ns.machine
     rest = list(ns.rest)
     if rest and ":=" not in rest[0] and not os.path.isfile(ns.target):
         opts.second = rest.pop(0)

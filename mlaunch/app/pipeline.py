@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from mlaunch.app.options import Options, own_log_level
 from mlaunch.app.parts import PartMaker, Run
 from mlaunch.plan.records import Said
-from mlaunch.plan.steps import Plan
+from mlaunch.plan.steps import SHARE, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -105,6 +105,14 @@ def load_file(
         if temp_dir is not None and native_ros1(opts, path):
             from mlaunch.parts import ros1_native
 
+            if opts.machine is not None:
+                from mlaunch.plan.errors import UsageError
+
+                raise UsageError(
+                    f"--machine {opts.machine}: a native ROS 1 run (its master and parameter"
+                    " server) is not split by machine; run the file on ROS 2 (--ros2), or whole"
+                )
+
             native: LaunchDescription = ros1_native.description(
                 path, opts.arguments, os.environ, temp_dir
             )
@@ -150,6 +158,7 @@ def resolve_for_run(
         scoped_file_locals=opts.scoped_file_locals,
         dry_run=opts.print_plan,
         log_levels=tuple(opts.log_levels),
+        machine=opts.machine,
     )
     if opts.use_sim_time is not None:
         from mlaunch.launch_ros.actions.set_parameter import with_use_sim_time
@@ -166,6 +175,10 @@ def resolve_for_run(
         labels=labels,
         noninteractive=opts.noninteractive,
     )
+    if opts.machine is not None:
+        from mlaunch.resolve.shares import check_share
+
+        check_share(plan, labels.run_state, opts.machine)
     return plan, options, labels
 
 
@@ -307,6 +320,8 @@ def _remote_spawner(labels: LabelCounter, run_id: str) -> Spawner | None:
     """The remote-process spawner when the launch declared other machines, else None."""
     if not labels.run_state.get("machines"):
         return None  # no Machine in the launch: mlaunch.machines is never imported
+    if SHARE in labels.run_state:
+        return None  # --machine: its share runs here, the others' are not started
     from mlaunch.plan.machine import remote_machines
 
     if not remote_machines(labels.run_state):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import os
 
+from mlaunch.plan.steps import SHARE
 from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -163,3 +164,46 @@ def check_name(name: str) -> str | None:
     if not name or any(c.isspace() for c in name) or os.sep in name:
         return "a machine name is a non-empty word without spaces or '/'"
     return None
+
+
+# --machine NAME: this run starts only machine NAME's share of the launch (mlaunch.app.options).
+# ``LOCAL_SHARE`` names the share of the processes given no machine (the launching computer's).
+LOCAL_SHARE = "local"
+
+
+def share_of(run_state: dict[str, Any]) -> str | None:
+    """The share this run starts (``--machine NAME``), or None: the whole launch."""
+    share: str | None = run_state.get(SHARE)
+    return share
+
+
+def machine_name(machine: MachineSpec | None) -> str:
+    """The share a process of ``machine`` belongs to: the machine's name, else ``local``."""
+    return LOCAL_SHARE if machine is None else machine.name
+
+
+def placed(
+    run_state: dict[str, Any], machine: MachineSpec | None
+) -> tuple[MachineSpec | None, bool]:
+    """(the machine a process runs on as this run sees it, whether it runs elsewhere).
+
+    Without ``--machine`` nothing changes. With it, a process of the chosen share runs here,
+    without ssh (this run is on that machine: its machine is marked local), and a process of
+    another share is elsewhere: this run does not start it.
+    """
+    share = run_state.get(SHARE)
+    if share is None:
+        return machine, False
+    if machine_name(machine) != share:
+        return machine, True
+    if machine is None or machine.local:
+        return machine, False
+    values = dict(zip(machine._fields, machine._values(), strict=True))
+    values["local"] = True
+    return MachineSpec(**values), False
+
+
+def runs_elsewhere(run_state: dict[str, Any], machine: MachineSpec | None) -> bool:
+    """Whether a process of ``machine`` belongs to another share than this run's."""
+    share = run_state.get(SHARE)
+    return share is not None and machine_name(machine) != share

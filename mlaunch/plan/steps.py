@@ -25,6 +25,10 @@ if TYPE_CHECKING:
 
     from mlaunch.plan.machine import MachineSpec
 
+# The run state's key (LaunchContext.run_state) for --machine NAME: this run starts that machine's
+# share of the launch (mlaunch.plan.machine).
+SHARE = "share"
+
 OUTPUT_MODES = ("log", "screen", "both", "own_log", "full")
 RESPAWN_MODES = ("never", "always", "on-failure")
 
@@ -407,6 +411,48 @@ class Note(Step):
     A lifecycle sequence, a smoke-test expectation. Any other step kind the supervisor does not
     know is an error, not skipped.
     """
+
+
+class Elsewhere(Note):
+    """A step of another machine's share (``--machine NAME``): not carried out in this run.
+
+    ``spec`` is the process another run starts (its label is counted here as in the whole
+    launch, so labels and log names match), or ``step`` a load into a container that run starts;
+    ``share`` is the machine that runs it (``local``: the processes given no machine).
+    """
+
+    __slots__ = ("share", "spec", "step")
+    _fields = (*Step._fields, "share", "spec", "step")
+
+    def __init__(
+        self,
+        origin: str = "",
+        share: str = "",
+        spec: ProcessSpec | None = None,
+        step: Step | None = None,
+    ) -> None:
+        self.origin = origin
+        self.share = share
+        self.spec = spec
+        self.step = step
+
+    @property
+    def container(self) -> str | None:
+        """The container a load is into (a Handoff's ``target``), None for a process."""
+        target = getattr(self.step, "target", None)
+        return target if isinstance(target, str) else None
+
+    def describe(self) -> str:
+        if self.spec is not None:
+            where = "is given no machine" if self.share == "local" else f"runs on {self.share}"
+            return (
+                f"{self.spec.label} {where}: not started by this run"
+                f" (mlaunch FILE --machine {self.share} starts it)"
+            )
+        return (
+            f"the load into {self.container} is done by the run that starts that container"
+            " (a container the launch does not start: the local share's run)"
+        )
 
 
 class Handoff(Step):

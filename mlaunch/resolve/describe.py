@@ -10,6 +10,7 @@ from mlaunch.launch.events.execution_complete import ExecutionComplete
 from mlaunch.plan.steps import (
     AddHandler,
     ArgumentInfo,
+    Elsewhere,
     EmitEvent,
     Log,
     Plan,
@@ -65,6 +66,8 @@ def describe_plan(plan: Plan, path: str) -> str:
         elif isinstance(step, EmitEvent) and not isinstance(step.event, ExecutionComplete):
             # (an action's completion, emitted for OnExecutionComplete handlers, goes unsaid)
             out.append(f"emit {type(step.event).__name__}")
+        elif isinstance(step, Elsewhere):
+            out.append(f"elsewhere: {step.describe()}   ({rel(step.origin)})")
         elif hasattr(step, "describe_lines"):
             # Steps of extensions (composable node loads) describe themselves.
             out.extend(step.describe_lines())

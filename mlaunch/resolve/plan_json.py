@@ -22,6 +22,7 @@ import signal
 from mlaunch.plan.steps import (
     AddHandler,
     Deferred,
+    Elsewhere,
     EmitEvent,
     Log,
     Plan,
@@ -137,6 +138,7 @@ class _Writer:
             RemoveHandler: _remove_handler,
             RequestShutdown: _shutdown,
             EmitEvent: _emit,
+            Elsewhere: _elsewhere,
         }
 
     def step(self, step: Step) -> dict[str, Any]:
@@ -236,6 +238,16 @@ def _stop(spec: ProcessSpec) -> dict[str, Any]:
             {"signal": signal.SIGTERM.name, "after": term},
             {"signal": signal.SIGKILL.name, "after": term + kill},
         ],
+    }
+
+
+def _elsewhere(step: Elsewhere) -> dict[str, Any]:
+    return {
+        "kind": "elsewhere",
+        "origin": origin_data(step.origin),
+        "share": step.share or None,
+        "label": None if step.spec is None else step.spec.label,
+        "container": step.container,
     }
 
 

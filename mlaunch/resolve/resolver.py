@@ -23,8 +23,11 @@ from mlaunch.plan.errors import (
 )
 from mlaunch.plan.origin import unset_variable_hint, user_location
 from mlaunch.plan.steps import (
+    SHARE,
     ArgumentInfo,
     Deferred,
+    Elsewhere,
+    Handoff,
     Need,
     Plan,
     ProcessSpec,
@@ -77,6 +80,7 @@ class ResolveOptions(Value):
         "dry_run",
         "collect",
         "log_levels",
+        "machine",
     )
     __slots__ = _fields
 
@@ -91,6 +95,7 @@ class ResolveOptions(Value):
         scoped_file_locals: bool = False,
         collect: list[MlaunchError] | None = None,
         log_levels: tuple[str, ...] = (),
+        machine: str | None = None,
     ) -> None:
         self.standins = standins
         self.packages = packages
@@ -109,6 +114,9 @@ class ResolveOptions(Value):
         self.collect = collect
         # --log-level: each item given to every ROS node's command line (--log-level ITEM).
         self.log_levels = log_levels
+        # --machine NAME: start only that machine's share (``local``: the processes given no
+        # machine); the other processes are Elsewhere steps (mlaunch.plan.machine.placed).
+        self.machine = machine
 
 
 class Resolver:
@@ -259,6 +267,8 @@ class Resolver:
     # --- what actions use ---------------------------------------------------------------------
 
     def add(self, step: Step) -> None:
+        if SHARE in self.labels.run_state and isinstance(step, Handoff):
+            step = _share_handoff(self.labels.run_state, step)
         self.plan.steps.append(step)
         needs = step_needs(step)
         if needs:
@@ -269,6 +279,9 @@ class Resolver:
             from mlaunch import standins
 
             standins.equip(spec)
+        if SHARE in self.labels.run_state:  # --machine NAME: one machine's share of the launch
+            self.add(_share_spawn(self.labels.run_state, spec))
+            return
         self.add(Spawn(origin=spec.origin, spec=spec))
 
     def emit(self, event: object, step: Step | None) -> None:
@@ -374,6 +387,51 @@ class Resolver:
         return argv, None
 
 
+# What the share of a run (--machine NAME) notes of each node it meets: here, or elsewhere.
+SHARE_NODES = "share_nodes"
+
+
+def _share_spawn(run_state: dict[str, Any], spec: ProcessSpec) -> Step:
+    """A Spawn when ``spec`` is of this run's share, else an Elsewhere step (not started here).
+
+    A process of the share starts as that machine's agent starts it over ssh: through the
+    machine's env-loader when it has one (a program on that machine that sets the environment
+    and runs its arguments), ``shell=True`` commands under ``/bin/sh -c`` behind it.
+    """
+    from mlaunch.plan.machine import machine_name, runs_elsewhere
+
+    elsewhere = runs_elsewhere(run_state, spec.machine)
+    node = spec.node.fully_qualified_name if spec.node is not None else None
+    if node:
+        run_state.setdefault(SHARE_NODES, {})[node] = not elsewhere
+    if elsewhere:
+        return Elsewhere(spec.origin, machine_name(spec.machine), spec=spec)
+    loader = spec.machine.env_loader if spec.machine is not None else None
+    if loader:
+        if spec.shell:
+            spec.argv = (loader, "/bin/sh", "-c", " ".join(spec.argv))
+            spec.shell = False
+        else:
+            spec.argv = (loader, *spec.argv)
+        spec.launch_prefix = (loader, *spec.launch_prefix)
+    return Spawn(origin=spec.origin, spec=spec)
+
+
+def _share_handoff(run_state: dict[str, Any], step: Handoff) -> Step:
+    """A load into a container (a Handoff with a ``target`` node) is the container's share's:
+    an Elsewhere step in the other shares. A container the launch does not start (loaded into
+    by name) is the local share's, so that one run loads it, not every machine's."""
+    from mlaunch.plan.machine import LOCAL_SHARE, share_of
+
+    target = getattr(step, "target", None)
+    if not isinstance(target, str):
+        return step
+    here = run_state.get(SHARE_NODES, {}).get(target)
+    if here is None:
+        here = share_of(run_state) == LOCAL_SHARE
+    return step if here else Elsewhere(step.origin, "", step=step)
+
+
 def _note_needs(entities: Iterable[Any], needs: set[Need]) -> None:
     """Add what ``entities`` (a timer's or handler's, not yet resolved) and theirs may need.
 
@@ -425,7 +483,10 @@ def resolve(
         warn=plan.warnings.append,
     )
     context.launch_configurations.update(arguments)
-    resolver = Resolver(context, plan, labels=labels or LabelCounter(), options=options)
+    labels = labels or LabelCounter()
+    if options.machine is not None:
+        labels.run_state[SHARE] = options.machine
+    resolver = Resolver(context, plan, labels=labels, options=options)
     with _package_search(options, context):
         if path is None:
             resolver.visit(description)

@@ -20,7 +20,7 @@ from mlaunch.launch.substitution import (
 from mlaunch.launch.substitutions.boolean_substitution import to_bool
 from mlaunch.launch.substitutions.launch_configuration import LaunchConfiguration
 from mlaunch.plan.errors import MlaunchError, SubstitutionFailure
-from mlaunch.plan.steps import OUTPUT_MODES, Deferred, ProcessSpec, RespawnPolicy
+from mlaunch.plan.steps import OUTPUT_MODES, SHARE, Deferred, ProcessSpec, RespawnPolicy
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -216,12 +216,18 @@ class ExecuteProcess(Action):
         ``machine`` is the MachineSpec it runs on (None: no machine given or pushed).
         """
         planner = context.planner
-        remote = machine is not None and not machine.local
+        elsewhere = False
+        if SHARE in context.run_state:  # --machine NAME: this run starts one machine's share
+            from mlaunch.plan.machine import placed
+
+            machine, elsewhere = placed(context.run_state, machine)
+        # Another computer's programs are found there (the ssh agent's lookup, or its share's run)
+        remote = elsewhere or (machine is not None and not machine.local)
         if not argv or not argv[0]:
             raise SubstitutionFailure("the command is empty", where=self.origin)
         named = argv
         located = None
-        if not remote:  # another computer's programs are found there
+        if not remote:
             argv, located = planner.locate_program(argv, shell=self.shell, origin=self.origin)
         prefix = self._prefix(context, named)
         # The label comes from the program the launch file named, not from its stand-in.
@@ -261,6 +267,17 @@ class ExecuteProcess(Action):
                 f"working directory {spec.cwd!r} does not exist", where=self.origin, what=base
             )
         return spec
+
+    def _runs_there(self, context: LaunchContext, machine: Any) -> bool:
+        """Whether this process's program is another computer's, found there: its machine is
+        reached over ssh, or (--machine) it is another machine's share, not started here."""
+        if SHARE in context.run_state:
+            from mlaunch.plan.machine import placed
+
+            machine, elsewhere = placed(context.run_state, machine)
+            if elsewhere:
+                return True
+        return machine is not None and not machine.local
 
     def _machine(self, context: LaunchContext) -> Any:
         """The MachineSpec this process runs on, or None (no machine given or pushed)."""

@@ -305,7 +305,7 @@ class Node(ExecuteProcess):
 
     def build_spec(self, context: LaunchContext) -> ProcessSpec:
         machine = self._machine(context)
-        found = self.node_command(context, remote=machine is not None and not machine.local)
+        found = self.node_command(context, remote=self._runs_there(context, machine))
         info = NodeInfo(
             name=found.names.name,
             namespace=found.names.namespace or "/",
