@@ -222,3 +222,38 @@ def test_a_share_runs_only_its_processes_without_ssh(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stdout + done.stderr
     assert sorted(os.listdir(said)) == ["here", "there", "there2"]
     assert (said / "here").read_text() == "no set"
+
+
+COMPOSED = """
+from launch import LaunchDescription
+from launch_ros.actions import ComposableNodeContainer, LoadComposableNodes
+from launch_ros.descriptions import ComposableNode
+from mlaunch.actions import Machine
+
+def generate_launch_description():
+    return LaunchDescription([
+        Machine(name="gpu", address="gpu-alias"),
+        ComposableNodeContainer(
+            name="box", namespace="", package="rclcpp_components",
+            executable="component_container", machine="gpu",
+            composable_node_descriptions=[
+                ComposableNode(package="demo", plugin="demo::Talker", name="talker")]),
+        LoadComposableNodes(target_container="/elsewhere_box", composable_node_descriptions=[
+            ComposableNode(package="demo", plugin="demo::Listener", name="listener")]),
+    ])
+"""
+
+
+def test_a_load_is_done_by_the_run_that_starts_its_container(tmp_path: Path) -> None:
+    def loads(plan: Plan) -> tuple[list[str], list[str | None]]:
+        here = [str(getattr(s, "target", "")) for s in plan.steps if hasattr(s, "requests")]
+        there = [s.container for s in plan.steps if isinstance(s, Elsewhere) and s.step]
+        return here, there
+
+    gpu = resolve_share(tmp_path, COMPOSED, "gpu")
+    local = resolve_share(tmp_path, COMPOSED, "local")
+    # the container's own share loads into it; a container the launch does not start: local
+    assert loads(gpu) == (["/box"], ["/elsewhere_box"])
+    assert loads(local) == (["/elsewhere_box"], ["/box"])
+    assert [s.label for s in gpu.processes()] == ["component_container-1"]
+    assert local.processes() == []
