@@ -343,18 +343,30 @@ done
 """
 
 
+def robot_package(tmp_path: Path, program_text: str) -> tuple[Path, Path, Path]:
+    """(prefix, program, env-loader): mlaunch_demo/talker installed in an ament prefix that only
+    the env-loader (the robot's environment) names."""
+    prefix = tmp_path / "robot-prefix"
+    program = prefix / "lib" / "mlaunch_demo" / "talker"
+    program.parent.mkdir(parents=True)
+    program.write_text(program_text)
+    program.chmod(0o755)
+    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
+    index.mkdir(parents=True)
+    (index / "mlaunch_demo").write_text("")
+    loader = tmp_path / "env.sh"
+    loader.write_text(
+        f'#!/bin/sh\nexport FROM_LOADER=yes AMENT_PREFIX_PATH="{prefix}"\nexec "$@"\n'
+    )
+    loader.chmod(0o755)
+    return prefix, program, loader
+
+
 def test_a_remote_node_is_found_there_and_gets_its_params_file(
     sshd: Server, tmp_path: Path, token: str
 ) -> None:
     # The package exists only on the "remote" (its env-loader's AMENT_PREFIX_PATH), not here.
-    prefix = tmp_path / "remote-prefix"
-    program = prefix / "lib" / "mlaunch_demo" / "talker"
-    program.parent.mkdir(parents=True)
-    program.write_text(TALKER)
-    program.chmod(0o755)
-    loader = tmp_path / "env.sh"
-    loader.write_text(f'#!/bin/sh\nexport AMENT_PREFIX_PATH="{prefix}"\nexec "$@"\n')
-    loader.chmod(0o755)
+    _, program, loader = robot_package(tmp_path, TALKER)
     path = tmp_path / "node.launch.py"
     path.write_text(
         "from launch import LaunchDescription\n"
@@ -412,19 +424,7 @@ def test_a_machines_share_run_there_gives_its_node_what_ssh_gives_it(
 ) -> None:
     # mlaunch FILE --machine robot, run on the robot, starts the robot's node as the launcher's
     # ssh agent does: the same program, arguments, parameters and environment.
-    prefix = tmp_path / "robot-prefix"
-    program = prefix / "lib" / "mlaunch_demo" / "talker"
-    program.parent.mkdir(parents=True)
-    program.write_text(SAYER)
-    program.chmod(0o755)
-    index = prefix / "share" / "ament_index" / "resource_index" / "packages"
-    index.mkdir(parents=True)
-    (index / "mlaunch_demo").write_text("")  # an installed package, as on the robot
-    loader = tmp_path / "env.sh"
-    loader.write_text(
-        f'#!/bin/sh\nexport FROM_LOADER=yes AMENT_PREFIX_PATH="{prefix}"\nexec "$@"\n'
-    )
-    loader.chmod(0o755)
+    prefix, program, loader = robot_package(tmp_path, SAYER)
     path = tmp_path / "node.launch.py"
     path.write_text(
         "from launch import LaunchDescription\n"
