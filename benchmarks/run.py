@@ -16,6 +16,7 @@ See benchmarks/README.md for what is measured and how.
 from __future__ import annotations
 
 import argparse
+import functools
 import hashlib
 import json
 import os
@@ -43,6 +44,8 @@ sys.path.append(str(REPO / "tests"))  # the ROS-domain lock the tests take (test
 import launchgen as gen  # noqa: E402
 import probes as pr  # noqa: E402
 from probes import BenchError  # noqa: E402
+from reference import HOME as REFERENCE_HOME  # noqa: E402
+from reference import MISSING as REFERENCE_MISSING  # noqa: E402
 from ros_domain import private_domain  # noqa: E402
 
 GROUPS = ("startup", "print", "output", "memory", "sim", "importtime")  # what --only selects
@@ -68,10 +71,16 @@ class Config:
     output_lines: int
     sim_runs: int
     sim_seconds: float
+    # ros2 launch passes ~30k lines/s at best: its output runs print fewer lines a child (the
+    # figure is a rate, so comparable), or one run would take half a minute.
+    reference_output_lines: int
 
 
-QUICK = Config("quick", 2, (1, 10, 100), (10, 100), 100, 1.0, 4, 100_000, 1, 2.0)
-FULL = Config("full", 5, (1, 10, 100, 500), (10, 100, 500), 100, 2.0, 4, 250_000, 2, 5.0)
+QUICK = Config("quick", 2, (1, 10, 100), (10, 100), 100, 1.0, 4, 100_000, 1, 2.0, 5_000)
+FULL = Config("full", 5, (1, 10, 100, 500), (10, 100, 500), 100, 2.0, 4, 250_000, 2, 5.0, 25_000)
+# The start-up sizes (Python files) ros2 launch is measured at beside mlaunch: its 500 children
+# take seconds a run and add nothing the 100 do not show.
+REFERENCE_NS = (1, 100)
 
 
 @dataclass(frozen=True)
@@ -82,6 +91,19 @@ class Venv:
     python: Path
     mlaunch: Path
     about: str
+
+
+@dataclass(frozen=True)
+class Reference:
+    """The reference ros2 launch (Jazzy's launch 3.4.3 and launch_ros 0.26.6, built by
+    scripts/reference): run as a user who sourced its env.sh runs ``ros2 launch FILE``."""
+
+    ros2: Path
+    env: dict[str, str]
+    about: str
+
+    def argv(self, path: Path) -> list[str]:
+        return [str(self.ros2), "launch", str(path)]
 
 
 @dataclass(frozen=True)
@@ -113,6 +135,7 @@ class Row:
     target: Target | None = None
     params: dict[str, Any] = field(default_factory=dict)
     note: str = ""
+    reference_samples: list[float] = field(default_factory=list)  # ros2 launch's, same run
 
     @property
     def median(self) -> float:
@@ -129,20 +152,33 @@ class Row:
 
     @property
     def ratio(self) -> float | None:
-        floor = self.floor_median
-        if floor is None or floor == 0 or self.unit == "lines":
+        return self._ratio(self.floor_median)
+
+    @property
+    def reference_median(self) -> float | None:
+        return statistics.median(self.reference_samples) if self.reference_samples else None
+
+    @property
+    def reference_ratio(self) -> float | None:
+        """mlaunch's median over ros2 launch's (below 1: mlaunch takes less; rates: more)."""
+        return self._ratio(self.reference_median)
+
+    def _ratio(self, other: float | None) -> float | None:
+        if other is None or other == 0 or self.unit == "lines":
             return None
-        return self.median / floor
+        return self.median / other
+
+    def _series(self, name: str, samples: list[float]) -> dict[str, Any] | None:
+        if not samples:
+            return None
+        return {
+            "name": name,
+            "best": best_of(samples, self.unit),
+            "median": statistics.median(samples),
+            "samples": samples,
+        }
 
     def to_json(self) -> dict[str, Any]:
-        floor = None
-        if self.floor_samples:
-            floor = {
-                "name": self.floor_name,
-                "best": best_of(self.floor_samples, self.unit),
-                "median": self.floor_median,
-                "samples": self.floor_samples,
-            }
         target = None
         if self.target is not None:
             target = {
@@ -157,8 +193,10 @@ class Row:
             "unit": self.unit,
             "params": self.params,
             "mlaunch": {"best": self.best, "median": self.median, "samples": self.samples},
-            "floor": floor,
+            "floor": self._series(self.floor_name, self.floor_samples),
             "ratio": self.ratio,
+            "reference": self._series("ros2 launch", self.reference_samples),
+            "reference_ratio": self.reference_ratio,
             "target": target,
             "note": self.note,
         }
@@ -276,6 +314,33 @@ def plain_venv() -> Venv | str:
     return Venv("plain", python, mlaunch, about)
 
 
+def find_reference(env: dict[str, str]) -> Reference | str:
+    """The reference ros2 launch where tests/reference.py finds it, with the environment its
+    env.sh gives on top of ``env``; else why not (printed as a skip, its rows go without it)."""
+    env_sh = REFERENCE_HOME / "env.sh"
+    if not env_sh.exists():
+        return REFERENCE_MISSING
+    # Sourced once here, not per run: each measured start is the ros2 executable itself, as
+    # from a shell where the user sourced env.sh (as /opt/ros/jazzy/setup.bash) beforehand.
+    done = subprocess.run(
+        ["bash", "-c", 'source "$1" >/dev/null && env -0', "bash", str(env_sh)],
+        env=env,
+        capture_output=True,
+        timeout=60,
+    )
+    if done.returncode != 0:
+        return f"sourcing {env_sh} failed: {one_line(done.stderr.decode(errors='replace'))}"
+    sourced = dict(item.split("=", 1) for item in done.stdout.decode().split("\0") if "=" in item)
+    for name in ("_", "SHLVL", "PWD", "OLDPWD"):
+        sourced.pop(name, None)
+        if name in env:
+            sourced[name] = env[name]
+    ros2 = shutil.which("ros2", path=sourced.get("PATH"))
+    if ros2 is None:
+        return f"no ros2 executable on the PATH {env_sh} sets"
+    return Reference(Path(ros2), sourced, f"ros2 launch of {REFERENCE_HOME} (env.sh sourced)")
+
+
 @contextmanager
 def ros_domain(requested: int | None) -> Iterator[int]:
     """A ROS_DOMAIN_ID no test or other benchmark holds (tests/ros_domain.py: the one lock)."""
@@ -292,13 +357,32 @@ def ros_domain(requested: int | None) -> Iterator[int]:
 class Bench:
     """Runs the cases for each venv and collects Rows; every case cleans up after itself."""
 
-    def __init__(self, config: Config, venvs: list[Venv], tmp: Path, results: Results) -> None:
+    def __init__(
+        self,
+        config: Config,
+        venvs: list[Venv],
+        tmp: Path,
+        results: Results,
+        reference: bool = True,
+    ) -> None:
         self.config = config
         self.venvs = venvs
         self.tmp = tmp
         self.results = results
         self.logs = tmp / "logs"
         self.env = measured_env(dict(os.environ), self.logs)
+        # ros2 launch beside mlaunch: measured once, alternating with the first venv's runs,
+        # and shown in every venv's rows (it runs in its own venv either way).
+        self.reference: Reference | None = None
+        if reference:
+            found = find_reference(self.env)
+            if isinstance(found, str):
+                results.skip("all", "ros2 launch", "the ros2 launch column", found)
+            else:
+                self.reference = found
+                results.meta["reference"] = found.about
+        self.reference_runs: dict[str, list[dict[str, float]]] = {}
+        self.reference_failed: set[str] = set()
         self.scripts = gen.write_child_scripts(tmp / "bin")
         self.fifo = tmp / "ready.fifo"
         self.launches = tmp / "launches"
@@ -340,6 +424,40 @@ class Bench:
         assert proc.exited_at is not None
         return proc.exited_at - proc.started
 
+    def reference_turn(
+        self, group: str, key: str, i: int, measure: Callable[[Reference], dict[str, float]]
+    ) -> None:
+        """ros2 launch's run ``i`` of ``key``, right after mlaunch's (until it has them all).
+
+        A failure skips that figure's ros2 launch column (said once), never mlaunch's row.
+        """
+        if self.reference is None or key in self.reference_failed:
+            return
+        got = self.reference_runs.setdefault(key, [])
+        if len(got) >= self.config.runs:
+            return
+        try:
+            one = measure(self.reference)
+        except BenchError as e:
+            self.reference_failed.add(key)
+            del self.reference_runs[key]
+            self.results.skip(group, "ros2 launch", key, str(e))
+            return
+        if i:
+            got.append(one)
+
+    def reference_samples(self, key: str) -> list[dict[str, float]]:
+        return self.reference_runs.get(key, [])
+
+    def wait_output(self, line: bytes, n: int, proc: pr.Launched, deadline: float) -> None:
+        """Until ``line`` is in the launcher's output ``n`` times (after the figures are taken)."""
+        while self.out_file.read_bytes().count(line) < n:
+            if proc.poll_exit():
+                raise BenchError(f"exit {proc.returncode}: {self.output_tail()}")
+            if time.perf_counter() > deadline:
+                raise BenchError(f"{line.decode()!r} not {n} times in the output in time")
+            time.sleep(0.002)
+
     def output_tail(self) -> str:
         try:
             return one_line(self.out_file.read_text(errors="replace"))
@@ -363,8 +481,17 @@ class Bench:
         n: int,
         idle: float = 0.0,
         env: dict[str, str] | None = None,
+        sigint_exit: int = 128 + signal.SIGINT,
+        noted: bytes | None = None,
+        stop_timeout: float = 20.0,
     ) -> dict[str, float]:
-        """Start a launcher of N ready-children; time first/all running, idle CPU, RSS, stop."""
+        """Start a launcher of N ready-children; time first/all running, idle CPU, RSS, stop.
+
+        ``sigint_exit`` is the launcher's exit status after SIGINT (ros2 launch exits 0).
+        ``noted``: before the idle window and the SIGINT, wait until the launcher's output holds
+        this line N times (ros2 launch: a SIGINT before it has noted a start never reaches that
+        child, and it waits for it forever).
+        """
         probe = pr.ReadyProbe(self.fifo).open()
         with open(self.out_file, "wb") as out:
             proc = pr.launch(
@@ -376,14 +503,16 @@ class Bench:
         try:
             first, last = probe.wait_ready(n, proc, time.perf_counter() + 30 + n / 10)
             result = {"first": first - proc.started, "all": last - proc.started}
+            if noted is not None:
+                self.wait_output(noted, n, proc, time.perf_counter() + 30 + n / 10)
             if idle > 0:
                 c0, t0 = pr.fine_cpu_seconds(proc.pid), time.perf_counter()
                 time.sleep(idle)  # the measurement window itself, not a synchronisation
                 c1, t1 = pr.fine_cpu_seconds(proc.pid), time.perf_counter()
                 result["idle_cpu"] = (c1 - c0) / (t1 - t0)
             result["hwm"] = pr.vm_hwm_mb(proc.pid)
-            result["shutdown"] = pr.stop_and_time(proc, probe, signal.SIGINT, 20.0)
-            if proc.returncode != 128 + signal.SIGINT:
+            result["shutdown"] = pr.stop_and_time(proc, probe, signal.SIGINT, stop_timeout)
+            if proc.returncode != sigint_exit:
                 raise BenchError(f"exit {proc.returncode} after SIGINT: {self.output_tail()}")
             return result
         except BenchError as e:
@@ -419,13 +548,36 @@ class Bench:
                         one = self.children_run([str(venv.mlaunch), str(path)], n, idle)
                         if i:
                             samples.append(one)
+                        if fmt == "py" and n in REFERENCE_NS:
+                            measure = functools.partial(self._reference_children, path, n, idle)
+                            self.reference_turn("startup", f"py N={n}", i, measure)
                 except BenchError as e:
                     self.results.skip("startup", venv.name, f"{fmt} N={n}", str(e))
                     if n == self.config.startup_ns[0]:
                         break  # the frontend cannot run this format at all
                     continue
-                self._startup_rows(venv, fmt, n, samples, floors.get(n, []))
+                refs = self.reference_samples(f"py N={n}") if fmt == "py" else []
+                self._startup_rows(venv, fmt, n, samples, floors.get(n, []), refs)
         self.node_startup(venv, floors.get(1, []))
+
+    def _reference_children(
+        self, path: Path, n: int, idle: float, ref: Reference, prefix: Path | None = None
+    ) -> dict[str, float]:
+        env = ref.env
+        if prefix is not None:
+            paths = [str(prefix), *ref.env.get("AMENT_PREFIX_PATH", "").split(os.pathsep)]
+            env = {**env, "AMENT_PREFIX_PATH": os.pathsep.join(p for p in paths if p)}
+        # Unbuffered, so that its "process started" lines can be waited for (not timed).
+        env = {**env, "PYTHONUNBUFFERED": "1"}
+        return self.children_run(
+            ref.argv(path),
+            n,
+            idle,
+            env=env,
+            sigint_exit=0,
+            noted=b"process started with pid [",
+            stop_timeout=30 + n,  # it ends its children one at a time: ~0.1 s each under load
+        )
 
     def node_startup(self, venv: Venv, floors: list[dict[str, float]]) -> None:
         """First child of a one-Node launch (an installed package, launch_ros's command line)."""
@@ -437,6 +589,8 @@ class Bench:
                 one = self.children_run([str(venv.mlaunch), str(path)], 1, env=env)
                 if i:
                     samples.append(one["first"])
+                measure = functools.partial(self._reference_children, path, 1, 0.0, prefix=prefix)
+                self.reference_turn("startup", "py one Node", i, measure)
         except BenchError as e:
             self.results.skip("startup", venv.name, "py one Node", str(e))
             return
@@ -451,6 +605,7 @@ class Bench:
                 [f["first"] for f in floors],
                 Target(0.06),
                 {"format": "py", "n": 1, "node": True},
+                reference_samples=[r["first"] for r in self.reference_samples("py one Node")],
             )
         )
 
@@ -461,11 +616,16 @@ class Bench:
         n: int,
         samples: list[dict[str, float]],
         floors: list[dict[str, float]],
+        refs: list[dict[str, float]],
     ) -> None:
         def pick(runs: list[dict[str, float]], key: str) -> list[float]:
             return [r[key] for r in runs]
 
-        add = self.results.rows.append
+        def add(row: Row, key: str) -> None:
+            """The row, with ros2 launch's figure of the same ``key`` where it was measured."""
+            row.reference_samples = [r[key] for r in refs if key in r]
+            self.results.rows.append(row)
+
         loop = "bare Popen loop"
         params = {"format": fmt, "n": n}
         first_target = Target(0.06) if (fmt, n) == ("py", 1) else None
@@ -480,7 +640,8 @@ class Bench:
                 pick(floors, "first"),
                 first_target,
                 params,
-            )
+            ),
+            "first",
         )
         if n > 1:
             targets = {100: Target(0.15), 500: Target(0.6)}
@@ -495,7 +656,8 @@ class Bench:
                     pick(floors, "all"),
                     targets.get(n),
                     params,
-                )
+                ),
+                "all",
             )
         if fmt != "py":
             return
@@ -511,7 +673,8 @@ class Bench:
                     pick(floors, "shutdown"),
                     Target(0.15) if n == 100 else None,
                     params,
-                )
+                ),
+                "shutdown",
             )
         if n == self.config.memory_n or n == max(self.config.startup_ns):
             add(
@@ -525,7 +688,8 @@ class Bench:
                     pick(floors, "hwm"),
                     Target(30.0) if n == self.config.memory_n else None,
                     params,
-                )
+                ),
+                "hwm",
             )
         if "idle_cpu" in samples[0]:
             add(
@@ -539,7 +703,8 @@ class Bench:
                     pick(floors, "idle_cpu"),
                     None,
                     {**params, "window_s": self.config.idle_seconds},
-                )
+                ),
+                "idle_cpu",
             )
 
     # --- --show-args / --print ----------------------------------------------------------------
@@ -586,12 +751,19 @@ class Bench:
 
     def output(self, venv: Venv, floors: dict[str, list[dict[str, float]]]) -> None:
         n, m = self.config.output_procs, self.config.output_lines
+        m_ref = self.config.reference_output_lines
         emitter = [str(self.scripts.emit), str(m)]
         for mode in ("screen", "log"):
             stem = f"emit_{mode}"
             path = gen.write(
                 [gen.many_children(stem, n, emitter, output=mode)], "py", self.launches / stem
             )
+            ref_path = gen.write(
+                [gen.many_children(stem, n, [str(self.scripts.emit), str(m_ref)], output=mode)],
+                "py",
+                self.launches / f"{stem}_ref",
+            )
+            measure = functools.partial(self._reference_output, ref_path, mode, n * m_ref)
             samples: list[dict[str, float]] = []
             try:
                 for i in self.runs():
@@ -600,10 +772,17 @@ class Bench:
                     one = self.output_run([str(venv.mlaunch), str(path)], mode, n * m)
                     if i:
                         samples.append(one)
+                    self.reference_turn("output", f"output={mode}", i, measure)
             except BenchError as e:
                 self.results.skip("output", venv.name, f"{n} x {m} lines, output={mode}", str(e))
                 continue
-            self._output_rows(venv, mode, n, m, samples, floors[mode])
+            refs = self.reference_samples(f"output={mode}")
+            self._output_rows(venv, mode, n, m, samples, floors[mode], refs)
+
+    def _reference_output(
+        self, path: Path, mode: str, expected: int, ref: Reference
+    ) -> dict[str, float]:
+        return self.output_run(ref.argv(path), mode, expected, ref.env)
 
     def _output_rows(
         self,
@@ -613,9 +792,12 @@ class Bench:
         m: int,
         samples: list[dict[str, float]],
         floors: list[dict[str, float]],
+        refs: list[dict[str, float]],
     ) -> None:
         where = "its stdout (a pipe)" if mode == "screen" else "the log files"
         params = {"processes": n, "lines_each": m, "output": mode}
+        if refs:
+            params["reference_lines_each"] = self.config.reference_output_lines
         floor_name = "cat" if mode == "screen" else "cat > file"
         self.results.rows.append(
             Row(
@@ -628,6 +810,7 @@ class Bench:
                 [f["rate"] for f in floors],
                 Target(200_000, higher_is_better=True) if mode == "screen" else None,
                 params,
+                reference_samples=[r["rate"] for r in refs],
             )
         )
         self.results.rows.append(
@@ -641,6 +824,7 @@ class Bench:
                 [f["cpu_share"] for f in floors],
                 Target(1.0) if mode == "screen" else None,
                 {**params, "cpu_seconds": [s["cpu"] for s in samples]},
+                reference_samples=[r["cpu_share"] for r in refs],
             )
         )
         if mode == "screen":
@@ -658,10 +842,21 @@ class Bench:
                 )
             )
 
-    def output_run(self, argv: Sequence[str], mode: str, expected: int) -> dict[str, float]:
-        """mlaunch passing N children's lines: rate to its stdout pipe or to the log files."""
+    def output_run(
+        self,
+        argv: Sequence[str],
+        mode: str,
+        expected: int,
+        reference_env: dict[str, str] | None = None,
+    ) -> dict[str, float]:
+        """mlaunch passing N children's lines: rate to its stdout pipe or to the log files.
+
+        With ``reference_env``, ros2 launch: its output=screen lines go to stdout only, its
+        output=log lines into launch.log (mlaunch: each process's own log file, always).
+        """
         log_dir = self.logs / f"out-{time.monotonic_ns()}"
-        env = {**self.env, "ROS_LOG_DIR": str(log_dir)}
+        base = self.env if reference_env is None else reference_env
+        env = {**base, "ROS_LOG_DIR": str(log_dir)}
         started = time.perf_counter()
         popen = subprocess.Popen(
             list(argv),
@@ -682,8 +877,9 @@ class Bench:
             code = proc.reap(deadline)
             if code != 0:
                 raise BenchError(f"mlaunch exited {code}: {one_line(counter.text())}")
-            logged = count_token_in_logs(log_dir, gen.EMIT_TOKEN)
-            if logged != expected:
+            reference = reference_env is not None
+            logged = count_token_in_logs(log_dir, gen.EMIT_TOKEN, with_launch_log=reference)
+            if logged != (0 if reference and mode == "screen" else expected):
                 raise BenchError(f"{logged} of {expected} lines in the log files")
             if mode == "screen":
                 # By design mlaunch drops screen lines a reader cannot take (never the log
@@ -1041,11 +1237,12 @@ def count_token_in_file(path: Path, token: bytes) -> int:
     return count + carry.count(token)
 
 
-def count_token_in_logs(log_base: Path, token: bytes) -> int:
-    """Benchmark lines in every process's own log file of the one run below ``log_base``."""
+def count_token_in_logs(log_base: Path, token: bytes, with_launch_log: bool = False) -> int:
+    """Benchmark lines in every process's own log file of the one run below ``log_base``
+    (and in launch.log, where ros2 launch writes output=log lines)."""
     total = 0
     for path in log_base.rglob("*.log"):
-        if path.name != "launch.log":
+        if with_launch_log or path.name != "launch.log":
             total += count_token_in_file(path, token)
     return total
 
@@ -1105,6 +1302,8 @@ def format_table(results: Results) -> str:
         "floor",
         "floor med",
         "ratio",
+        "ros2 launch",
+        "vs ros2",
         "target",
         "",
     )
@@ -1128,6 +1327,8 @@ def format_table(results: Results) -> str:
                 floor,
                 fmt_value(r.floor_median, r.unit),
                 ratio,
+                fmt_value(r.reference_median, r.unit),
+                "-" if r.reference_ratio is None else f"{r.reference_ratio:.2f}",
                 target,
                 status,
             )
@@ -1142,7 +1343,8 @@ def format_table(results: Results) -> str:
         f"mlaunch benchmarks, {meta.get('mode')} mode, {meta.get('config', {}).get('runs')} runs"
         f" after a warm-up, {meta.get('cpus')} CPUs, load average before/after:"
         f" {_load(meta.get('loadavg_before'))} / {_load(meta.get('loadavg_after'))}",
-        "best = min (max for rates); ratio = median / floor median; PASS/MISS on the median",
+        "best = min (max for rates); ratio = median / floor median; ros2 launch = its median in"
+        " the same run, vs ros2 = median / that; PASS/MISS on the median",
         "",
         "  ".join(h.ljust(w) for h, w in zip(head, widths, strict=True)).rstrip(),
         rule,
@@ -1171,6 +1373,89 @@ def format_table(results: Results) -> str:
     return "\n".join(text) + "\n"
 
 
+# --- the README's figures -----------------------------------------------------------------
+
+README = REPO / "README.md"
+README_BEGIN = "<!-- benchmarks/run.py --readme: begin -->"
+README_END = "<!-- benchmarks/run.py --readme: end -->"
+# (what the README calls it, the row's group and name in the results); ros venv first.
+README_ROWS = (
+    ("first child running, one-process launch", "startup", "first child running, py, N=1"),
+    ("first child running, one-Node launch", "startup", "first child running, py, one Node"),
+    ("all 100 children running", "startup", "all 100 children running, py"),
+    ("100 children gone after Ctrl-C", "shutdown", "SIGINT until all gone, N=100"),
+    ("peak memory with 100 children", "memory", "peak RSS (VmHWM), 100 children"),
+    ("lines/s from 4 children to a pipe", "output", "lines to its stdout (a pipe)"),
+)
+
+
+def readme_table(data: dict[str, Any]) -> str:
+    """The README's short figures table, from a results JSON (medians; ros venv preferred)."""
+    rows = data.get("rows", [])
+    venvs = [v for v in ("ros", "plain") if any(r["venv"] == v for r in rows)]
+    if not venvs:
+        raise BenchError("the results hold no rows of the ros or plain venv")
+    venv = venvs[0]
+    meta = data.get("meta", {})
+    out = [
+        "| figure | mlaunch | floor | ros2 launch | ratio to floor / to ros2 launch | target |",
+        "|---|---|---|---|---|---|",
+    ]
+    missing = []
+    for label, group, name in README_ROWS:
+        row = next(
+            (
+                r
+                for r in rows
+                if r["venv"] == venv and r["group"] == group and r["name"].endswith(name)
+            ),
+            None,
+        )
+        if row is None:
+            missing.append(label)
+            continue
+        unit = row["unit"]
+        floor, ref = row.get("floor"), row.get("reference")
+        cells = [
+            label,
+            fmt_value(row["mlaunch"]["median"], unit),
+            f"{fmt_value(floor['median'], unit)} ({floor['name']})" if floor else "-",
+            fmt_value(ref["median"], unit) if ref else "-",
+            " / ".join(
+                "-" if x is None else f"{x:.2f}x"
+                for x in (row["ratio"], row.get("reference_ratio"))
+            ),
+            ""
+            if row["target"] is None
+            else f"{'≥' if row['target']['op'] == '>=' else '≤'} "
+            f"{fmt_value(row['target']['limit'], unit)}",
+        ]
+        out.append("| " + " | ".join(cells) + " |")
+    if missing:
+        raise BenchError(f"the results lack the rows of: {', '.join(missing)}")
+    load = meta.get("loadavg_before"), meta.get("loadavg_after")
+    out += [
+        "",
+        f"Medians of {meta.get('config', {}).get('runs')} runs each, {meta.get('mode')} mode,"
+        f" {venv} venv, commit {meta.get('git') or '?'}, {str(meta.get('when', '?'))[:10]},"
+        f" {meta.get('cpus')} CPUs, load average {_load(load[0])} before, {_load(load[1])}"
+        " after; floor and ros2 launch measured in the same run, alternating with mlaunch."
+        " Regenerate: `benchmarks/run.py --json FILE`, then `benchmarks/run.py --readme FILE`.",
+    ]
+    return "\n".join(out) + "\n"
+
+
+def render_readme(results_json: Path, readme: Path = README) -> None:
+    """Replace the text between the README's markers with the table of ``results_json``."""
+    table = readme_table(json.loads(results_json.read_text()))
+    text = readme.read_text()
+    begin, end = text.find(README_BEGIN), text.find(README_END)
+    if begin < 0 or end < begin:
+        raise BenchError(f"{readme}: no {README_BEGIN!r} ... {README_END!r} markers, in that order")
+    head = text[: begin + len(README_BEGIN)]
+    readme.write_text(head + "\n" + table + text[end:])
+
+
 # --- main -----------------------------------------------------------------------------------
 
 
@@ -1187,6 +1472,16 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--runs", type=int, help="measured runs per figure (after a warm-up)")
     parser.add_argument("--ros-domain", type=int, help="ROS_DOMAIN_ID for the simulation")
     parser.add_argument("--keep-temp", action="store_true", help="keep the generated files")
+    parser.add_argument(
+        "--readme",
+        metavar="RESULTS_JSON",
+        help="measure nothing: write the README's figures table from this results JSON",
+    )
+    parser.add_argument(
+        "--no-reference",
+        action="store_true",
+        help="leave out the ros2 launch column (measured where tests/reference.py finds it)",
+    )
     args = parser.parse_args(list(argv))
     if args.only:
         unknown = set(args.only.split(",")) - set(GROUPS)
@@ -1233,7 +1528,7 @@ def run(args: argparse.Namespace) -> Results:
     venvs = choose_venvs(args.venv, results)
     results.meta["venvs"] = {v.name: v.about for v in venvs}
     tmp = Path(tempfile.mkdtemp(prefix="mlaunch-bench-"))
-    bench = Bench(config, venvs, tmp, results)
+    bench = Bench(config, venvs, tmp, results, reference=not args.no_reference)
     output_floors: dict[str, list[dict[str, float]]] = {}
     try:
         for venv in venvs:
@@ -1269,6 +1564,14 @@ def git_describe() -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = parse_args(sys.argv[1:] if argv is None else argv)
+    if args.readme:
+        try:
+            render_readme(Path(args.readme))
+        except (OSError, ValueError, KeyError, BenchError) as e:
+            print(f"benchmarks/run.py --readme: {e}", file=sys.stderr)
+            return 1
+        print(f"README.md: figures table written from {args.readme}")
+        return 0
     if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
         # Started in the background by a shell: children would inherit SIGINT ignored, and
         # the shutdown benchmark relies on the default action in the floor's children.

@@ -25,6 +25,7 @@ BENCH = REPO / "benchmarks"
 sys.path.insert(0, str(BENCH))
 
 import launchgen as gen  # noqa: E402
+import reference  # noqa: E402
 import run as bench  # noqa: E402
 
 UNITS = {"s", "lines/s", "cores", "MB", "x", "lines"}
@@ -102,6 +103,140 @@ def test_table_shows_targets_and_ratios() -> None:
     assert "[sim] ros: simulation: the reason" in text
 
 
+def test_table_shows_ros2_launch_beside_mlaunch() -> None:
+    results = bench.Results(meta={"mode": "quick", "config": {"runs": 2}, "cpus": 2})
+    row = bench.Row("startup", "demo", "ros", "s", [0.1, 0.1], "floor", [0.05, 0.05])
+    row.reference_samples = [0.4, 0.3, 0.5]
+    results.rows.append(row)
+    line = next(line for line in bench.format_table(results).splitlines() if "demo" in line)
+    assert "400.0 ms" in line and "0.25" in line and "2.00" in line
+    data = row.to_json()
+    assert data["reference"]["median"] == 0.4 and data["reference"]["best"] == 0.3
+    assert data["reference_ratio"] == pytest.approx(0.25)
+
+
+def _results_json(with_reference: bool) -> dict[str, Any]:
+    """A results JSON holding every row the README's table takes, as a run writes it."""
+    results = bench.Results(
+        meta={
+            "mode": "full",
+            "config": {"runs": 5},
+            "cpus": 2,
+            "git": "abc1234",
+            "when": "2026-11-29T08:00:00+0000",
+            "loadavg_before": [0.5, 0, 0],
+            "loadavg_after": [0.7, 0, 0],
+        }
+    )
+    for i, (_, group, name) in enumerate(bench.README_ROWS):
+        unit = "lines/s" if group == "output" else "MB" if group == "memory" else "s"
+        row = bench.Row(
+            group,
+            f"4 x 1 {name}" if unit == "lines/s" else name,
+            "ros",
+            unit,
+            [0.02 * (i + 1)],
+            "floor",
+            [0.01 * (i + 1)],
+            bench.Target(0.05),
+        )
+        if with_reference:
+            row.reference_samples = [0.08 * (i + 1)]
+        results.rows.append(row)
+    # A plain-venv row of the same name is not the one shown.
+    results.rows.append(bench.Row("startup", bench.README_ROWS[0][2], "plain", "s", [9.0]))
+    return results.to_json()
+
+
+def test_readme_table_is_written_between_the_markers(tmp_path: Path) -> None:
+    readme = tmp_path / "README.md"
+    readme.write_text(
+        f"# x\n\nbefore\n{bench.README_BEGIN}\nold table\n{bench.README_END}\nafter\n"
+    )
+    results = tmp_path / "results.json"
+    results.write_text(json.dumps(_results_json(with_reference=True)))
+    bench.render_readme(results, readme)
+    text = readme.read_text()
+    assert "old table" not in text and text.startswith("# x\n\nbefore\n")
+    assert text.endswith(f"{bench.README_END}\nafter\n")
+    table = [line for line in text.splitlines() if line.startswith("| ")]
+    assert table[0].startswith("| figure | mlaunch | floor | ros2 launch |")
+    assert len(table) == 1 + len(bench.README_ROWS)
+    first = table[1]
+    assert first.startswith(f"| {bench.README_ROWS[0][0]} | 20.0 ms | 10.0 ms (floor) | 80.0 ms |")
+    assert "| 2.00x / 0.25x | ≤ 50.0 ms |" in first
+    assert "commit abc1234" in text and "load average 0.50 before, 0.70 after" in text
+    bench.render_readme(results, readme)  # again: the same text, nothing doubled
+    assert readme.read_text() == text
+
+
+def test_readme_table_without_ros2_launch_or_rows_or_markers(tmp_path: Path) -> None:
+    table = bench.readme_table(_results_json(with_reference=False))
+    assert "| 20.0 ms | 10.0 ms (floor) | - | 2.00x / - |" in table
+    data = _results_json(with_reference=True)
+    data["rows"] = [r for r in data["rows"] if r["group"] != "shutdown"]
+    with pytest.raises(bench.BenchError, match="lack the rows of: 100 children gone"):
+        bench.readme_table(data)
+    readme = tmp_path / "README.md"
+    readme.write_text("no markers\n")
+    results = tmp_path / "results.json"
+    results.write_text(json.dumps(_results_json(with_reference=True)))
+    with pytest.raises(bench.BenchError, match="markers"):
+        bench.render_readme(results, readme)
+    assert readme.read_text() == "no markers\n"
+
+
+def test_the_project_readme_has_the_markers() -> None:
+    text = (REPO / "README.md").read_text()
+    assert text.count(bench.README_BEGIN) == 1 and text.count(bench.README_END) == 1
+    assert text.index(bench.README_BEGIN) < text.index(bench.README_END)
+
+
+REFERENCE_PROBE = """
+import json, sys
+sys.path.insert(0, sys.argv[1])
+import launchgen as gen, run as bench
+from pathlib import Path
+tmp = Path(sys.argv[2])
+config = bench.Config(**{**bench.asdict(bench.QUICK), "runs": 1, "reference_output_lines": 200})
+results = bench.Results()
+harness = bench.Bench(config, [], tmp, results)
+bench.pr.become_subreaper()
+try:
+    path = gen.write(
+        [gen.many_children("one", 2, [str(harness.scripts.ready), str(harness.fifo)])],
+        "py",
+        tmp / "one",
+    )
+    for i in range(2):
+        measure = bench.functools.partial(harness._reference_children, path, 2, 0.0)
+        harness.reference_turn("startup", "py N=2", i, measure)
+    emit = [str(harness.scripts.emit), "200"]
+    out = gen.write([gen.many_children("emit", 2, emit, output="log")], "py", tmp / "emit")
+    measure = bench.functools.partial(harness._reference_output, out, "log", 400)
+    harness.reference_turn("output", "output=log", 1, measure)
+finally:
+    bench.pr.kill_descendants()
+found = harness.reference is not None
+print(json.dumps({"found": found, "runs": harness.reference_runs, "skips": results.to_json()["skipped"]}))
+"""
+
+
+@pytest.mark.skipif(not reference.ENV_SH.exists(), reason=reference.MISSING)
+def test_ros2_launch_is_measured_as_mlaunch_is(tmp_path: Path) -> None:
+    """The ros2 launch column: one start-up with its shutdown, one output run (few lines), in
+    a process of its own (the harness becomes the subreaper of what it starts)."""
+    argv = [sys.executable, "-c", REFERENCE_PROBE, str(BENCH), str(tmp_path)]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr[-2000:]
+    data = json.loads(done.stdout.splitlines()[-1])
+    assert data["found"] and not data["skips"], data
+    (one,) = data["runs"]["py N=2"]
+    assert 0 < one["first"] <= one["all"] and one["shutdown"] > 0 and one["hwm"] > 0
+    (rate,) = data["runs"]["output=log"]
+    assert rate["rate"] > 0 and rate["cpu"] > 0
+
+
 def _check_row(row: dict[str, Any], config: dict[str, Any]) -> None:
     where = f"{row['group']}: {row['name']}"
     assert row["unit"] in UNITS, where
@@ -114,6 +249,13 @@ def _check_row(row: dict[str, Any], config: dict[str, Any]) -> None:
         assert floor["samples"] and floor["name"], where
         if row["ratio"] is not None:
             assert row["ratio"] == pytest.approx(row["mlaunch"]["median"] / floor["median"])
+    ref = row["reference"]
+    if ref is not None:
+        assert ref["samples"] and ref["name"] == "ros2 launch", where
+        ratio = row["reference_ratio"]
+        assert ratio == pytest.approx(row["mlaunch"]["median"] / ref["median"]), where
+    else:
+        assert row["reference_ratio"] is None, where
     target = row["target"]
     if target is not None:
         median, limit = row["mlaunch"]["median"], target["limit"]
@@ -152,7 +294,10 @@ def test_quick_run(tmp_path: Path, ros_env: dict[str, str]) -> None:
     """One quick run in the project venv (the plain venv takes a minute to create once)."""
     out = tmp_path / "bench.json"
     domain = ros_env["ROS_DOMAIN_ID"]
-    argv = [sys.executable, str(BENCH / "run.py"), "--quick", "--venv", "ros", "--json", str(out)]
+    # Without the ros2 launch column (its runs take longer than mlaunch's whole quick run; the
+    # test above measures it): --no-reference.
+    argv = [sys.executable, str(BENCH / "run.py"), "--quick", "--venv", "ros", "--no-reference"]
+    argv += ["--json", str(out)]
     done = subprocess.run(
         [*argv, "--ros-domain", domain], env=ros_env, capture_output=True, text=True, timeout=150
     )
