@@ -392,7 +392,7 @@ def test_the_page_shows_the_readiness_checks_as_ctl_wait_ready_has_them(
 
 
 def test_the_log_ring_numbers_every_line_and_says_what_it_dropped() -> None:
-    from mlaunch.parts.dashboard import RING, Hub
+    from mlaunch.parts.dashboard_hub import RING, Hub
 
     hub = Hub()
     hub.add_output("a", b"".join(b"line %d\n" % i for i in range(10)))

@@ -179,11 +179,33 @@ def test_the_engine_knows_no_stand_in():
     assert named == []
 
 
-def test_the_engine_s_modules_import_each_other_one_way():
+def test_the_run_s_modules_import_each_other_one_way():
     """The launch file's handlers see the run through a protocol (``HandledRun``), the sayings
-    their printer through one (``Saying``): no module of the engine imports back (issue 31)."""
-    cycles = [c for c in layering.module_cycles(ROOT) if layering.package_of(c[0]) == "engine"]
+    their printer through one (``Saying``), runtime control the LoadNode driver and lifecycle
+    driving through theirs, the launch panel's HTTP side the panel through one (``Panel``);
+    what two modules share has a module of its own (``parts.usage.Sample``,
+    ``parts.dashboard_hub``, ``parts.ros1_environ``): no module of the engine, the parts, the
+    smoke checks or the applications' pipeline imports back (issue 31)."""
+    cycles = [
+        c
+        for c in layering.module_cycles(ROOT)
+        if layering.package_of(c[0]) in ("engine", "parts", "smoke", "app")
+    ]
     assert cycles == []
+
+
+def test_no_part_names_the_supervisor():
+    """Each part sees the run through a protocol of what it uses (``engine.part.AttachedRun``,
+    extended by the part's own: ``ControlledRun``, ``LoadingRun`` ...), so it can be read and
+    tested without the whole Supervisor; only the applications, which make the run, name it."""
+    edges = [
+        str(edge)
+        for edge in layering.imports(ROOT)
+        if layering.package_of(edge.source) in ("parts", "smoke", "engine")
+        and edge.target == "mlaunch.engine.supervisor"
+        and edge.source != "mlaunch.engine.supervisor"
+    ]
+    assert edges == []
 
 
 def test_resolve_edits_no_private_field_of_the_launch_context():

@@ -349,7 +349,7 @@ def dashboard_part(run: Run) -> Dashboard:
 
     def composable() -> list[dict[str, object]]:
         driver = run.components
-        return [] if driver is None else driver.loader.listed()
+        return [] if driver is None else driver.listed()
 
     panel: list[Dashboard] = []
 

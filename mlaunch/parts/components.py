@@ -41,9 +41,22 @@ from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Protocol
 
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.part import AttachedRun, EndingRun
+    from mlaunch.plan.steps import Plan
+
+    class LoadingRun(AttachedRun, EndingRun, Protocol):
+        """What the LoadNode driver uses of the run (the Supervisor is one): the plan (its
+        processes' environment), and work that keeps an idle run alive (a pending load)."""
+
+        @property
+        def plan(self) -> Plan: ...
+
+        def busy(self, work: object) -> None: ...
+
+        def done(self, work: object) -> None: ...
+
 
 # (level, message): where the driver's lines go (the run's printer, a test's list).
 Log = Callable[[str, str], None]
@@ -447,7 +460,7 @@ class ComponentDriver(Part):
     loop thread (the printer is not shared across threads).
     """
 
-    def __init__(self, supervisor: Supervisor) -> None:
+    def __init__(self, supervisor: LoadingRun) -> None:
         import os
 
         from mlaunch.parts.graph_types import domain_id_from
@@ -537,6 +550,10 @@ class ComponentDriver(Part):
         self.loop.call_soon(lambda: self.supervisor.records.emit(event))
 
     # --- runtime control (mlaunch.parts.control, loop thread) ----------------------------------
+
+    def listed(self) -> list[dict[str, object]]:
+        """Every composable node of the run and its state (any thread)."""
+        return self.loader.listed()
 
     def unload(self, name: str, done: Callable[[dict[str, object]], None]) -> None:
         """Unload the composable node ``name``; ``done(its state)`` on the loop thread."""

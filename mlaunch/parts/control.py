@@ -55,11 +55,60 @@ from mlaunch.plan.records import Controlled, Exited, FailedToStart, NotStarted, 
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+    from typing import Any, Protocol, TypeVar
+
     from mlaunch.engine.output import Printer
-    from mlaunch.engine.supervisor import Supervisor
-    from mlaunch.parts.components import ComponentDriver
-    from mlaunch.parts.lifecycle import LifecycleManager
+    from mlaunch.engine.part import AttachedRun
     from mlaunch.plan.records import ProcessView
+
+    class ControlledRun(AttachedRun, Protocol):
+        """What runtime control uses of the run (the Supervisor is one): what it knows of each
+        label and its processes, whether it is shutting down, a stop, a start again, a
+        pending respawn cancelled."""
+
+        @property
+        def process_states(self) -> Mapping[str, ProcessState]: ...
+
+        @property
+        def processes(self) -> list[Process]: ...
+
+        @property
+        def shutting_down(self) -> bool: ...
+
+        def stop(self, process: Process) -> None: ...
+
+        def start_again(self, old: Process) -> object: ...
+
+        def cancel_respawn(self, label: str, outcome: str) -> None: ...
+
+    class ComponentLoads(Protocol):
+        """What runtime control uses of the LoadNode driver (mlaunch.parts.components)."""
+
+        def listed(self) -> list[dict[str, object]]: ...
+
+        def unload(self, name: str, done: ComponentDone) -> None: ...
+
+        def load(self, name: str, done: ComponentDone) -> None: ...
+
+    class LifecycleNode(Protocol):
+        @property
+        def fqn(self) -> str: ...
+
+        @property
+        def process(self) -> object: ...
+
+    Node = TypeVar("Node", bound=LifecycleNode)
+
+    class LifecycleRequests(Protocol[Node]):
+        """What runtime control uses of lifecycle driving (mlaunch.parts.lifecycle)."""
+
+        def listed(self) -> list[dict[str, object]]: ...
+
+        def find(self, name: str) -> Node | None: ...
+
+        def request(self, managed: Node, label: str, done: ComponentDone) -> None: ...
+
 
 # What a control request can ask, in the order ``mlaunch ctl --help`` lists them.
 OPERATIONS = (
@@ -182,10 +231,10 @@ class Control(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: ControlledRun,
         printer: Printer,
-        components: Callable[[], ComponentDriver | None] = lambda: None,
-        lifecycle: Callable[[], LifecycleManager | None] = lambda: None,
+        components: Callable[[], ComponentLoads | None] = lambda: None,
+        lifecycle: Callable[[], LifecycleRequests[Any] | None] = lambda: None,
     ) -> None:
         self.supervisor = supervisor
         self.printer = printer
@@ -330,7 +379,7 @@ class Control(Part):
     def composable_nodes(self) -> list[dict[str, object]]:
         """Every composable node of the run: container, name, plugin, state (any thread)."""
         driver = self.components()
-        return [] if driver is None else driver.loader.listed()
+        return [] if driver is None else driver.listed()
 
     def unload(self, name: str, *, by: str = "", done: ComponentDone) -> None:
         """Ask its container to unload the composable node ``name`` (its full name, or its
@@ -344,7 +393,7 @@ class Control(Part):
         self._driver("load").load(name, done)
         self.supervisor.records.emit(Controlled(name, "load", by))
 
-    def _driver(self, action: str) -> ComponentDriver:
+    def _driver(self, action: str) -> ComponentLoads:
         driver = self.components()
         if driver is None:
             raise ControlError(f"cannot {action}: this run has no composable nodes")

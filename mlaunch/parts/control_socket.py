@@ -44,7 +44,21 @@ from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from mlaunch.engine.supervisor import Supervisor
+    from typing import Protocol
+
+    from mlaunch.engine.guard import Guard
+    from mlaunch.engine.part import AttachedRun
+
+    class SocketRun(AttachedRun, Protocol):
+        """What the control socket uses of the run (the Supervisor is one): its id, and the guard
+        that removes the socket after kill -9."""
+
+        @property
+        def run_id(self) -> str: ...
+
+        @property
+        def guard(self) -> Guard | None: ...
+
     from mlaunch.engine.timers import Timer
     from mlaunch.parts.control import Control, ProcessInfo
 
@@ -158,7 +172,7 @@ class ControlSocket:
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: SocketRun,
         control: Callable[[], Control],
         log_dir: str,
         environ: Mapping[str, str] = os.environ,

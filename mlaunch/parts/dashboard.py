@@ -35,24 +35,34 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 from mlaunch.engine.part import Part
+from mlaunch.parts.dashboard_hub import Hub
 from mlaunch.plan.records import Output, Record, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
     from socketserver import BaseServer
+    from typing import Protocol
 
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.part import AttachedRun
+    from mlaunch.engine.process import Process
+
+    class PanelRun(AttachedRun, Protocol):
+        """What the launch panel uses of the run (the Supervisor is one): its id and its
+        processes."""
+
+        @property
+        def run_id(self) -> str: ...
+
+        @property
+        def processes(self) -> list[Process]: ...
+
     from mlaunch.parts.control import Control
     from mlaunch.parts.handoff import LoopCall
-    from mlaunch.parts.metrics import Metrics, Sample
+    from mlaunch.parts.metrics import Metrics
+    from mlaunch.parts.usage import Sample
 
-# Lines kept per process for the log view's follow (older ones are read from its log file).
-RING = 2000
 # Samples of CPU and memory kept per process for the sparklines (a second each).
 HISTORY = 300
-# Browser streams served at once; more are refused (503) rather than given a thread each.
-MAX_STREAMS = 64
-LINE_MAX = 2000  # characters of one output line sent to the page
 
 # Builds the evidence bundle (a .tar.gz) from the processes as they were and their last lines.
 Evidence = Callable[[Sequence[Any], Mapping[str, Sequence[str]]], bytes]
@@ -65,77 +75,6 @@ def dashboard_socket(run_id: str) -> str:
     return named(run_id)
 
 
-class Hub:
-    """What the browsers' threads read, written by the loop and the metrics thread.
-
-    ``state`` is the latest message (JSON bytes) and ``version`` counts them; the state streams
-    wait on ``changed``, which is notified once per message. ``lines`` keeps each label's last
-    RING output lines numbered from ``first[label]``; the log views look at them a few times a
-    second (``ended`` is set at the end), so a line of output wakes no thread.
-    """
-
-    def __init__(self) -> None:
-        self.changed = threading.Condition()
-        self.lock = threading.Lock()
-        self.ended = threading.Event()
-        self.version = 0
-        self.state = b"{}"
-        self.lines: dict[str, deque[str]] = {}
-        self.first: dict[str, int] = {}  # the number of lines[label][0]
-        self.last: dict[str, str] = {}
-        self.history: dict[str, deque[tuple[float, int]]] = {}
-        self.closed = False
-        self.streams = 0
-        self.looked = False  # a page has opened a stream: the readiness checks are worth watching
-
-    def add_output(self, label: str, data: bytes) -> None:
-        text = data.decode("utf-8", "replace").splitlines()
-        if not text:
-            return
-        with self.lock:
-            ring = self.lines.get(label)
-            if ring is None:
-                ring = self.lines[label] = deque(maxlen=RING)
-                self.first[label] = 0
-            # The ring keeps the last RING lines; the numbers of those it drops count on.
-            if len(text) >= RING:
-                self.first[label] += len(ring) + len(text) - RING
-                ring.clear()
-                text = text[-RING:]
-            else:
-                self.first[label] += max(0, len(ring) + len(text) - RING)
-            ring.extend(line[:LINE_MAX] for line in text)
-            self.last[label] = text[-1][:LINE_MAX]
-
-    def end(self, label: str) -> int:
-        """The number the label's next line will get (loop thread: no line arrives meanwhile)."""
-        ring = self.lines.get(label)
-        return self.first.get(label, 0) + (len(ring) if ring is not None else 0)
-
-    def lines_since(self, label: str, number: int) -> tuple[int, list[str], int]:
-        """(lines skipped, the lines from ``number`` on, the next number) for the log view."""
-        with self.lock:
-            ring = self.lines.get(label)
-            if ring is None:
-                return 0, [], number
-            first = self.first[label]
-            skipped = max(0, first - number)
-            start = max(number, first) - first
-            return skipped, list(ring)[start:], first + len(ring)
-
-    def publish(self, state: bytes) -> None:
-        with self.changed:
-            self.state = state
-            self.version += 1
-            self.changed.notify_all()
-
-    def close(self) -> None:
-        with self.changed:
-            self.closed = True
-            self.changed.notify_all()
-        self.ended.set()
-
-
 class Dashboard(Part):
     """The launch panel's servers and state; opened on the loop's first turn.
 
@@ -145,7 +84,7 @@ class Dashboard(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: PanelRun,
         control: Callable[[], Control],
         metrics: Metrics,
         *,
@@ -284,6 +223,11 @@ class Dashboard(Part):
             reply({"ok": True, "label": resolved, "lines": text, "next": self.hub.end(resolved)})
 
         return self.call(tail, 10.0)
+
+    @property
+    def run_id(self) -> str:
+        """The run's id (the evidence bundle's name)."""
+        return self.supervisor.run_id
 
     def evidence_bundle(self) -> tuple[bytes | None, str]:
         """The evidence of the run so far as a .tar.gz, or why not. The processes are copied on

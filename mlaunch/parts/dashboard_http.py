@@ -36,11 +36,35 @@ from typing import Any
 from urllib.parse import parse_qs
 
 from mlaunch.parts.control import OPERATIONS
+from mlaunch.parts.dashboard_hub import MAX_STREAMS
 from mlaunch.standins.viewer_http import QuietErrors
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
-    from mlaunch.parts.dashboard import Dashboard
+    from typing import Protocol
+
+    from mlaunch.parts.dashboard_hub import Hub
+
+    class Panel(Protocol):
+        """What the HTTP side uses of the launch panel (mlaunch.parts.dashboard's Dashboard is
+        one): the shared state, the run's token and id, a control request, a log view's start,
+        the evidence bundle."""
+
+        @property
+        def hub(self) -> Hub: ...
+
+        @property
+        def token(self) -> str: ...
+
+        @property
+        def run_id(self) -> str: ...
+
+        def request(self, request: dict[str, object], timeout: float) -> dict[str, object]: ...
+
+        def follow_start(self, label: str, lines: int) -> dict[str, object]: ...
+
+        def evidence_bundle(self) -> tuple[bytes | None, str]: ...
+
 
 PAGE = Path(__file__).with_name("dashboard.html")
 LOCAL_NAMES = ("127.0.0.1", "localhost")
@@ -61,7 +85,7 @@ def _page(token: str) -> bytes:
     return PAGE.read_bytes().replace(b"__MLAUNCH_TOKEN__", token.encode())
 
 
-def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
+def make_handler(dashboard: Panel) -> type[BaseHTTPRequestHandler]:
     page = _page(dashboard.token)
     hub = dashboard.hub
 
@@ -149,7 +173,7 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
             if data is None:
                 self._json(409, {"ok": False, "error": error})
                 return
-            name = f"mlaunch-evidence-{dashboard.supervisor.run_id}.tar.gz"
+            name = f"mlaunch-evidence-{dashboard.run_id}.tar.gz"
             self.send_response(200)
             self.send_header("Content-Type", "application/gzip")
             self.send_header("Content-Length", str(len(data)))
@@ -181,8 +205,6 @@ def make_handler(dashboard: Dashboard) -> type[BaseHTTPRequestHandler]:
 
         def _stream(self, body: Any) -> None:
             """Serve one event stream, if fewer than MAX_STREAMS are open."""
-            from mlaunch.parts.dashboard import MAX_STREAMS
-
             with hub.lock:
                 if hub.streams >= MAX_STREAMS:
                     full = True
@@ -313,14 +335,14 @@ def _run(server: socketserver.BaseServer, name: str) -> None:
     thread.start()
 
 
-def serve_tcp(dashboard: Dashboard, port: int) -> PanelServer:
+def serve_tcp(dashboard: Panel, port: int) -> PanelServer:
     """The panel on 127.0.0.1:port (0: any free port), served from a thread."""
     server = PanelServer(("127.0.0.1", port), make_handler(dashboard))
     _run(server, "mlaunch-dashboard")
     return server
 
 
-def serve_unix(dashboard: Dashboard, address: str) -> UnixPanelServer:
+def serve_unix(dashboard: Panel, address: str) -> UnixPanelServer:
     """The panel at the abstract unix socket ``address``, for the viewer's page."""
     server = UnixPanelServer(address, make_handler(dashboard))
     _run(server, "mlaunch-dashboard-viewer")

@@ -60,8 +60,27 @@ from mlaunch.plan.records import (
 from mlaunch.plan.steps import ProcessSpec
 
 if TYPE_CHECKING:
+    from typing import Protocol
+
+    from mlaunch.engine.part import AttachedRun, EndingRun
     from mlaunch.engine.process import Process
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.plan.steps import Plan
+
+    class DrivenRun(AttachedRun, EndingRun, Protocol):
+        """What lifecycle driving uses of the run (the Supervisor is one): the plan (its
+        lifecycle nodes, their environment), its processes, and a process's stop held back
+        while its node deactivates."""
+
+        @property
+        def plan(self) -> Plan: ...
+
+        @property
+        def processes(self) -> list[Process]: ...
+
+        def hold_stop(self, process: Process) -> None: ...
+
+        def release_stop(self, process: Process) -> None: ...
+
     from mlaunch.parts.bridge import RosGraph, TransitionResult
     from mlaunch.plan.records import ProcessView
 
@@ -149,7 +168,7 @@ class LifecycleManager(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: DrivenRun,
         *,
         sequences: Iterable[SequenceStep] = (),
         timeout: float = DEFAULT_TIMEOUT,
@@ -617,7 +636,7 @@ def _matches(event: Any, managed: Managed) -> bool:
     return False
 
 
-def _graph_environ(supervisor: Supervisor) -> dict[str, str]:
+def _graph_environ(supervisor: DrivenRun) -> dict[str, str]:
     """The environment the managed nodes get (their ROS_DOMAIN_ID): a lifecycle node's, else
     the first process's (a container of lifecycle components), else mlaunch's own."""
     processes = supervisor.plan.processes()
@@ -630,7 +649,7 @@ def _graph_environ(supervisor: Supervisor) -> dict[str, str]:
 # --- attaching -----------------------------------------------------------------------------------
 
 
-def attach(arguments: Mapping[str, str], supervisor: Supervisor) -> LifecycleManager:
+def attach(arguments: Mapping[str, str], supervisor: DrivenRun) -> LifecycleManager:
     """The pipeline's lifecycle part: a manager with the plan's sequences (and the argument's).
 
     ``arguments``: the command line's launch arguments (``mlaunch_lifecycle_sequence:=...``).

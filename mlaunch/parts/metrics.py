@@ -23,14 +23,14 @@ import time
 from collections.abc import Callable
 
 from mlaunch.engine.part import Part
-from mlaunch.parts.usage import GroupSampler, Usage, group_members
+from mlaunch.parts.usage import GroupSampler, Sample, group_members
 from mlaunch.plan.records import Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
     from typing import IO
 
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.part import AttachedRun
     from mlaunch.parts.control import Control, ProcessInfo
 
 PERIOD = 1.0
@@ -47,25 +47,6 @@ COLUMNS = (
 )
 
 
-class Sample:
-    """Every process at one moment: ``rows`` of (ProcessInfo, Usage or None when not running);
-    ``extra`` what the ``readers`` said on the loop thread at that moment (by name)."""
-
-    __slots__ = ("elapsed", "extra", "rows", "time")
-
-    def __init__(
-        self,
-        time: float,
-        elapsed: float,
-        rows: list[tuple[ProcessInfo, Usage | None]],
-        extra: dict[str, object] | None = None,
-    ) -> None:
-        self.time = time
-        self.elapsed = elapsed
-        self.rows = rows
-        self.extra = {} if extra is None else extra
-
-
 Listener = Callable[[Sample], None]
 
 
@@ -75,7 +56,7 @@ class Metrics(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: AttachedRun,
         control: Callable[[], Control],
         *,
         csv_path: str | None = None,

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
-    from mlaunch.parts.metrics import Sample
+    from mlaunch.parts.usage import Sample
 
 MAX_POINTS = 600
 WIDTH, HEIGHT = 900, 220

@@ -17,13 +17,13 @@ import xmlrpc.client
 from typing import Any
 
 from mlaunch.parts.graph_types import GraphNotRunning, RosBridgeError, TopicWatch
+from mlaunch.parts.ros1_environ import SYSTEM_PYTHON
 
 # Each call to the master is given this long (a master that does not answer is not up yet).
 CALL_TIMEOUT = 2.0
 CALLER_ID = "/mlaunch_test"
 
 
-SYSTEM_PYTHON = "/usr/bin/python3"
 PROBE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "ros1_topic_probe.py")
 
 
@@ -39,7 +39,7 @@ class MasterGraph:
 
     def watch_topic(self, topic: str) -> TopicWatch:
         """Counts the topic's messages (any type), through a rospy helper under Debian's Python."""
-        from mlaunch.parts.ros1_native import system_python_env
+        from mlaunch.parts.ros1_environ import system_python_env
 
         watch = TopicWatch(topic, None)
         env = system_python_env(os.environ)

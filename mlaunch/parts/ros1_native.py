@@ -29,6 +29,7 @@ from typing import Any
 
 from mlaunch.launch.action import Action
 from mlaunch.launch.actions.execute_process import ExecuteProcess
+from mlaunch.parts.ros1_environ import system_python_env
 from mlaunch.plan.errors import LaunchFileError, UsageError
 from mlaunch.ros1.actions import MappingWarning
 from mlaunch.ros1.config import Config, Ros1Node, load
@@ -400,56 +401,6 @@ def is_executable(path: str) -> bool:
         return False
     wanted = stat.S_IRUSR | stat.S_IXUSR
     return mode & wanted == wanted
-
-
-# What mlaunch's own process has that is not the user's: the ROS 2 wheels' bootstrap (their
-# ``.pth`` re-executes Python with their libraries on LD_LIBRARY_PATH and this guard set).
-BOOTSTRAP_GUARD = "_ROS_WHEELS_BOOTSTRAP_COMPLETE"
-
-
-def system_python_env(env: Mapping[str, str]) -> dict[str, str]:
-    """The environment without mlaunch's virtual environment: ROS 1's Python programs
-    (``#!/usr/bin/env python3``) must find the system's Python and its packages, and no ROS 1
-    program gets the ROS 2 wheels' libraries (LD_LIBRARY_PATH entries inside the venv) or
-    their bootstrap's guard."""
-    out = dict(env)
-    venv = sys.prefix if sys.prefix != sys.base_prefix else out.get("VIRTUAL_ENV")
-    system_first(out)
-    out.pop("VIRTUAL_ENV", None)
-    out.pop("PYTHONHOME", None)
-    out.pop(BOOTSTRAP_GUARD, None)
-    if venv:
-        inside = os.path.realpath(venv) + os.sep
-
-        def keep(entry: str) -> bool:
-            return bool(entry) and not (os.path.realpath(entry) + os.sep).startswith(inside)
-
-        for name in ("PATH", "PYTHONPATH", "LD_LIBRARY_PATH"):
-            if name in out:
-                kept = [e for e in out[name].split(os.pathsep) if keep(e)]
-                if kept:
-                    out[name] = os.pathsep.join(kept)
-                else:
-                    out.pop(name)
-    return out
-
-
-SYSTEM_PYTHON = "/usr/bin/python3"
-
-
-def system_first(env: dict[str, str]) -> None:
-    """``python3`` on PATH is the system's (where ROS 1's packages are): its folder goes
-    first when another one (a pyenv shim, a virtual environment) would be found before it."""
-    import shutil
-
-    if not os.access(SYSTEM_PYTHON, os.X_OK):
-        return
-    found = shutil.which("python3", path=env.get("PATH", os.defpath))
-    if found is not None and os.path.realpath(found) == os.path.realpath(SYSTEM_PYTHON):
-        return
-    folder = os.path.dirname(SYSTEM_PYTHON)
-    rest = [e for e in env.get("PATH", "").split(os.pathsep) if e and e != folder]
-    env["PATH"] = os.pathsep.join([folder, *rest])
 
 
 def ros_home(env: Mapping[str, str]) -> str:

@@ -5,12 +5,12 @@ ladder, respawn and the parameters it reads, and then the parameter server itsel
 
 from __future__ import annotations
 
-import os
 import shlex
 from collections.abc import Mapping
 from typing import Any
 
 from mlaunch.launch.action import Action
+from mlaunch.parts.ros1_environ import shell_environ
 from mlaunch.plan.steps import Note
 from mlaunch.plan.text import rel, shorten, value_text
 from mlaunch.ros1.config import Ros1Node
@@ -112,29 +112,6 @@ class NativeNodes(Note):
             )
         params = {k: value_text(v) for k, v in sorted(self.params.items())}
         return {"kind": "ros1_nodes", "nodes": nodes, "params": params}
-
-
-def shell_environ(environ: Mapping[str, str]) -> dict[str, str]:
-    """The environment the user's shell gave mlaunch: without what the ROS 2 wheels' bootstrap
-    added to mlaunch's own (their libraries on LD_LIBRARY_PATH, its guard)."""
-    import sys
-
-    from mlaunch.parts.ros1_native import BOOTSTRAP_GUARD
-
-    out = dict(environ)
-    if out.pop(BOOTSTRAP_GUARD, None) is None:
-        return out
-    inside = os.path.realpath(sys.prefix) + os.sep
-    kept = [
-        e
-        for e in out.get("LD_LIBRARY_PATH", "").split(os.pathsep)
-        if e and not (os.path.realpath(e) + os.sep).startswith(inside)
-    ]
-    if kept:
-        out["LD_LIBRARY_PATH"] = os.pathsep.join(kept)
-    else:
-        out.pop("LD_LIBRARY_PATH", None)
-    return out
 
 
 def _changed(before: Mapping[str, str], after: Mapping[str, str]) -> dict[str, str | None]:

@@ -26,9 +26,18 @@ from mlaunch.plan.records import Record, Said, ShutdownBegun, SimTimeWait
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from typing import Any
+    from typing import Any, Protocol
 
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.part import AttachedRun
+
+    class ClockedRun(AttachedRun, Protocol):
+        """What the ROS clock part uses of the run (the Supervisor is one): work that keeps an idle
+        run alive (a wait on /clock)."""
+
+        def busy(self, work: object) -> None: ...
+
+        def done(self, work: object) -> None: ...
+
     from mlaunch.parts.graph_types import TopicWatch
 
 
@@ -45,7 +54,7 @@ class _Wait:
 class RosClock(Part):
     """Takes every ``SimTimeWait`` handed over and ends it when /clock says so."""
 
-    def __init__(self, supervisor: Supervisor) -> None:
+    def __init__(self, supervisor: ClockedRun) -> None:
         self.supervisor = supervisor
         self.loop = LoopCall(supervisor.selector)
         self.graph = SharedGraph(dict(os.environ), f"_mlaunch_clock_{os.getpid()}")

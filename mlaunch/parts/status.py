@@ -34,11 +34,31 @@ from mlaunch.plan.records import Output, Record, Said
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+    from typing import Protocol
+
     from rich.console import Console
 
+    from mlaunch.engine.guard import Guard
     from mlaunch.engine.keyboard import Keyboard
     from mlaunch.engine.output import Printer
-    from mlaunch.engine.supervisor import Supervisor
+    from mlaunch.engine.part import AttachedRun
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.process_state import ProcessState
+
+    class ViewedRun(AttachedRun, Protocol):
+        """What the status view uses of the run (the Supervisor is one): what it knows of each
+        label, its processes, the guard (which puts the terminal back after kill -9)."""
+
+        @property
+        def process_states(self) -> Mapping[str, ProcessState]: ...
+
+        @property
+        def processes(self) -> list[Process]: ...
+
+        @property
+        def guard(self) -> Guard | None: ...
+
     from mlaunch.parts.control import Control
     from mlaunch.parts.status_keys import StatusKeys
     from mlaunch.parts.usage import GroupSampler
@@ -89,7 +109,7 @@ class StatusView(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: ViewedRun,
         printer: Printer,
         control: Callable[[], Control],
         *,
@@ -423,7 +443,7 @@ def _printable(raw: bytes, *, strip: bool = True) -> str:
 
 
 def attach_status_view(
-    supervisor: Supervisor, printer: Printer, control: Callable[[], Control]
+    supervisor: ViewedRun, printer: Printer, control: Callable[[], Control]
 ) -> StatusView | None:
     """The view on a terminal; on anything else a warning (redrawing would fill a log file).
 

@@ -2,12 +2,17 @@
 
 A launched process is counted with the living members of its process group (a shell's or a
 wrapper's children are part of what that label costs), as the ``--status`` view shows it and
-``--metrics`` writes it. psutil reads /proc; it is imported on the first sample.
+``--metrics`` writes it. psutil reads /proc; it is imported on the first sample. A ``Sample`` is
+every process at one moment, what ``--metrics`` and the launch panel are handed.
 """
 
 from __future__ import annotations
 
 from typing import Any
+
+TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
+if TYPE_CHECKING:
+    from mlaunch.parts.control import ProcessInfo
 
 
 class Usage:
@@ -70,3 +75,22 @@ class GroupSampler:
             usage[pgid] = total
         self._procs = alive
         return usage
+
+
+class Sample:
+    """Every process at one moment: ``rows`` of (ProcessInfo, Usage or None when not running);
+    ``extra`` what the ``readers`` said on the loop thread at that moment (by name)."""
+
+    __slots__ = ("elapsed", "extra", "rows", "time")
+
+    def __init__(
+        self,
+        time: float,
+        elapsed: float,
+        rows: list[tuple[ProcessInfo, Usage | None]],
+        extra: dict[str, object] | None = None,
+    ) -> None:
+        self.time = time
+        self.elapsed = elapsed
+        self.rows = rows
+        self.extra = {} if extra is None else extra

@@ -19,10 +19,10 @@ from mlaunch.smoke.settings import Settings
 from mlaunch.smoke.watch import SmokeRun
 
 if TYPE_CHECKING:
-    from mlaunch.engine.supervisor import Supervisor
     from mlaunch.parts.lifecycle import LifecycleManager
     from mlaunch.parts.sd_notify import Notifier
     from mlaunch.smoke.expectations import Expectation
+    from mlaunch.smoke.watch import CheckedRun
 
 # STATUS= is sent at most this often while coming up (on a change).
 STATUS_PERIOD = 0.5
@@ -34,7 +34,7 @@ class ReadyWatch(SmokeRun):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: CheckedRun,
         expectations: list[Expectation],
         *,
         lifecycle: LifecycleManager | None = None,
@@ -122,7 +122,7 @@ class Readiness(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: CheckedRun,
         expectations: list[Expectation],
         *,
         notifier: Notifier | None = None,

@@ -17,12 +17,35 @@ from mlaunch.smoke.expectations import Expectation
 from mlaunch.smoke.settings import Settings
 
 if TYPE_CHECKING:
-    from mlaunch.engine.supervisor import Supervisor
+    from collections.abc import Mapping
+    from typing import Protocol
+
+    from mlaunch.engine.part import AttachedRun, EndingRun
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.process_state import ProcessState
+    from mlaunch.plan.steps import Plan
+
+    class CheckedRun(AttachedRun, EndingRun, Protocol):
+        """What the smoke checks use of the run (the Supervisor is one): the plan, what it knows
+        of each label, its processes, and why it is shutting down."""
+
+        @property
+        def plan(self) -> Plan: ...
+
+        @property
+        def process_states(self) -> Mapping[str, ProcessState]: ...
+
+        @property
+        def processes(self) -> list[Process]: ...
+
+        @property
+        def shutdown_reason(self) -> str: ...
+
     from mlaunch.parts.handoff import SharedGraph
     from mlaunch.parts.lifecycle import LifecycleManager, Outcome
     from mlaunch.parts.ros1_graph import SharedMaster
     from mlaunch.plan.records import ProcessView
-    from mlaunch.plan.steps import Plan, ProcessSpec
+    from mlaunch.plan.steps import ProcessSpec
     from mlaunch.smoke.recorder import Recorder
     from mlaunch.smoke.report import Window
 
@@ -69,7 +92,7 @@ class SmokeRun(Part):
 
     def __init__(
         self,
-        supervisor: Supervisor,
+        supervisor: CheckedRun,
         expectations: list[Expectation],
         settings: Settings,
         *,
