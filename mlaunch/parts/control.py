@@ -91,14 +91,14 @@ if TYPE_CHECKING:
 
         def load(self, name: str, done: ComponentDone) -> None: ...
 
-    class LifecycleNode(Protocol):
+    class ManagedNode(Protocol):
         @property
         def fqn(self) -> str: ...
 
         @property
         def process(self) -> object: ...
 
-    Node = TypeVar("Node", bound=LifecycleNode)
+    Node = TypeVar("Node", bound=ManagedNode)
 
     class LifecycleRequests(Protocol[Node]):
         """What runtime control uses of lifecycle driving (mlaunch.parts.lifecycle)."""
@@ -269,12 +269,12 @@ class Control(Part):
             raise AmbiguousLabel(name, named)
         raise UnknownLabel(name, self.labels())
 
-    def record(self, label: str) -> ProcessState:
-        """The record of the label ``label`` means (``resolve``)."""
+    def process_state(self, label: str) -> ProcessState:
+        """What the run knows of the label ``label`` means (``resolve``)."""
         return self.supervisor.process_states[self.resolve(label)]
 
     def info(self, label: str) -> ProcessInfo:
-        record = self.record(label)
+        record = self.process_state(label)
         label = record.label
         running = record.state in (RUNNING, STOPPING)
         now = self.supervisor.clock()
@@ -431,7 +431,7 @@ class Control(Part):
 
     def _acting_on(self, name: str, action: str) -> tuple[str, ProcessState, Process | None]:
         """The label, its record and latest instance, once the launch may still act on it."""
-        record = self.record(name)
+        record = self.process_state(name)
         label = record.label
         if self.supervisor.shutting_down:
             raise ControlError(f"cannot {action} {label}: the launch is shutting down")

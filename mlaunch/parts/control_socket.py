@@ -481,7 +481,7 @@ def carry_out(
     elif op == "start":
         control.start(label, by=by, done=done)
     else:
-        spec = control.record(label).spec  # raises before anything is said for a bad label
+        spec = control.process_state(label).spec  # raises before anything is said for a bad label
         if accepted is not None:
             wait = spec.sigterm_timeout + spec.sigkill_timeout + WAIT_MARGIN
             accepted({"accepted": True, "wait": wait})
