@@ -56,16 +56,16 @@ class Loads:
         self.count = count
         self.steps: list[LoadComponents] = []
         self.order: list[str] = []
-        harness.sup.records.subscribe(self.on_event)
+        harness.sup.records.subscribe(self.on_record)
 
-    def on_event(self, event: Record) -> None:
-        if isinstance(event, Started):
-            self.order.append(f"started {event.process.spec.base_name}")
-        if not isinstance(event, HandedOff) or not isinstance(event.step, LoadComponents):
+    def on_record(self, record: Record) -> None:
+        if isinstance(record, Started):
+            self.order.append(f"started {record.process.spec.base_name}")
+        if not isinstance(record, HandedOff) or not isinstance(record.step, LoadComponents):
             return
-        event.taken = True
-        self.steps.append(event.step)
-        self.order.append(f"load {event.step.target}")
+        record.taken = True
+        self.steps.append(record.step)
+        self.order.append(f"load {record.step.target}")
         if len(self.steps) == self.count:
             self.harness.sup.begin_shutdown("every load handed over")
 
@@ -94,19 +94,19 @@ def test_a_load_keeps_an_idle_launch_running_until_its_work_is_done() -> None:
     seen: list[str] = []
     work = object()
 
-    def on_event(event: Record) -> None:
-        if isinstance(event, HandedOff):
-            event.taken = True
+    def on_record(record: Record) -> None:
+        if isinstance(record, HandedOff):
+            record.taken = True
             h.sup.busy(work)
             h.sup.schedule(0.05, finish, keeps_alive=False)
-        elif isinstance(event, ShutdownBegun):
-            seen.append(f"shutdown {event.reason}")
+        elif isinstance(record, ShutdownBegun):
+            seen.append(f"shutdown {record.reason}")
 
     def finish() -> None:
         seen.append("done")
         h.sup.done(work)
 
-    h.sup.records.subscribe(on_event)
+    h.sup.records.subscribe(on_record)
     assert h.run() == 0
     assert seen == ["done", "shutdown idle"]
 

@@ -275,11 +275,11 @@ def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
     h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
     driver = ComponentDriver(h.sup)
 
-    def on_event(event: Record) -> None:
-        if isinstance(event, HandedOff):  # the driver has its thread waiting by now
+    def on_record(record: Record) -> None:
+        if isinstance(record, HandedOff):  # the driver has its thread waiting by now
             h.sup.schedule(0.0, h.shutdown)
 
-    h.sup.records.subscribe(on_event)
+    h.sup.records.subscribe(on_record)
     try:
         assert h.run() == 0
     finally:

@@ -28,9 +28,9 @@ class Seen:
         self.events: list[Record] = []
         h.sup.records.subscribe(self._on)
 
-    def _on(self, event: Record) -> None:
-        if isinstance(event, (Started, Exited, RespawnScheduled, Controlled)):
-            self.events.append(event)
+    def _on(self, record: Record) -> None:
+        if isinstance(record, (Started, Exited, RespawnScheduled, Controlled)):
+            self.events.append(record)
 
     def of(self, kind: type[E]) -> list[E]:
         return [e for e in self.events if isinstance(e, kind)]
@@ -246,8 +246,8 @@ def test_a_stop_cancels_a_pending_respawn() -> None:
     h = Harness([make_spec("crash", "import sys; sys.exit(1)", respawn=policy)])
     infos: list[ProcessInfo] = []
 
-    def on_exit(event: Record) -> None:
-        if isinstance(event, RespawnScheduled):
+    def on_exit(record: Record) -> None:
+        if isinstance(record, RespawnScheduled):
             pending = h.control().info("crash")
             assert pending.restart_in is not None and 29 < pending.restart_in <= 30
             assert pending.uptime is None and pending.state == "restarting"

@@ -38,9 +38,9 @@ def test_records_emitted_while_one_is_handled_wait_for_it_to_finish() -> None:
     stream = RecordStream()
     seen: list[str] = []
 
-    def first(event: Record) -> None:
-        seen.append(f"first {event!r}")
-        if isinstance(event, Said) and event.text == "a":
+    def first(record: Record) -> None:
+        seen.append(f"first {record!r}")
+        if isinstance(record, Said) and record.text == "a":
             stream.emit(Said("INFO", "t", "b"))  # queued: "a" reaches `second` before "b"
 
     stream.subscribe(first)
@@ -69,8 +69,8 @@ def test_a_subscriber_that_raises_leaves_the_stream_usable() -> None:
     stream = RecordStream()
     seen: list[Record] = []
 
-    def fails(event: Record) -> None:
-        if isinstance(event, StoppingAll):
+    def fails(record: Record) -> None:
+        if isinstance(record, StoppingAll):
             raise RuntimeError("boom")
 
     stream.subscribe(fails)

@@ -314,9 +314,9 @@ def test_a_clean_shutdown_walks_the_tree_without_scanning_every_process(
     h = Harness([make_spec(f"s{i}", "", argv=up) for i in range(3)])
     ups: list[str] = []
 
-    def saw(event: Record) -> None:
-        if isinstance(event, Output):
-            ups.extend(event.process.label for line in event.data.splitlines() if line == b"up")
+    def saw(record: Record) -> None:
+        if isinstance(record, Output):
+            ups.extend(record.process.label for line in record.data.splitlines() if line == b"up")
             if len(ups) == 3:
                 h.shutdown()
 

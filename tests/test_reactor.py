@@ -51,12 +51,12 @@ class Faulty(Part):
         self.kind = kind
         self.calls = 0
         self.closed = False
-        supervisor.records.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_record)
 
-    def on_event(self, event: Record) -> None:
+    def on_record(self, record: Record) -> None:
         self.calls += 1
-        if isinstance(event, self.kind):
-            raise RuntimeError(f"broken at {type(event).__name__}")
+        if isinstance(record, self.kind):
+            raise RuntimeError(f"broken at {type(record).__name__}")
 
     def close(self) -> None:
         self.closed = True
@@ -80,7 +80,7 @@ def test_a_subscriber_that_raises_is_said_detached_and_the_run_goes_on() -> None
         "[ERROR] [launch]: the faulty part failed and was detached: RuntimeError: broken at Started"
     ]
     assert faulty.calls == 1 and faulty.closed  # never called again, closed at once
-    assert faulty.on_event not in h.sup.records.subscribers
+    assert faulty.on_record not in h.sup.records.subscribers
     # The part after it still got the record the faulty one broke at, and everything after.
     kinds = [type(e) for e in after.seen]
     assert Started in kinds and Output in kinds and Exited in kinds
@@ -188,9 +188,9 @@ from mlaunch.plan.records import Started
 
 class Broken(Part):
     def __init__(self, run):
-        run.supervisor.records.subscribe(self.on_event)
+        run.supervisor.records.subscribe(self.on_record)
 
-    def on_event(self, event):
+    def on_record(self, event):
         if isinstance(event, Started):
             raise RuntimeError("broken at its first start")
 

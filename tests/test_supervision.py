@@ -117,19 +117,19 @@ class Harness:
     def listen(self, listener: Callable[[str, ProcessView], object]) -> None:
         """Call ``listener("started" | "exited", process)`` from the supervisor's record stream."""
 
-        def on_event(event: Record) -> None:
-            if isinstance(event, Started):
-                listener("started", event.process)
-            elif isinstance(event, Exited):
-                listener("exited", event.process)
+        def on_record(record: Record) -> None:
+            if isinstance(record, Started):
+                listener("started", record.process)
+            elif isinstance(record, Exited):
+                listener("exited", record.process)
 
-        self.sup.records.subscribe(on_event)
+        self.sup.records.subscribe(on_record)
 
-    def _saw(self, event: Record) -> None:
-        if not isinstance(event, Output):
+    def _saw(self, record: Record) -> None:
+        if not isinstance(record, Output):
             return
-        label = event.process.label
-        for line in event.data.splitlines():
+        label = record.process.label
+        for line in record.data.splitlines():
             self.lines.append((label, line))
             for trigger in list(self._triggers):
                 if trigger[0] in line:

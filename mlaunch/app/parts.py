@@ -190,13 +190,13 @@ def lifecycle_part(
     ):
         return make()
 
-    def wants(event: Record) -> bool:
-        if isinstance(event, Started):
-            node = event.process.spec.node
+    def wants(record: Record) -> bool:
+        if isinstance(record, Started):
+            node = record.process.spec.node
             return node is not None and node.lifecycle
-        if isinstance(event, HandedOff):  # a load of a lifecycle component to autostart
-            return Need.LIFECYCLE in event.step.needs
-        return isinstance(event, LaunchEvent) and bool(getattr(event.event, "needs", None))
+        if isinstance(record, HandedOff):  # a load of a lifecycle component to autostart
+            return Need.LIFECYCLE in record.step.needs
+        return isinstance(record, LaunchEvent) and bool(getattr(record.event, "needs", None))
 
     return _AttachOnDemand(supervisor, wants, make)
 
@@ -235,8 +235,8 @@ def components_part(
     if Need.COMPONENTS in plan.needs:
         return driver()
 
-    def wants(event: Record) -> bool:
-        return isinstance(event, HandedOff) and Need.COMPONENTS in event.step.needs
+    def wants(record: Record) -> bool:
+        return isinstance(record, HandedOff) and Need.COMPONENTS in record.step.needs
 
     return _AttachOnDemand(supervisor, wants, driver)
 
@@ -276,17 +276,17 @@ class _AttachOnDemand(Part):
         self.wants = wants
         self.make = make
         self.driver: ComponentDriver | RosClock | LifecycleManager | None = None
-        supervisor.records.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_record)
 
-    def _on_event(self, event: Record) -> None:
-        if not self.wants(event):
+    def _on_record(self, record: Record) -> None:
+        if not self.wants(record):
             return
-        self.supervisor.records.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_record)
         driver = self.driver = self.make()
-        driver.on_event(event)
+        driver.on_record(record)
 
     def close(self) -> None:
-        self.supervisor.records.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_record)
         if self.driver is not None:
             self.driver.close()
 
@@ -406,16 +406,16 @@ class _ViewerWatch(Part):
     def __init__(self, run: Run) -> None:
         self.run = run
         self.panel: Dashboard | None = None
-        run.supervisor.records.subscribe(self._on_event)
+        run.supervisor.records.subscribe(self._on_record)
 
-    def _on_event(self, event: Record) -> None:
-        if not isinstance(event, Started) or VIEWER_MODULE not in event.process.spec.argv:
+    def _on_record(self, record: Record) -> None:
+        if not isinstance(record, Started) or VIEWER_MODULE not in record.process.spec.argv:
             return
-        self.run.supervisor.records.unsubscribe(self._on_event)
+        self.run.supervisor.records.unsubscribe(self._on_record)
         self.panel = dashboard_part(self.run)
 
     def close(self) -> None:
-        self.run.supervisor.records.unsubscribe(self._on_event)
+        self.run.supervisor.records.unsubscribe(self._on_record)
         if self.panel is not None:
             self.panel.close()
 

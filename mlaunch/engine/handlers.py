@@ -74,24 +74,24 @@ class LaunchHandlers:
     def remove(self, handler: object) -> None:
         self.handlers[:] = [h for h in self.handlers if h.handler is not handler]
 
-    def __call__(self, event: Record) -> None:
+    def __call__(self, record: Record) -> None:
         """The subscription: the records launch has events for."""
-        if isinstance(event, Output):
+        if isinstance(record, Output):
             if self.handlers:
-                self.output(event.process, event.stream, event.data)
-        elif isinstance(event, Started):
-            self._started(event.process)
-        elif isinstance(event, Exited):
-            self._exited(event.process, event.code)
-        elif isinstance(event, (ShutdownBegun, ShutdownRepeated)):
-            sigint = event.due_to_signal == 2  # SIGINT, without importing signal for it
-            self.dispatch("shutdown", None, ev.Shutdown(reason=event.reason, due_to_sigint=sigint))
-        elif isinstance(event, Transition):
-            self._transition(event)
-        elif isinstance(event, LaunchEvent):
-            self._launch_event(event)
-        elif isinstance(event, Completed):
-            self._completed(event.action)
+                self.output(record.process, record.stream, record.data)
+        elif isinstance(record, Started):
+            self._started(record.process)
+        elif isinstance(record, Exited):
+            self._exited(record.process, record.code)
+        elif isinstance(record, (ShutdownBegun, ShutdownRepeated)):
+            sigint = record.due_to_signal == 2  # SIGINT, without importing signal for it
+            self.dispatch("shutdown", None, ev.Shutdown(reason=record.reason, due_to_sigint=sigint))
+        elif isinstance(record, Transition):
+            self._transition(record)
+        elif isinstance(record, LaunchEvent):
+            self._launch_event(record)
+        elif isinstance(record, Completed):
+            self._completed(record.action)
 
     def wants_completion(self, action: object) -> bool:
         """Whether a handler registered now waits for ``action`` to complete.

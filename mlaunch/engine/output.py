@@ -330,13 +330,13 @@ class Printer:
 
     # --- the run's events, in words -------------------------------------------------------------
 
-    def __call__(self, event: Record) -> None:
+    def __call__(self, record: Record) -> None:
         """The printer's subscription to the supervisor's RecordStream: each record in words."""
-        method = _SAYS.get(type(event))
+        method = _SAYS.get(type(record))
         if method is not None:
-            method(self, event)
+            method(self, record)
         else:
-            self.sayings(event)
+            self.sayings(record)
 
     def say_lines_of(self, label: str, start: bytes) -> None:
         """``label``'s stdout lines that begin with ``start`` are said whatever its output mode."""

@@ -60,11 +60,11 @@ class Sayings:
         self.message = printer.message
         self._core: tuple[str, bool, int] | None = None  # core_pattern, read at the first crash
 
-    def __call__(self, event: Record) -> None:
-        """Say ``event`` (records not in SAYINGS are not said)."""
-        method = SAYINGS.get(type(event))
+    def __call__(self, record: Record) -> None:
+        """Say ``record`` (records not in SAYINGS are not said)."""
+        method = SAYINGS.get(type(record))
         if method is not None:
-            method(self, event)
+            method(self, record)
 
     def _started(self, event: Started) -> None:
         process = event.process

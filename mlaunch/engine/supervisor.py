@@ -397,9 +397,9 @@ class Supervisor:
         """A handler of the launch file failed: say where, then shut down (exit status 2)."""
         self.executor.handler_failed(message)
 
-    def _react(self, event: Record) -> None:
+    def _react(self, record: Record) -> None:
         """The supervisor's own subscription: the stop ladder begins at StoppingAll."""
-        if isinstance(event, StoppingAll) and not event.kill:
+        if isinstance(record, StoppingAll) and not record.kill:
             self.shutdown.stop_all()
 
     # --- processes ---------------------------------------------------------------------------

@@ -484,17 +484,17 @@ class ComponentDriver(Part):
         )
         # Who waits for a load thread to end (a ``load`` asked through runtime control).
         self.waiting: list[Callable[[threading.Thread], None]] = []
-        supervisor.records.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_record)
 
-    def on_event(self, event: Record) -> None:
-        if isinstance(event, HandedOff) and isinstance(event.step, LoadComponents):
-            event.taken = True
+    def on_record(self, record: Record) -> None:
+        if isinstance(record, HandedOff) and isinstance(record.step, LoadComponents):
+            record.taken = True
             # Keeps an idle launch running until the loads are done (or the launch stops).
-            self.supervisor.busy(self.loader.start(event.step))
-        elif isinstance(event, ShutdownBegun):
+            self.supervisor.busy(self.loader.start(record.step))
+        elif isinstance(record, ShutdownBegun):
             self.loader.stop.set()
-        elif isinstance(event, Exited):
-            self._exited(event)
+        elif isinstance(record, Exited):
+            self._exited(record)
 
     def _exited(self, event: Exited) -> None:
         node = event.process.spec.node
@@ -616,6 +616,6 @@ class ComponentDriver(Part):
         self.loader.stop.set()
         self.loader.join(3.0)
         self.loop.run_pending()  # the loop is over: the abandoned loads' lines are said here
-        self.supervisor.records.unsubscribe(self.on_event)
+        self.supervisor.records.unsubscribe(self.on_record)
         self.loader.context.try_shutdown()
         self.loop.close()

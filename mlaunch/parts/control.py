@@ -4,8 +4,8 @@ The core of ``mlaunch ctl`` (through the control socket, mlaunch.parts.control_s
 ``--status`` keys. The run (``mlaunch.app.parts.Run.control``) makes one Control on first
 use; it asks the printer for what only the printer knows (mutes, log tails). Every method
 runs on the supervisor's loop thread and never blocks: call it from a selector callback, a timer
-(``Supervisor.schedule``) or an event subscriber. Another thread must hand its request to the
-loop (the control socket is read by the loop's own selector, so it needs no hand-over).
+(``Supervisor.schedule``) or a subscriber of the records. Another thread must hand its request
+to the loop (the control socket is read by the loop's own selector, so it needs no hand-over).
 
 What the user does reaches everything else through the record stream, as the launch's own
 stops do:
@@ -245,7 +245,7 @@ class Control(Part):
         # (process, what, callback): "exit" calls back when it exits, "restart" when its
         # label's next instance has started.
         self._waits: list[tuple[Process, str, Done]] = []
-        supervisor.records.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_record)
 
     # --- reading ---------------------------------------------------------------------------
 
@@ -459,19 +459,19 @@ class Control(Part):
 
     def close(self) -> None:
         """Stop following the run (its waiting callbacks are dropped)."""
-        self.supervisor.records.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_record)
         self._waits.clear()
 
-    def _on_event(self, event: Record) -> None:
+    def _on_record(self, record: Record) -> None:
         """Calls back those waiting for an exit, or for the start that follows a restart."""
         if not self._waits:
             return
-        if isinstance(event, Exited):
-            self._exited(event.process)
-        elif isinstance(event, (Started, FailedToStart)):
-            self._restarted(event.process.label)
-        elif isinstance(event, NotStarted):
-            self._restarted(event.spec.label)
+        if isinstance(record, Exited):
+            self._exited(record.process)
+        elif isinstance(record, (Started, FailedToStart)):
+            self._restarted(record.process.label)
+        elif isinstance(record, NotStarted):
+            self._restarted(record.spec.label)
 
     def _exited(self, process: ProcessView) -> None:
         for wait in list(self._waits):

@@ -104,7 +104,7 @@ class Dashboard(Part):
         self.servers: list[BaseServer] = []
         self.loop: LoopCall | None = None
         self.url = ""
-        supervisor.records.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_record)
         metrics.listeners.append(self._sampled)
         supervisor.schedule(0.0, self._open, keeps_alive=False)
 
@@ -134,9 +134,9 @@ class Dashboard(Part):
 
     # --- fed by the run ---------------------------------------------------------------------
 
-    def _on_event(self, event: Record) -> None:
-        if type(event) is Output:
-            self.hub.add_output(event.process.label, event.data)
+    def _on_record(self, record: Record) -> None:
+        if type(record) is Output:
+            self.hub.add_output(record.process.label, record.data)
 
     def _sampled(self, sample: Sample) -> None:
         """The metrics thread: each second's state, as the message every browser gets."""
@@ -258,7 +258,7 @@ class Dashboard(Part):
             self.evidence_busy.release()
 
     def close(self) -> None:
-        self.supervisor.records.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_record)
         if self._sampled in self.metrics.listeners:
             self.metrics.listeners.remove(self._sampled)
         self.hub.close()

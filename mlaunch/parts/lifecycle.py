@@ -189,7 +189,7 @@ class LifecycleManager(Part):
         self._in_sequence = {name for seq in self.sequences for name in seq.nodes}
         for spec in supervisor.plan.processes():
             self._track(spec)
-        supervisor.records.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_record)
         self._check_sequences()
         if self.sequences:
             # First thing in the loop, after the plan's processes are started.
@@ -227,25 +227,25 @@ class LifecycleManager(Part):
 
     # --- the supervisor's events (loop thread) -------------------------------------------------
 
-    def on_event(self, event: Record) -> None:
+    def on_record(self, record: Record) -> None:
         """The subscription: processes starting and exiting, ChangeState, the shutdown.
 
         A manager attached during the run is handed the record that showed it was needed.
         """
-        if isinstance(event, Started):
-            self._on_process(False, event.process)
-        elif isinstance(event, Exited):
-            self._on_process(True, event.process)
-        elif isinstance(event, ComponentLoaded):
-            self._on_loaded(event)
-        elif isinstance(event, ShutdownBegun):
+        if isinstance(record, Started):
+            self._on_process(False, record.process)
+        elif isinstance(record, Exited):
+            self._on_process(True, record.process)
+        elif isinstance(record, ComponentLoaded):
+            self._on_loaded(record)
+        elif isinstance(record, ShutdownBegun):
             self._on_shutdown()
-        elif isinstance(event, LaunchEvent):
+        elif isinstance(record, LaunchEvent):
             from mlaunch.launch_ros.events.lifecycle.change_state import ChangeState
 
-            if isinstance(event.event, ChangeState):
-                event.taken = True
-                self._on_change_state(event.event)
+            if isinstance(record.event, ChangeState):
+                record.taken = True
+                self._on_change_state(record.event)
 
     def _on_process(self, exited: bool, process: ProcessView) -> None:
         if exited:

@@ -64,13 +64,13 @@ class RosClock(Part):
         self._next_due = math.inf
         self._watch: TopicWatch | None = None
         self._starting = False
-        supervisor.records.subscribe(self.on_event)
+        supervisor.records.subscribe(self.on_record)
 
-    def on_event(self, event: Record) -> None:
-        if isinstance(event, SimTimeWait):
-            event.taken = True
-            self._begin(event)
-        elif isinstance(event, ShutdownBegun):
+    def on_record(self, record: Record) -> None:
+        if isinstance(record, SimTimeWait):
+            record.taken = True
+            self._begin(record)
+        elif isinstance(record, ShutdownBegun):
             for wait in [w for w in self._waits if w.step.cancel_on_shutdown]:
                 self._forget(wait)
 
@@ -143,7 +143,7 @@ class RosClock(Part):
             self.supervisor.schedule(wait.step.period, wait.step.expire)
 
     def close(self) -> None:
-        self.supervisor.records.unsubscribe(self.on_event)
+        self.supervisor.records.unsubscribe(self.on_record)
         for wait in list(self._waits):
             self._forget(wait)
         self.loop.close()

@@ -234,13 +234,13 @@ class StatusView(Part):
             self._footer = self.render().encode("utf-8", "replace")
             self._redraw = True
 
-    def _saw_output(self, event: Record) -> None:
-        if not isinstance(event, Output):
+    def _saw_output(self, record: Record) -> None:
+        if not isinstance(record, Output):
             return
-        data = event.data
+        data = record.data
         end = len(data) - 1  # data is complete lines: it ends with a newline
         start = data.rfind(b"\n", 0, end) + 1
-        self.last_line[event.process.label] = data[start : min(end, start + LAST_LINE)]
+        self.last_line[record.process.label] = data[start : min(end, start + LAST_LINE)]
 
     def _tick(self) -> None:
         if self._closed:

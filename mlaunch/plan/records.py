@@ -382,20 +382,20 @@ class RecordStream:
         if subscriber in self.subscribers:
             self.subscribers.remove(subscriber)
 
-    def emit(self, event: Record) -> None:
-        """Queue ``event``; dispatch the queue now unless a dispatch or a visit is under way."""
-        self._queue.append(event)
+    def emit(self, record: Record) -> None:
+        """Queue ``record``; dispatch the queue now unless a dispatch or a visit is under way."""
+        self._queue.append(record)
         if not self._dispatching and not self._held:
             self._drain()
 
-    def say_now(self, event: Record) -> None:
-        """Hand ``event`` to every subscriber at once, ahead of what is queued.
+    def say_now(self, record: Record) -> None:
+        """Hand ``record`` to every subscriber at once, ahead of what is queued.
 
         Only for lines that are not events in launch (LogInfo is said while its description is
         visited, before the starts of that visit are handled).
         """
         for subscriber in list(self.subscribers):
-            subscriber(event)
+            subscriber(record)
 
     def hold(self) -> None:
         """Queue without dispatching until the matching ``release`` (a description's visit)."""
@@ -416,8 +416,8 @@ class RecordStream:
         queue = self._queue
         try:
             while queue:
-                event = queue.popleft()
+                record = queue.popleft()
                 for subscriber in list(self.subscribers):
-                    subscriber(event)
+                    subscriber(record)
         finally:
             self._dispatching = False

@@ -137,7 +137,7 @@ class Readiness(Part):
             supervisor, expectations, lifecycle=lifecycle, on_change=self._changed
         )
         self.watch.seed(logs)
-        supervisor.records.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_record)
         if notifier is not None:
             self._status()
             supervisor.schedule(STATUS_PERIOD, self._tick, keeps_alive=False)
@@ -183,14 +183,14 @@ class Readiness(Part):
         self.notifier.watchdog()
         self.supervisor.schedule(self._watchdog_period(), self._watchdog, keeps_alive=False)
 
-    def _on_event(self, event: Record) -> None:
-        if isinstance(event, ShutdownBegun) and self.notifier is not None:
-            reason = event.reason or "shutting down"
+    def _on_record(self, record: Record) -> None:
+        if isinstance(record, ShutdownBegun) and self.notifier is not None:
+            reason = record.reason or "shutting down"
             self.notifier.stopping(f"stopping: {reason}")
             self._last_status = "stopping"
 
     def close(self) -> None:
-        self.supervisor.records.unsubscribe(self._on_event)
+        self.supervisor.records.unsubscribe(self._on_record)
         self.watch.close()
         if self.notifier is not None:
             self.notifier.close()

@@ -130,7 +130,7 @@ class SmokeRun(Part):
         # The last seconds of the named topics, for the evidence of a failure: fed by the graph.
         self.recorder = recorder if graph is None else None
         self._recording = False
-        supervisor.records.subscribe(self._on_event)
+        supervisor.records.subscribe(self._on_record)
         supervisor.schedule(TICK, self._tick, keeps_alive=False)
         if any(e.kind in GRAPH_KINDS for e in expectations) or self.recorder is not None:
             self._start_checker()
@@ -140,22 +140,22 @@ class SmokeRun(Part):
 
     # --- loop thread ---------------------------------------------------------------------------
 
-    def _on_event(self, event: Record) -> None:
+    def _on_record(self, record: Record) -> None:
         """The subscription: output, starts and exits, and the lifecycle manager's results."""
         from mlaunch.parts.lifecycle import Outcome
 
-        if isinstance(event, Output):
-            self._on_output(event.process.label, event.data)
-        elif isinstance(event, Started):
-            self._on_process(False, event.process)
-        elif isinstance(event, Exited):
-            self._on_process(True, event.process)
-        elif isinstance(event, Outcome):
-            self._on_transition(event)
-        elif isinstance(event, HandedOff):
-            self._on_handoff(event.step)
-        elif isinstance(event, LoadRefused):
-            self._on_refused(event)
+        if isinstance(record, Output):
+            self._on_output(record.process.label, record.data)
+        elif isinstance(record, Started):
+            self._on_process(False, record.process)
+        elif isinstance(record, Exited):
+            self._on_process(True, record.process)
+        elif isinstance(record, Outcome):
+            self._on_transition(record)
+        elif isinstance(record, HandedOff):
+            self._on_handoff(record.step)
+        elif isinstance(record, LoadRefused):
+            self._on_refused(record)
 
     def _on_output(self, label: str, data: bytes) -> None:
         lines = _ANSI.sub("", data.decode("utf-8", "replace")).splitlines()
