@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 
     from mlaunch.engine.handlers import LaunchHandlers
     from mlaunch.engine.signals import SignalWatch
-    from mlaunch.engine.stopping import Shutdown
+    from mlaunch.engine.stopping import Stopping
     from mlaunch.engine.timers import Timers
     from mlaunch.plan.records import RecordStream
     from mlaunch.plan.steps import Deferred, Plan, ProcessSpec, Step
@@ -57,7 +57,7 @@ class Executor:
         records: RecordStream,
         timers: Timers,
         handlers: LaunchHandlers,
-        shutdown: Shutdown,
+        shutdown: Stopping,
         signals: SignalWatch,
         start: Callable[[ProcessSpec], object],
         resolve: Callable[[Deferred, object, bool | None], Plan],

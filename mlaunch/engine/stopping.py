@@ -1,8 +1,8 @@
 """How a run stops: the two-phase shutdown, holding a process back, the second Ctrl-C.
 
-``Shutdown`` is one object of the Supervisor (mlaunch.engine.supervisor) with state of its own:
+``Stopping`` is one object of the Supervisor (mlaunch.engine.supervisor) with state of its own:
 whether the run is shutting down and why, the processes held back from the stop ladder, the
-stop presses. What it acts on (the run's processes, their records, the stop ladder, the event
+stop presses. What it acts on (the run's processes, their states, the stop ladder, the record
 stream, the timers) is handed to it when it is made.
 """
 
@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from mlaunch.plan.records import RecordStream
 
 
-class Shutdown:
+class Stopping:
     """The shutdown of one run.
 
     ``processes`` and ``lingering`` are the supervisor's lists (kept up to date by it);

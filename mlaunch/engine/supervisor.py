@@ -21,7 +21,7 @@ terminal holds the children's pipes unread instead of losing lines. The per-labe
 (mlaunch.engine.process_state) is what the status view and the exit summary read. Signals are
 recorded by mlaunch.engine.signals, timers are mlaunch.engine.timers, the respawn policy is
 mlaunch.engine.respawn, the launch file's event handlers are mlaunch.engine.handlers, and the
-shutdown is its ``Shutdown`` (mlaunch.engine.stopping), the respawns its ``Respawns``, and the
+shutdown is its ``Stopping`` (mlaunch.engine.stopping), the respawns its ``Respawns``, and the
 plan's steps are carried out by its ``Executor`` (mlaunch.engine.executor).
 """
 
@@ -47,7 +47,7 @@ from mlaunch.engine.process_state import RESTARTING, RUNNING, STOPPED, ProcessSt
 from mlaunch.engine.reactor import PartSelector, Reactor, RunRecords
 from mlaunch.engine.respawn import Respawns
 from mlaunch.engine.signals import SignalWatch
-from mlaunch.engine.stopping import Shutdown, handle_signals
+from mlaunch.engine.stopping import Stopping, handle_signals
 from mlaunch.engine.strays import STRAY_GRACE, Strays, comm
 from mlaunch.engine.timers import Timer, Timers
 from mlaunch.plan.errors import EXIT_FAILURE, EXIT_INTERNAL, EXIT_OK
@@ -157,7 +157,7 @@ class Supervisor:
         self.selector = PartSelector(self._selector, self.reactor)
         self._index = itertools.count()
         self.exit_code = EXIT_OK
-        self.shutdown = Shutdown(
+        self.shutdown = Stopping(
             records=self.records,
             timers=self.timers,
             states=self.states,
@@ -205,11 +205,11 @@ class Supervisor:
         return self.shutdown.reason
 
     def begin_shutdown(self, reason: str, *, due_to_signal: int | None = None) -> None:
-        """Shut the launch down (``Shutdown.begin``): ShutdownBegun, then StoppingAll."""
+        """Shut the launch down (``Stopping.begin``): ShutdownBegun, then StoppingAll."""
         self.shutdown.begin(reason, due_to_signal=due_to_signal)
 
     def hold_stop(self, process: Process) -> None:
-        """Keep ``process`` out of the stop ladder until ``release_stop`` (``Shutdown.hold``)."""
+        """Keep ``process`` out of the stop ladder until ``release_stop`` (``Stopping.hold``)."""
         self.shutdown.hold(process)
 
     def release_stop(self, process: Process) -> None:
