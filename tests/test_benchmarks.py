@@ -321,3 +321,51 @@ def test_quick_run(tmp_path: Path, ros_env: dict[str, str]) -> None:
     imports = data["importtime"]["ros"]
     assert len(imports["top"]) == 10 and isinstance(imports["rclpy_imported"], bool)
     _check_table(done.stdout, rows)
+
+
+def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
+    """benchmarks/bisect_revs.py runs a revision's mlaunch from a temporary worktree (and
+    removes it): each round's sample has the launcher's CPU and both wall times."""
+    out = tmp_path / "bisect.json"
+
+    def worktrees() -> list[str]:
+        listed = subprocess.run(
+            ["git", "-C", str(REPO), "worktree", "list", "--porcelain"],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        return [line for line in listed.stdout.splitlines() if line.startswith("worktree ")]
+
+    before = worktrees()
+    argv = [sys.executable, str(BENCH / "bisect_revs.py"), "--runs", "2", "--n", "3"]
+    done = subprocess.run(
+        [*argv, "--json", str(out), "HEAD"], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert worktrees() == before
+    data = json.loads(out.read_text())
+    head = subprocess.run(
+        ["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True, text=True, check=True
+    ).stdout.strip()[:7]
+    [subject] = data["subjects"]
+    assert subject["label"] == head and len(subject["samples"]) == 2
+    for sample in subject["samples"]:
+        assert sample["cpu"] > 0 and 0 < sample["first"] <= sample["all"]
+    assert f"\n{head} " in done.stdout
+
+
+def test_bisect_spreads_revisions_over_the_history() -> None:
+    import bisect_revs
+
+    history = subprocess.run(
+        ["git", "-C", str(REPO), "rev-list", "--first-parent", "--max-count=5", "HEAD"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
+    if len(history) < 5:
+        pytest.skip("a shallow clone: fewer than 5 commits of history")
+    old, new = history[-1], history[0]
+    assert bisect_revs.spread(old, new, 2) == [old, history[2], new]
+    assert bisect_revs.spread(old, new, 10) == history[::-1]

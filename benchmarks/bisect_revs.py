@@ -1,0 +1,341 @@
+"""Which commit made start-up slower: several revisions of mlaunch side by side, in one run.
+
+    .venv/bin/python benchmarks/bisect_revs.py [--runs N] [--n 100] [--format py|yaml|xml]
+                                          [--ros2] [--json FILE] REV [REV ...]
+    .venv/bin/python benchmarks/bisect_revs.py --between OLD NEW --steps K [...]
+
+Each revision is checked out into a temporary worktree (``git worktree add --detach``, removed
+at the end) and run by this interpreter with ``PYTHONPATH`` at that tree, so nothing is
+reinstalled: the venv's packages are shared, only mlaunch's code differs. Every revision starts
+the same generated launch of N children (``ready_child.sh``, as ``run.py`` does); the rounds
+alternate the revisions (rotating the order each round, so a burst of load from elsewhere hits
+them all) and the table gives best and median over the rounds of:
+
+- CPU ms: user + system time of the launcher, read the moment the N-th child reports running:
+  mlaunch and every descendant running the same executable (its guard, a fork), each thread to
+  the nanosecond from ``schedstat`` plus the ticks of threads that already ended. On a shared
+  machine this is the figure to compare: it does not grow while the launcher waits for a core.
+- all ms: wall time from exec of the launcher to the N-th child running (confirms the CPU);
+- first ms: to the first child running.
+
+``--ros2`` adds the reference ros2 launch as one more column of the same rounds (the folder
+``scripts/reference`` built, or ``MLAUNCH_REFERENCE``), and the ratios of each revision to it.
+``--between OLD NEW --steps K`` measures K+1 revisions evenly spread over OLD..NEW's first-parent
+history (both ends included): bisect by narrowing it run after run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+if str(HERE) not in sys.path:
+    sys.path.insert(0, str(HERE))
+
+import launchgen as gen  # noqa: E402
+import probes as pr  # noqa: E402
+import run as bench  # noqa: E402
+from probes import BenchError  # noqa: E402
+
+# What pip writes as the ``mlaunch`` console script (entry point mlaunch.cli:program).
+LAUNCHER = """\
+import sys
+from mlaunch.cli import program
+sys.argv[0] = "mlaunch"
+sys.exit(program())
+"""
+
+
+@dataclass
+class Subject:
+    """One column of the rounds: a revision of mlaunch, or the reference ros2 launch."""
+
+    label: str
+    argv: list[str]
+    env: dict[str, str]
+    about: str
+    # SIGINT and wait for a clean exit after each run (ros2 launch needs tens of seconds to
+    # stop 100 children: it is killed, with its process group and every descendant, instead).
+    graceful: bool = True
+    samples: list[dict[str, float]] = field(default_factory=list)
+
+    def best(self, key: str) -> float:
+        return min(s[key] for s in self.samples)
+
+    def median(self, key: str) -> float:
+        return statistics.median(s[key] for s in self.samples)
+
+
+def git(*args: str) -> str:
+    done = subprocess.run(
+        ["git", "-C", str(REPO), *args], capture_output=True, text=True, check=True
+    )
+    return done.stdout.strip()
+
+
+def spread(old: str, new: str, steps: int) -> list[str]:
+    """steps+1 commits evenly spaced over old..new (first parent), old and new included."""
+    history = git("rev-list", "--first-parent", "--reverse", f"{old}..{new}").split()
+    chain = [git("rev-parse", old), *history]
+    if steps <= 0 or len(chain) <= steps + 1:
+        return chain
+    picks = [chain[round(i * (len(chain) - 1) / steps)] for i in range(steps + 1)]
+    return list(dict.fromkeys(picks))
+
+
+# --- the launcher's CPU ----------------------------------------------------------------------
+
+
+def _ticks(stat_path: str) -> int:
+    with open(stat_path) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])
+
+
+def process_cpu(pid: int) -> float:
+    """CPU seconds of one process: its live threads in ns, those that ended in ticks."""
+    live_ns = live_ticks = 0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/schedstat") as f:
+                live_ns += int(f.read().split()[0])
+            live_ticks += _ticks(f"/proc/{pid}/task/{tid}/stat")
+        except (FileNotFoundError, ProcessLookupError):
+            continue  # ended between listdir and open: its time is in the ticks below
+    dead = max(0, _ticks(f"/proc/{pid}/stat") - live_ticks)
+    return live_ns / 1e9 + dead / pr.CLK_TCK
+
+
+def descendants(pid: int) -> list[int]:
+    """Every live descendant of pid (children lists of every thread, recursively)."""
+    found: list[int] = []
+    todo = [pid]
+    while todo:
+        parent = todo.pop()
+        try:
+            tids = os.listdir(f"/proc/{parent}/task")
+        except FileNotFoundError:
+            continue
+        for tid in tids:
+            try:
+                with open(f"/proc/{parent}/task/{tid}/children") as f:
+                    kids = [int(k) for k in f.read().split()]
+            except FileNotFoundError:
+                continue
+            found.extend(kids)
+            todo.extend(kids)
+    return found
+
+
+def launcher_cpu(pid: int) -> float:
+    """CPU seconds of the launcher and its descendants running the same executable."""
+    total = process_cpu(pid)
+    exe = os.readlink(f"/proc/{pid}/exe")
+    for kid in descendants(pid):
+        try:
+            if os.readlink(f"/proc/{kid}/exe") == exe:
+                total += process_cpu(kid)
+        except (FileNotFoundError, PermissionError):
+            continue
+    return total
+
+
+# --- one run ---------------------------------------------------------------------------------
+
+
+def one_run(subject: Subject, n: int, fifo: Path, out_file: Path) -> dict[str, float]:
+    probe = pr.ReadyProbe(fifo).open()
+    with open(out_file, "wb") as out:
+        proc = pr.launch(subject.argv, subject.env, stdout=out.fileno(), stderr=subprocess.STDOUT)
+    try:
+        try:
+            first, last = probe.wait_ready(n, proc, time.perf_counter() + 30 + n / 10)
+            cpu = launcher_cpu(proc.pid)
+            if subject.graceful:
+                pr.stop_and_time(proc, probe, signal.SIGINT, 30.0)
+        except BenchError as e:
+            tail = bench.one_line(out_file.read_text(errors="replace"))
+            raise BenchError(f"{subject.label}: {e}; output: {tail}") from None
+        return {"cpu": cpu, "all": last - proc.started, "first": first - proc.started}
+    finally:
+        proc.kill()
+        probe.close()
+        pr.kill_descendants()
+
+
+# --- the subjects ----------------------------------------------------------------------------
+
+
+def revision_subject(rev: str, trees: Path, env: dict[str, str], launch: Path) -> Subject:
+    sha = git("rev-parse", "--verify", f"{rev}^{{commit}}")
+    tree = trees / sha[:10]
+    if not tree.exists():
+        git("worktree", "add", "--detach", "--quiet", str(tree), sha)
+    script = tree / ".bisect-mlaunch"
+    script.write_text(LAUNCHER)
+    subject_env = {**env, "PYTHONPATH": str(tree)}
+    title = git("log", "-1", "--format=%s", sha)
+    return Subject(sha[:7], [sys.executable, str(script), str(launch)], subject_env, title)
+
+
+def reference_subject(env: dict[str, str], launch: Path) -> Subject:
+    """ros2 launch as a user runs it: env.sh sourced, then ``ros2 launch FILE``."""
+    home = os.environ.get("MLAUNCH_REFERENCE")
+    if not home:
+        setup = os.environ.get("MLAUNCH_REFERENCE_SETUP", "")
+        built = subprocess.run(
+            [str(REPO / "scripts" / "reference"), setup], capture_output=True, text=True
+        )
+        if built.returncode != 0:
+            raise SystemExit(
+                "bisect_revs: --ros2 needs the reference ros2 launch: set MLAUNCH_REFERENCE=FOLDER"
+                " (what scripts/reference SETUP_SH prints) or MLAUNCH_REFERENCE_SETUP=SETUP_SH;"
+                f" scripts/reference said: {bench.one_line(built.stderr)}"
+            )
+        home = built.stdout.strip()
+    env_sh = Path(home) / "env.sh"
+    dumped = subprocess.run(
+        ["bash", "-c", f"source {shlex.quote(str(env_sh))} && env -0"],
+        env=env,
+        capture_output=True,
+        check=True,
+    ).stdout
+    ref_env = dict(item.split("=", 1) for item in dumped.decode().split("\0") if "=" in item)
+    ros2 = Path(home) / "venv" / "bin" / "ros2"
+    argv = [str(ros2), "launch", str(launch)]
+    return Subject("ros2", argv, ref_env, f"ros2 launch ({home})", graceful=False)
+
+
+# --- the table -------------------------------------------------------------------------------
+
+
+def table(subjects: Sequence[Subject], ref: Subject | None, meta: dict[str, object]) -> str:
+    lines = [
+        f"N={meta['n']} children ({meta['format']}), {meta['runs']} rounds after a warm-up;"
+        f" load average {meta['load_before']} -> {meta['load_after']}",
+        "",
+    ]
+    head = f"{'rev':8} {'CPU ms best/med':>16} {'all ms best/med':>16} {'first ms':>9}"
+    if ref is not None:
+        head += f" {'CPU/ros2':>9} {'all/ros2':>9}"
+    lines.append(head + "  subject")
+    for s in [*subjects, ref] if ref is not None else subjects:
+        row = (
+            f"{s.label:8} {s.best('cpu') * 1e3:7.1f}/{s.median('cpu') * 1e3:7.1f}"
+            f"  {s.best('all') * 1e3:7.1f}/{s.median('all') * 1e3:7.1f}"
+            f" {s.best('first') * 1e3:9.1f}"
+        )
+        if ref is not None:
+            row += (
+                f" {s.median('cpu') / ref.median('cpu'):9.3f}"
+                f" {s.median('all') / ref.median('all'):9.3f}"
+            )
+        lines.append(row + "  " + s.about[:70])
+    return "\n".join(lines) + "\n"
+
+
+def parse_args(argv: Sequence[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(prog="bisect_revs.py", description=__doc__.split("\n\n")[0])
+    p.add_argument("revs", nargs="*", help="revisions to compare (any git revision)")
+    p.add_argument("--between", nargs=2, metavar=("OLD", "NEW"))
+    p.add_argument("--steps", type=int, default=8, help="with --between: K+1 revisions")
+    p.add_argument("--runs", type=int, default=7, help="rounds after the warm-up (7)")
+    p.add_argument("--n", type=int, default=100, help="children in the launch (100)")
+    p.add_argument("--format", choices=gen.FORMATS, default="py")
+    p.add_argument("--ros2", action="store_true", help="add the reference ros2 launch")
+    p.add_argument("--json", help="also write the samples as JSON to FILE")
+    args = p.parse_args(argv)
+    if not args.revs and not args.between:
+        p.error("name revisions, or --between OLD NEW")
+    return args
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)  # the children stop on SIGINT
+    revs = list(args.revs)
+    if args.between:
+        revs += spread(args.between[0], args.between[1], args.steps)
+    pr.become_subreaper()
+    tmp = Path(tempfile.mkdtemp(prefix="mlaunch-bisect-"))
+    trees = tmp / "trees"
+    trees.mkdir()
+    try:
+        env = bench.measured_env(dict(os.environ), tmp / "logs")
+        scripts = gen.write_child_scripts(tmp / "bin")
+        fifo, out_file = tmp / "ready.fifo", tmp / "out.txt"
+        child = [str(scripts.ready), str(fifo)]
+        launch = gen.write(
+            [gen.many_children(f"start_{args.n}", args.n, child)], args.format, tmp / "launch"
+        )
+        subjects = [revision_subject(rev, trees, env, launch) for rev in dict.fromkeys(revs)]
+        ref = None
+        if args.ros2:
+            with bench.ros_domain(None) as domain:
+                ref = reference_subject({**env, "ROS_DOMAIN_ID": str(domain)}, launch)
+                return measure(args, [*subjects, ref], subjects, ref, fifo, out_file)
+        return measure(args, subjects, subjects, ref, fifo, out_file)
+    finally:
+        pr.kill_descendants()
+        for tree in trees.iterdir():
+            subprocess.run(
+                ["git", "-C", str(REPO), "worktree", "remove", "--force", str(tree)],
+                capture_output=True,
+            )
+        subprocess.run(["git", "-C", str(REPO), "worktree", "prune"], capture_output=True)
+        subprocess.run(["rm", "-rf", str(tmp)], check=False)
+
+
+def measure(
+    args: argparse.Namespace,
+    columns: list[Subject],
+    revisions: list[Subject],
+    ref: Subject | None,
+    fifo: Path,
+    out_file: Path,
+) -> int:
+    load_before = [round(x, 2) for x in os.getloadavg()]
+    for round_no in range(args.runs + 1):  # round 0 warms up (bytecode, caches)
+        shift = round_no % len(columns)
+        for subject in columns[shift:] + columns[:shift]:
+            one = one_run(subject, args.n, fifo, out_file)
+            if round_no:
+                subject.samples.append(one)
+        print(f"round {round_no}/{args.runs} done", file=sys.stderr, flush=True)
+    meta: dict[str, object] = {
+        "n": args.n,
+        "format": args.format,
+        "runs": args.runs,
+        "load_before": load_before,
+        "load_after": [round(x, 2) for x in os.getloadavg()],
+        "python": sys.executable,
+    }
+    sys.stdout.write(table(revisions, ref, meta))
+    if args.json:
+        document = {
+            "meta": meta,
+            "subjects": [
+                {"label": s.label, "about": s.about, "samples": s.samples}
+                for s in ([*revisions, ref] if ref else revisions)
+            ],
+        }
+        Path(args.json).write_text(json.dumps(document, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
