@@ -9,6 +9,7 @@ process and no folder, and a host whose launch dies at once is reported failed.
 
 from __future__ import annotations
 
+import getpass
 import json
 import os
 import re
@@ -60,7 +61,7 @@ def generate_launch_description():
 def recap(output: str) -> dict[str, dict[str, int]]:
     """PLAY RECAP's counts per host."""
     out = {}
-    for host, counts in re.findall(r"^(r\d)\s+:\s+(ok=.*)$", output, re.M):
+    for host, counts in re.findall(r"^(r\d|local)\s+:\s+(ok=.*)$", output, re.M):
         out[host] = {k: int(v) for k, v in re.findall(r"(\w+)=(\d+)", counts)}
     return out
 
@@ -79,26 +80,38 @@ def talkers() -> list[str]:
     return found
 
 
-@pytest.fixture
-def robots(tmp_path: Path) -> object:
+@pytest.fixture(scope="module")
+def robots(tmp_path_factory: pytest.TempPathFactory) -> object:
+    """Two sshd daemons on 127.0.0.1, reached as the ssh aliases r1 and r2 (each server's own
+    client configuration names it): the module's tests share them."""
     servers = []
     try:
         for name in ("r1", "r2"):
-            root = tmp_path / f"sshd-{name}"
-            root.mkdir()
-            servers.append(sshd.start(root, alias=name))
+            servers.append(sshd.start(tmp_path_factory.mktemp(f"sshd-{name}"), alias=name))
         yield servers
     finally:
         for server in servers:
             sshd.stop(server)
 
 
+def fleet_vars(path: Path, ros_env: dict[str, str]) -> dict[str, object]:
+    """The inventory's variables for every host: this mlaunch, a folder under the test's, one
+    shared ROS domain, the system's Python for Ansible's modules."""
+    names = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMENTATION")
+    environment: dict[str, str] = {k: ros_env[k] for k in names if k in ros_env}
+    return {
+        "mlaunch": str(MLAUNCH),
+        "install_root": str(path.parent / "robots"),
+        "ready_timeout": 90,
+        "launch_environment": environment,
+        "ansible_python_interpreter": PYTHON,
+    }
+
+
 def inventory(
     path: Path, servers: list[sshd.Server], ros_env: dict[str, str], hosts: dict[str, dict]
 ) -> Path:
     """r1 and r2 on their own servers; r3 on r2's (one computer, two inventory names)."""
-    names = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMENTATION")
-    environment: dict[str, str] = {k: ros_env[k] for k in names if k in ros_env}
     server_of = {"r1": servers[0], "r2": servers[1], "r3": servers[1]}
     data = {
         "all": {
@@ -110,13 +123,7 @@ def inventory(
                 }
                 for name, arguments in hosts.items()
             },
-            "vars": {
-                "mlaunch": str(MLAUNCH),
-                "install_root": str(path.parent / "robots"),
-                "ready_timeout": 90,
-                "launch_environment": environment,
-                "ansible_python_interpreter": PYTHON,
-            },
+            "vars": fleet_vars(path, ros_env),
         }
     }
     path.write_text(json.dumps(data, indent=2))
@@ -147,6 +154,18 @@ def play(out: Path, inv: Path, book: str, *extra: str) -> subprocess.CompletedPr
     )
 
 
+def export(tmp_path: Path, name: str, text: str) -> Path:
+    """``text`` as launch/NAME.launch.py, exported to NAME/ (its programs are this venv's)."""
+    launch = tmp_path / "launch" / f"{name}.launch.py"
+    launch.parent.mkdir()
+    launch.write_text(text)
+    out = tmp_path / name
+    done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), "--allow-standins",
+                       env=clean_env())  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return out
+
+
 def test_an_export_of_programs_only_this_computer_has_is_refused_unless_allowed(
     tmp_path: Path,
 ) -> None:
@@ -169,13 +188,7 @@ def test_an_export_of_programs_only_this_computer_has_is_refused_unless_allowed(
 def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     tmp_path: Path, ros_env: dict[str, str], robots: list[sshd.Server]
 ) -> None:
-    launch = tmp_path / "launch" / "fleet.launch.py"
-    launch.parent.mkdir()
-    launch.write_text(LAUNCH)
-    out = tmp_path / "fleet"
-    done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), "--allow-standins",
-                       env=clean_env())  # fmt: skip
-    assert done.returncode == 0, done.stderr
+    out = export(tmp_path, "fleet", LAUNCH)
     root = tmp_path / "robots" / "fleet"
     # Each robot's readiness includes the other's node: both pass only in one shared graph.
     # r3's launch dies at once.
@@ -224,7 +237,28 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     assert not root.exists(), list(root.rglob("*"))
 
 
-def test_a_launch_with_machines_is_said_to_go_to_one_host(tmp_path: Path) -> None:
+SPLIT = f"""\
+import sys
+from launch import LaunchDescription
+from launch_ros.actions import Node
+from mlaunch.actions import Machine
+
+def talker(namespace, **machine):
+    return Node(executable=sys.executable, arguments=[{str(TALKER)!r}], name="talker",
+                namespace=namespace, exec_name="talker", **machine)
+
+def generate_launch_description():
+    return LaunchDescription([
+        Machine(name="r1", address="r1"),
+        Machine(name="r2", address="r2", user="{getpass.getuser()}"),
+        talker("r1", machine="r1"),
+        talker("r2", machine="r2"),
+        talker("base"),
+    ])
+"""
+
+
+def test_a_launch_with_machines_is_split_one_host_per_machine(tmp_path: Path) -> None:
     launch = tmp_path / "machines.launch.py"
     launch.write_text(
         "from launch import LaunchDescription\n"
@@ -232,7 +266,8 @@ def test_a_launch_with_machines_is_said_to_go_to_one_host(tmp_path: Path) -> Non
         "from mlaunch.actions import Machine\n"
         "def generate_launch_description():\n"
         "    return LaunchDescription([\n"
-        "        Machine(name='gpu', address='gpu-alias'),\n"
+        "        Machine(name='gpu', address='gpu-box.local', user='ros', ssh_port=2200),\n"
+        "        Machine(name='idle', address='idle-alias'),\n"
         "        ExecuteProcess(cmd=['sleep', '9'], name='here'),\n"
         "        ExecuteProcess(cmd=['sleep', '9'], name='there', machine='gpu'),\n"
         "    ])\n"
@@ -240,9 +275,79 @@ def test_a_launch_with_machines_is_said_to_go_to_one_host(tmp_path: Path) -> Non
     out = tmp_path / "out"
     done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), env=clean_env())
     assert done.returncode == 0, done.stderr
-    assert "declares machines (gpu)" in done.stderr and "-e hosts=NAME" in done.stderr
-    assert "declares machines (gpu)" in (out / "README.md").read_text()
-    exported = json.loads((out / "export.yml").read_text().split("\n", 1)[1])
-    assert exported["mlaunch_export"]["launch"] == "machines.launch.py"
+    hosts = json.loads(strip_comments((out / "inventory.yml").read_text()))["all"]["hosts"]
+    assert hosts == {
+        "local": {"ansible_host": "192.0.2.10", "mlaunch_machine": "local"},
+        "gpu": {
+            "ansible_host": "gpu-box.local",
+            "ansible_user": "ros",
+            "ansible_port": 2200,
+            "mlaunch_machine": "gpu",
+        },
+    }
+    exported = json.loads(strip_comments((out / "export.yml").read_text()))
+    assert exported["mlaunch_export"]["shares"] == ["local", "gpu"]
+    assert "machine(s) idle start no process at launch" in done.stderr
+    assert "split by machine" in (out / "README.md").read_text()
     assert (out / "files" / "launch" / "machines.launch.py").read_text() == launch.read_text()
     assert not (out / "files" / "launch" / "out").exists()  # the export is not copied into itself
+
+
+def strip_comments(text: str) -> str:
+    return "\n".join(line for line in text.splitlines() if not line.startswith("#"))
+
+
+@pytest.mark.timeout(400)  # two playbook runs: about a minute on a loaded 2-core machine
+def test_a_launch_split_by_machine_runs_each_share_on_its_host(
+    tmp_path: Path, ros_env: dict[str, str], robots: list[sshd.Server]
+) -> None:
+    out = export(tmp_path, "split", SPLIT)
+    # The exported inventory as it is, with what reaches the test's daemons added: 'local' (the
+    # processes given no machine) on r1's computer too, in a folder of its own.
+    data = json.loads(strip_comments((out / "inventory.yml").read_text()))
+    hosts = data["all"]["hosts"]
+    assert {h: v.get("ansible_host") for h, v in hosts.items()} == {
+        "r1": "r1", "r2": "r2", "local": "192.0.2.10"
+    }  # fmt: skip
+    assert hosts["r2"]["ansible_user"] == getpass.getuser()
+    hosts["local"]["ansible_host"] = "r1"
+    # Each host's readiness waits for another host's node: all ready means one ROS graph.
+    peers = {"r1": "/r2/talker", "r2": "/base/talker", "local": "/r1/talker"}
+    for name, server in (("r1", robots[0]), ("r2", robots[1]), ("local", robots[0])):
+        hosts[name]["ansible_ssh_common_args"] = f"-F {server.client_config}"
+        hosts[name]["launch_arguments"] = {"mlaunch_expect_peer": f"node {peers[name]}"}
+    data["all"]["vars"] = fleet_vars(tmp_path / "inventory.yml", ros_env)
+    inv = tmp_path / "inventory.yml"
+    inv.write_text(json.dumps(data, indent=2))
+    root = tmp_path / "robots" / "split"
+
+    started = time.monotonic()
+    deployed = play(out, inv, "deploy.yml")
+    took = time.monotonic() - started
+    try:
+        assert deployed.returncode == 0, deployed.stdout + deployed.stderr
+        counts = recap(deployed.stdout)
+        assert sorted(counts) == ["local", "r1", "r2"], deployed.stdout
+        assert all(c["failed"] == 0 for c in counts.values()), deployed.stdout
+        for host in ("r1", "r2", "local"):
+            assert re.search(rf'"msg": "{host}: ready: ', deployed.stdout), deployed.stdout
+        # Each host runs exactly its share: one talker each, started in its own folder by
+        # an mlaunch that runs its --machine.
+        running: dict[str, list[list[str]]] = {}
+        for line in talkers():
+            pid, *argv = line.split()
+            host = os.path.basename(os.readlink(f"/proc/{pid}/cwd"))
+            running.setdefault(host, []).append(argv)
+        namespace = {"r1": "/r1", "r2": "/r2", "local": "/base"}
+        assert sorted(running) == ["local", "r1", "r2"], running
+        for host, argvs in running.items():
+            assert argvs == [[sys.executable, str(TALKER), "--ros-args", "-r", "__node:=talker",
+                              "-r", f"__ns:={namespace[host]}"]], (host, argvs)  # fmt: skip
+            command = (root / host / "command").read_text()
+            assert f" --machine {host}" in command, command
+        print(f"deploy of a launch split over three hosts: {took:.1f} s")
+    finally:
+        down = play(out, inv, "teardown.yml")
+    assert down.returncode == 0, down.stdout + down.stderr
+    assert wait_until(lambda: not talkers(), 30), talkers()
+    assert not root.exists(), list(root.rglob("*"))

@@ -15,6 +15,10 @@ hosts on one computer (a simulated fleet) never see each other's run. The superv
 (``--user``, or the system's as root) when PID 1 is systemd, else mlaunch itself, detached, with
 its guard (mlaunch kills what it started when it is killed). Idempotent: a host whose launch is
 up with the same files and arguments is left alone; a change of either restarts it.
+
+A launch that declares machines is split by machine: the example inventory has one host per
+share (each machine with processes, and ``local`` for those given no machine), and each host
+runs only its share (``mlaunch FILE --machine SHARE``, mlaunch.resolve.shares).
 """
 
 from __future__ import annotations
@@ -26,12 +30,14 @@ import sys
 
 from mlaunch.export.bundle import check_portable, copy_launch_tree, stem
 from mlaunch.plan.errors import MlaunchError, UsageError
+from mlaunch.plan.machine import LOCAL_SHARE
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     import argparse
 
     from mlaunch.app.options import Options
+    from mlaunch.plan.machine import MachineSpec
     from mlaunch.plan.steps import ProcessSpec
 
 # The plays, as mlaunch ships them (mlaunch/export/playbook/), copied into the export.
@@ -39,13 +45,18 @@ PLAYBOOK = os.path.join(os.path.dirname(os.path.abspath(__file__)), "playbook")
 PLAYBOOK_FILES = ("deploy.yml", "teardown.yml", "vars.yml", "tasks/facts.yml", "tasks/stop.yml")
 
 
-def inventory_text(name: str) -> str:
+def inventory_text(name: str, shares: dict[str, MachineSpec | None] | None = None) -> str:
+    """The example inventory: two robots; for a launch split by machine, one host per share
+    (named by its machine, with its address, user and ssh port as the machine says them)."""
+    hosts: dict[str, dict[str, object]] = {
+        "robot1": {"ansible_host": "192.0.2.11", "launch_arguments": {}},
+        "robot2": {"ansible_host": "192.0.2.12", "launch_arguments": {}},
+    }
+    if shares:
+        hosts = {share: _host_vars(machine) for share, machine in shares.items()}
     example = {
         "all": {
-            "hosts": {
-                "robot1": {"ansible_host": "192.0.2.11", "launch_arguments": {}},
-                "robot2": {"ansible_host": "192.0.2.12", "launch_arguments": {}},
-            },
+            "hosts": hosts,
             "vars": {
                 "mlaunch": "mlaunch",
                 "install_root": "mlaunch-fleet",
@@ -64,10 +75,52 @@ def inventory_text(name: str) -> str:
         "#   ready_timeout       seconds wait-ready waits (default: 60)\n"
         "#   supervisor          detached | systemd-user | systemd-system (default: found)\n"
     )
+    if shares:
+        head += (
+            "#   mlaunch_machine     the share of the launch the host runs (mlaunch --machine):\n"
+            "#                       a machine of the launch, or 'local' for the processes given\n"
+            "#                       no machine (default: the host's inventory name)\n"
+            "# One host per machine of the launch, each running only its processes; their\n"
+            "# address, user and ssh port as the launch declares the machine. 'local' runs the\n"
+            "# processes given no machine: set its address (192.0.2.10 is a placeholder), or\n"
+            "# ansible_connection: local to run them where ansible-playbook runs.\n"
+        )
     return head + json.dumps(example, indent=2) + "\n"
 
 
-def export_text(name: str, launch: str, arguments: dict[str, str], specs: list[ProcessSpec]) -> str:
+def _host_vars(machine: MachineSpec | None) -> dict[str, object]:
+    if machine is None:  # the local share: the computer that launched before the split
+        return {"ansible_host": "192.0.2.10", "mlaunch_machine": LOCAL_SHARE}
+    out: dict[str, object] = {"ansible_host": machine.address}
+    if machine.user:
+        out["ansible_user"] = machine.user
+    if machine.ssh_port:
+        out["ansible_port"] = machine.ssh_port
+    out["mlaunch_machine"] = machine.name
+    return out
+
+
+def shares_of(
+    specs: list[ProcessSpec], declared: dict[str, MachineSpec]
+) -> dict[str, MachineSpec | None]:
+    """The shares of a launch with machines, each with its machine (None for ``local``), in the
+    order of their first process; empty for a launch without machines (it is not split)."""
+    if not declared:
+        return {}
+    out: dict[str, MachineSpec | None] = {}
+    for spec in specs:
+        share = LOCAL_SHARE if spec.machine is None else spec.machine.name
+        out.setdefault(share, None if spec.machine is None else declared.get(share, spec.machine))
+    return out
+
+
+def export_text(
+    name: str,
+    launch: str,
+    arguments: dict[str, str],
+    specs: list[ProcessSpec],
+    shares: list[str] | None = None,
+) -> str:
     ladder = max((s.sigterm_timeout + s.sigkill_timeout for s in specs), default=10.0)
     data = {
         "mlaunch_export": {
@@ -76,13 +129,17 @@ def export_text(name: str, launch: str, arguments: dict[str, str], specs: list[P
             "arguments": arguments,
             "stop_seconds": round(ladder + 10.0, 3),
             "start_seconds": 120,
+            # a launch with machines: each host runs one of these (mlaunch --machine)
+            "shares": shares or [],
         }
     }
     head = "# Written by mlaunch export: what the export fixed (the plays read it).\n"
     return head + json.dumps(data, indent=2) + "\n"
 
 
-def readme_text(name: str, launch: str, out_dir: str, warnings: list[str]) -> str:
+def readme_text(
+    name: str, launch: str, out_dir: str, warnings: list[str], shares: list[str] | None = None
+) -> str:
     where = shlex.quote(out_dir)
     lines = [
         f"# {name}: {launch} for a fleet, through Ansible",
@@ -103,6 +160,16 @@ def readme_text(name: str, launch: str, out_dir: str, warnings: list[str]) -> st
         " the ROS 2 packages the launch runs, and the environment to find them"
         " (`launch_environment`).",
     ]
+    if shares:
+        lines += [
+            "",
+            f"The launch declares machines, so it is split by machine: inventory.yml lists one"
+            f" host per share ({', '.join(shares)}), each running only its own processes"
+            " (`mlaunch FILE --machine SHARE`; the host variable `mlaunch_machine`, by default"
+            " the host's inventory name), with the address, user and ssh port the launch gives"
+            " the machine. `local` runs the processes given no machine. The hosts share one ROS"
+            " graph through `launch_environment` (the same ROS_DOMAIN_ID on each).",
+        ]
     if warnings:
         lines += ["", "## Warnings", ""] + [f"- {w}" for w in warnings]
     return "\n".join(lines) + "\n"
@@ -127,7 +194,7 @@ def export_ansible(opts: Options, settings: argparse.Namespace, out_dir: str) ->
     name = unit_name(settings.name or stem(path))
     temp_dir = private_temp_dir()
     try:
-        plan, _options, _labels = pipeline.resolve_for_run(
+        plan, _options, labels = pipeline.resolve_for_run(
             opts, path, description, temp_dir=temp_dir, log_dir=""
         )
     finally:
@@ -137,22 +204,27 @@ def export_ansible(opts: Options, settings: argparse.Namespace, out_dir: str) ->
         raise MlaunchError(f"{path}: the launch starts no process; nothing to export")
     warnings = list(plan.warnings)
     check_portable(specs, settings.allow_standins, warnings)
-    machines = sorted(
-        {s.machine.name for s in specs if s.machine is not None and not s.machine.local}
-    )
-    if machines:
-        # Each host would run the whole launch, SSH to the machines included: twice with two.
+    declared: dict[str, MachineSpec] = labels.run_state.get("machines") or {}
+    if LOCAL_SHARE in declared:
+        raise MlaunchError(
+            f"{path}: the launch declares a machine named {LOCAL_SHARE!r}, which names the"
+            " processes given no machine in a split by machine; rename that machine",
+            where=declared[LOCAL_SHARE].origin or None,
+        )
+    shares = shares_of(specs, declared)
+    unused = sorted(set(declared) - set(shares))
+    if unused:
         warnings.append(
-            f"the launch declares machines ({', '.join(machines)}): each host it is deployed to"
-            " runs the whole launch and starts their processes over SSH itself, so deploy it to"
-            " one host (-e hosts=NAME); the plays do not split a launch by machine"
+            f"machine(s) {', '.join(unused)} start no process at launch: no host of the"
+            " inventory runs them (a process a timer or a handler starts there later runs"
+            " in its machine's share: add a host with mlaunch_machine set to it)"
         )
     launch = os.path.basename(path)
     texts = {name: _read(os.path.join(PLAYBOOK, name)) for name in PLAYBOOK_FILES}
     texts |= {
-        "inventory.yml": inventory_text(name),
-        "export.yml": export_text(name, launch, dict(opts.arguments), specs),
-        "README.md": readme_text(name, launch, out_dir, warnings),
+        "inventory.yml": inventory_text(name, shares),
+        "export.yml": export_text(name, launch, dict(opts.arguments), specs, list(shares)),
+        "README.md": readme_text(name, launch, out_dir, warnings, list(shares)),
     }
     folder = Folder.open(out_dir, force=settings.force)
     try:
