@@ -66,16 +66,18 @@ def recap(output: str) -> dict[str, dict[str, int]]:
     return out
 
 
-def talkers() -> list[str]:
-    """The test's talkers running anywhere on this computer: pid and command line."""
+def talkers(root: Path) -> list[str]:
+    """The test's talkers running on this computer, started in a host folder under ``root``
+    (the test's own: the module's other test may run beside it): pid and command line."""
     found = []
     for pid in filter(str.isdigit, os.listdir("/proc")):
         try:
             argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+            cwd = os.readlink(f"/proc/{pid}/cwd")  # (its folder may be removed: " (deleted)")
         except OSError:
             continue
         words = [w.decode(errors="replace") for w in argv if w]
-        if str(TALKER) in words:
+        if str(TALKER) in words and cwd.startswith(f"{root}{os.sep}"):
             found.append(f"{pid} {' '.join(words)}")
     return found
 
@@ -202,7 +204,7 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     checked = play(out, inv, "deploy.yml", "--check")
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert all(c["changed"] > 0 for c in recap(checked.stdout).values()), checked.stdout
-    assert not talkers() and not root.exists()  # check mode starts and writes nothing
+    assert not talkers(root) and not root.exists()  # check mode starts and writes nothing
 
     started = time.monotonic()
     deployed = play(out, inv, "deploy.yml")
@@ -215,7 +217,7 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
         assert re.search(r'"msg": "r1: ready: 3 checks met', deployed.stdout), deployed.stdout
         assert re.search(r'"msg": "r2: ready: 3 checks met', deployed.stdout), deployed.stdout
         assert "ended before it was ready" in deployed.stdout, deployed.stdout
-        running = talkers()
+        running = talkers(root)
         assert len(running) == 2, running
         assert any("__ns:=/r1" in t and "__node:=talker" in t for t in running), running
         assert any("__ns:=/r2" in t and "__node:=talker" in t for t in running), running
@@ -229,11 +231,11 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
         assert counts["r1"]["changed"] == counts["r2"]["changed"] == 0, again.stdout
         assert counts["r1"]["failed"] == counts["r2"]["failed"] == 0, again.stdout
         assert counts["r3"]["failed"] == 1, again.stdout  # started again, dead again
-        assert sorted(talkers()) == sorted(running)  # the same processes, untouched
+        assert sorted(talkers(root)) == sorted(running)  # the same processes, untouched
     finally:
         down = play(out, inv, "teardown.yml")
     assert down.returncode == 0, down.stdout + down.stderr
-    assert wait_until(lambda: not talkers(), 30), talkers()
+    assert wait_until(lambda: not talkers(root), 30), talkers(root)
     assert not root.exists(), list(root.rglob("*"))
 
 
@@ -334,7 +336,7 @@ def test_a_launch_split_by_machine_runs_each_share_on_its_host(
         # Each host runs exactly its share: one talker each, started in its own folder by
         # an mlaunch that runs its --machine.
         running: dict[str, list[list[str]]] = {}
-        for line in talkers():
+        for line in talkers(root):
             pid, *argv = line.split()
             host = os.path.basename(os.readlink(f"/proc/{pid}/cwd"))
             running.setdefault(host, []).append(argv)
@@ -349,5 +351,5 @@ def test_a_launch_split_by_machine_runs_each_share_on_its_host(
     finally:
         down = play(out, inv, "teardown.yml")
     assert down.returncode == 0, down.stdout + down.stderr
-    assert wait_until(lambda: not talkers(), 30), talkers()
+    assert wait_until(lambda: not talkers(root), 30), talkers(root)
     assert not root.exists(), list(root.rglob("*"))
