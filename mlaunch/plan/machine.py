@@ -5,7 +5,6 @@ from __future__ import annotations
 import itertools
 import os
 
-from mlaunch.plan.steps import SHARE
 from mlaunch.plan.value import Value
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
@@ -171,27 +170,19 @@ def check_name(name: str) -> str | None:
 LOCAL_SHARE = "local"
 
 
-def share_of(run_state: dict[str, Any]) -> str | None:
-    """The share this run starts (``--machine NAME``), or None: the whole launch."""
-    share: str | None = run_state.get(SHARE)
-    return share
-
-
 def machine_name(machine: MachineSpec | None) -> str:
     """The share a process of ``machine`` belongs to: the machine's name, else ``local``."""
     return LOCAL_SHARE if machine is None else machine.name
 
 
-def placed(
-    run_state: dict[str, Any], machine: MachineSpec | None
-) -> tuple[MachineSpec | None, bool]:
+def placed(share: str | None, machine: MachineSpec | None) -> tuple[MachineSpec | None, bool]:
     """(the machine a process runs on as this run sees it, whether it runs elsewhere).
 
-    Without ``--machine`` nothing changes. With it, a process of the chosen share runs here,
-    without ssh (this run is on that machine: its machine is marked local), and a process of
-    another share is elsewhere: this run does not start it.
+    ``share`` is the one this run starts (``--machine NAME``: the run state's
+    ``plan.steps.SHARE``), None for the whole launch: then nothing changes. With it, a process
+    of the chosen share runs here, without ssh (this run is on that machine: its machine is
+    marked local), and a process of another share is elsewhere: this run does not start it.
     """
-    share = run_state.get(SHARE)
     if share is None:
         return machine, False
     if machine_name(machine) != share:
@@ -203,7 +194,6 @@ def placed(
     return MachineSpec(**values), False
 
 
-def runs_elsewhere(run_state: dict[str, Any], machine: MachineSpec | None) -> bool:
-    """Whether a process of ``machine`` belongs to another share than this run's."""
-    share = run_state.get(SHARE)
+def runs_elsewhere(share: str | None, machine: MachineSpec | None) -> bool:
+    """Whether a process of ``machine`` belongs to another share than ``share``, this run's."""
     return share is not None and machine_name(machine) != share

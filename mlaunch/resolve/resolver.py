@@ -400,7 +400,7 @@ def _share_spawn(run_state: dict[str, Any], spec: ProcessSpec) -> Step:
     """
     from mlaunch.plan.machine import machine_name, runs_elsewhere
 
-    elsewhere = runs_elsewhere(run_state, spec.machine)
+    elsewhere = runs_elsewhere(run_state.get(SHARE), spec.machine)
     node = spec.node.fully_qualified_name if spec.node is not None else None
     if node:
         run_state.setdefault(SHARE_NODES, {})[node] = not elsewhere
@@ -421,14 +421,14 @@ def _share_handoff(run_state: dict[str, Any], step: Handoff) -> Step:
     """A load into a container (a Handoff with a ``target`` node) is the container's share's:
     an Elsewhere step in the other shares. A container the launch does not start (loaded into
     by name) is the local share's, so that one run loads it, not every machine's."""
-    from mlaunch.plan.machine import LOCAL_SHARE, share_of
+    from mlaunch.plan.machine import LOCAL_SHARE
 
     target = getattr(step, "target", None)
     if not isinstance(target, str):
         return step
     here = run_state.get(SHARE_NODES, {}).get(target)
     if here is None:
-        here = share_of(run_state) == LOCAL_SHARE
+        here = run_state.get(SHARE) == LOCAL_SHARE
     return step if here else Elsewhere(step.origin, "", step=step)
 
 

@@ -220,7 +220,7 @@ class ExecuteProcess(Action):
         if SHARE in context.run_state:  # --machine NAME: this run starts one machine's share
             from mlaunch.plan.machine import placed
 
-            machine, elsewhere = placed(context.run_state, machine)
+            machine, elsewhere = placed(context.run_state[SHARE], machine)
         # Another computer's programs are found there (the ssh agent's lookup, or its share's run)
         remote = elsewhere or (machine is not None and not machine.local)
         if not argv or not argv[0]:
@@ -274,7 +274,7 @@ class ExecuteProcess(Action):
         if SHARE in context.run_state:
             from mlaunch.plan.machine import placed
 
-            machine, elsewhere = placed(context.run_state, machine)
+            machine, elsewhere = placed(context.run_state[SHARE], machine)
             if elsewhere:
                 return True
         return machine is not None and not machine.local
