@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 import signal
 import time
+from pathlib import Path
 
 from test_supervision import Harness, make_spec
 
@@ -155,12 +156,18 @@ def fake_usage(groups: dict[int, list[int]]) -> dict[int, tuple[float, int]]:
     return {pgid: (12.0, 3 << 20) for pgid in groups}
 
 
-def test_status_view_keeps_the_scrollback_clean() -> None:
-    code = """
-    import time
+def test_status_view_keeps_the_scrollback_clean(tmp_path: Path) -> None:
+    # The talker lives on after its ticks until the view has drawn six frames (60 s at most):
+    # 0.6 s held fewer on a loaded machine.
+    drawn = tmp_path / "drawn"
+    code = f"""
+    import os, time
     for i in range(5):
         print("tick", i, flush=True)
         time.sleep(0.12)
+    deadline = time.monotonic() + 60
+    while not os.path.exists({str(drawn)!r}) and time.monotonic() < deadline:
+        time.sleep(0.02)  # the child under test, not a test: polling is fine
     """
     policy = RespawnPolicy(mode="on-failure", delay=0.2, max_retries=1)
     h = Harness(
@@ -178,6 +185,14 @@ def test_status_view_keeps_the_scrollback_clean() -> None:
         period=0.05,
         sampler=fake_usage,
     )
+
+    def watch() -> None:
+        if view.frames > 5:
+            drawn.touch()
+        else:
+            h.sup.schedule(0.05, watch, keeps_alive=False)
+
+    watch()
     assert h.run() == 0
     assert view.frames > 5  # redrawn while it ran, not just once
     term = Terminal()
