@@ -57,8 +57,18 @@ def pytest_runtest_protocol(
     folder = alone.lock_folder(item.config)
     if folder is None:
         return (yield)
-    with alone.turn(folder, item.get_closest_marker(alone.MARKER) is not None):
+    serial = _serial(item)
+    with alone.turn(folder, serial, keep=serial and nextitem is not None and _serial(nextitem)):
         return (yield)
+
+
+def _serial(item: pytest.Item) -> bool:
+    return item.get_closest_marker(alone.MARKER) is not None
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """The serial tests first, one after the other (tests/alone.py: they drain the run once)."""
+    items.sort(key=lambda item: not _serial(item))  # a stable sort: the rest keep their order
 
 
 @pytest.fixture
