@@ -141,15 +141,15 @@ def build(sources: Path, cache: Path = CACHE, python: str = sys.executable) -> T
         return tree
     cache.mkdir(parents=True, exist_ok=True)
     _write_map(tree.map_path)
-    staging = Path(tempfile.mkdtemp(prefix="prefix-", dir=cache))
+    staging = Path(tempfile.mkdtemp(prefix="staging-", dir=cache))
     try:
         _lay_out(sources, staging, python)
         made = Tree(staging, tree.map_path)
         _add_executables(made, python)
         check(made, python)
         (staging / ".built").write_text("")
-        if prefix.exists():
-            shutil.rmtree(prefix)
+        for old in cache.glob("prefix-*"):  # of other sources or an older builder
+            shutil.rmtree(old)
         staging.rename(prefix)
     finally:
         if staging.exists():

@@ -48,9 +48,11 @@ from reference import HOME as REFERENCE_HOME  # noqa: E402
 from reference import MISSING as REFERENCE_MISSING  # noqa: E402
 from ros_domain import private_domain  # noqa: E402
 
-GROUPS = ("startup", "print", "output", "memory", "sim", "importtime")  # what --only selects
+GROUPS = ("startup", "print", "output", "memory", "sim", "importtime", "autoware")  # --only
+# Minutes long, and needs sources fetched beforehand: only when --only names it.
+DEFAULT_GROUPS = tuple(g for g in GROUPS if g != "autoware")
 # The table's sections: shutdown and memory are measured in the start-up runs.
-SECTIONS = ("startup", "shutdown", "memory", "print", "output", "sim")
+SECTIONS = ("startup", "shutdown", "memory", "print", "output", "sim", "autoware")
 SIM_LAUNCH = REPO / "launches" / "jtbot_sim.launch.py"
 SIM_WORLD = REPO / "robots" / "jtbot_description" / "world" / "jt.world"
 SIM_XACRO = REPO / "robots" / "jtbot_description" / "urdf" / "jtbot.urdf.xacro"
@@ -1161,6 +1163,34 @@ class Bench:
             return
         self.results.importtime[venv.name] = parse_importtime(done.stderr)
 
+    # --- Autoware's planning_simulator, beside ros2 launch -------------------------------------
+
+    def autoware(self, venv: Venv, domain: int) -> None:
+        """benchmarks/autoware_bench.py: the real tree, mlaunch and ros2 launch alternating."""
+        import autoware_bench
+
+        env = {
+            **self.env,
+            "ROS_DOMAIN_ID": str(domain),
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        }
+        runs = 1 if self.config.mode == "quick" else 3
+        say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
+        try:
+            figures = autoware_bench.measure(runs, venv.mlaunch, venv.python, env, self.tmp, say)
+        except BenchError as e:
+            self.results.skip("autoware", venv.name, "Autoware tree", str(e))
+            return
+        if isinstance(figures, str):
+            self.results.skip("autoware", venv.name, "Autoware tree", figures)
+            return
+        for f in figures:
+            target = None if f.target is None else Target(f.target)
+            self.results.rows.append(
+                Row("autoware", f.name, venv.name, f.unit, f.samples, f.floor_name,
+                    f.floor_samples, target, {"runs": runs}, f.note, f.reference_samples)
+            )  # fmt: skip
+
 
 class LineCounter:
     """Counts the benchmark lines in a stream as it arrives and notes when they came.
@@ -1509,7 +1539,7 @@ def run(args: argparse.Namespace) -> Results:
     config = QUICK if args.quick else FULL
     if args.runs is not None:
         config = Config(**{**asdict(config), "runs": args.runs})
-    groups = set(args.only.split(",")) if args.only else set(GROUPS)
+    groups = set(args.only.split(",")) if args.only else set(DEFAULT_GROUPS)
     if "startup" in groups:
         groups.add("memory")  # measured in the same runs
     results = Results()
@@ -1545,6 +1575,12 @@ def run(args: argparse.Namespace) -> Results:
         if "sim" in groups and ros is not None:
             with ros_domain(args.ros_domain) as domain:
                 bench.sim(ros, domain)
+        if "autoware" in groups:
+            if ros is None:
+                results.skip("autoware", "ros", "Autoware tree", "needs the project venv (rclpy)")
+            else:
+                with ros_domain(args.ros_domain) as domain:
+                    bench.autoware(ros, domain)
     finally:
         pr.kill_descendants()
         if args.keep_temp:

@@ -369,3 +369,38 @@ def test_bisect_spreads_revisions_over_the_history() -> None:
     old, new = history[-1], history[0]
     assert bisect_revs.spread(old, new, 2) == [old, history[2], new]
     assert bisect_revs.spread(old, new, 10) == history[::-1]
+
+
+def test_autoware_is_its_own_group_and_skips_without_sources(tmp_path: Path) -> None:
+    """--only autoware selects it; a plain run does not start it (minutes, fetched sources);
+    without the pinned archives it is one clear line naming the command that gets them."""
+    import autoware_bench
+
+    assert "autoware" in bench.GROUPS and "autoware" not in bench.DEFAULT_GROUPS
+    assert bench.parse_args(["--only", "autoware"]).only == "autoware"
+    said: list[str] = []
+    reason = autoware_bench.measure(
+        1, Path("mlaunch"), Path("python"), {}, tmp_path, said.append, cache=tmp_path
+    )
+    assert isinstance(reason, str) and not said
+    assert f"no Autoware sources in {tmp_path / 'sources'}" in reason
+    assert "benchmarks/autoware_tree.py" in reason and "\n" not in reason
+
+
+def test_autoware_watch_tells_the_launch_from_the_launcher(tmp_path: Path) -> None:
+    """The fixture's processes (recorders before and after their exec, containers) and the
+    tree's xacro are not the launcher's; a helper of the launcher (its guard) is."""
+    import autoware_bench as ab
+    import autoware_container
+
+    prefix = tmp_path / "prefix"
+    assert ab.is_fixture(["sleep", "2147483647"], prefix)
+    assert ab.is_fixture(["/bin/sh", str(prefix / "lib/pkg/exe"), "--ros-args"], prefix)
+    assert ab.is_fixture(["/venv/bin/python", "/x/benchmarks/autoware_container.py"], prefix)
+    assert not ab.is_fixture(["launch-guard [run 12]"], prefix)
+    assert not ab.is_fixture(["/bin/sh", "/usr/lib/other"], prefix)
+    assert ab.is_tree_command(["/venv/bin/python", "/venv/bin/xacro", "vehicle.xacro"])
+    assert not ab.is_tree_command(["/venv/bin/python", "/venv/bin/mlaunch", "x.launch.xml"])
+    assert autoware_container.default_name("autoware::planning::PlannerNode") == "plannernode"
+    plugins = autoware_container.AnyPlugin()
+    assert plugins.get(("any_pkg", "ns::Thing"))[0] == "thing" and len(plugins) == 0
