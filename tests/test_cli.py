@@ -483,3 +483,28 @@ def test_on_process_io_callbacks(tmp_path: Path, env: dict[str, str]) -> None:
     # No traceback from mlaunch itself (the child's own KeyboardInterrupt lines are [w-1] ...).
     assert "Traceback" not in done.stderr
     assert not [line for line in done.stdout.splitlines() if line.startswith("Traceback")]
+
+
+def test_python_including_xml_reads_no_entry_points(tmp_path: Path, env: dict[str, str]) -> None:
+    """A Python launch file that includes XML through launch_xml's source (Autoware's do) pays
+    for importlib.metadata (~20-40 ms) only if a tag outside the built-in tables needs it."""
+    (tmp_path / "inner.launch.xml").write_text('<launch><log message="inner"/></launch>\n')
+    outer = tmp_path / "outer.launch.py"
+    inner = str(tmp_path / "inner.launch.xml")
+    outer.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import IncludeLaunchDescription\n"
+        "from launch_xml.launch_description_sources import XMLLaunchDescriptionSource\n\n\n"
+        "def generate_launch_description():\n"
+        f"    source = XMLLaunchDescriptionSource({inner!r})\n"
+        "    return LaunchDescription([IncludeLaunchDescription(source)])\n"
+    )
+    code = (
+        "import sys; from mlaunch.cli import main; rc = main([sys.argv[1], '--print']);"
+        " print('LOADED', 'importlib.metadata' in sys.modules); sys.exit(rc)"
+    )
+    done = __import__("subprocess").run(
+        [PY, "-c", code, str(outer)], capture_output=True, text=True, env=env, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "inner" in done.stdout and "LOADED False" in done.stdout

@@ -11,7 +11,6 @@ Third-party tags and substitutions come from ``launch.frontend.launch_extension`
 
 from __future__ import annotations
 
-import importlib.metadata as importlib_metadata
 import os
 import traceback
 import warnings
@@ -41,10 +40,23 @@ class InvalidFrontendLaunchFileError(InvalidLaunchFileError):
     """No markup implementation could read the file."""
 
 
+def __getattr__(name: str) -> Any:
+    """``importlib_metadata`` (upstream's module name for it), imported on first use: it costs
+    ~20-40 ms (email, zipfile, csv...) and a file whose tags are all built in never reads an
+    entry point (a Python launch file that imports launch_xml to include XML, as Autoware's do)."""
+    if name == "importlib_metadata":
+        import importlib.metadata
+
+        globals()[name] = importlib.metadata
+        return importlib.metadata
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 def _entry_points(group: str) -> Any:
     # Read through the module attribute at call time (a test may patch it); old Pythons and
     # patched values give a dict of groups.
-    found = importlib_metadata.entry_points()
+    metadata = globals().get("importlib_metadata") or __getattr__("importlib_metadata")
+    found = metadata.entry_points()
     if hasattr(found, "select"):
         return found.select(group=group)
     return found.get(group, [])
@@ -194,4 +206,5 @@ class Parser:
         return set()
 
 
-__all__ = ["InvalidFrontendLaunchFileError", "Parser", "importlib_metadata"]
+# importlib_metadata is served by __getattr__ (imported on first use).
+__all__ = ["InvalidFrontendLaunchFileError", "Parser", "importlib_metadata"]  # noqa: F822
