@@ -288,7 +288,12 @@ def reference_env(base: Mapping[str, str], work: Path) -> dict[str, str] | str:
 
 
 def rusage(argv: Sequence[str], env: Mapping[str, str], timeout: float = 120.0) -> Usage:
-    """Wall time, CPU (its own and its children's) and peak RSS of ``argv``, which must succeed."""
+    """Wall time, CPU (its own and its reaped children's) of ``argv``, which must succeed, and
+    the peak RSS it says last on stderr (``VmHWM: N kB``, what ``HWM_LINE`` prints), if it does.
+
+    Not ru_maxrss: a child forked from the harness starts with the harness's RSS (~30 MB), and
+    ru_maxrss keeps that across the exec.
+    """
     started = time.perf_counter()
     proc = subprocess.Popen(
         list(argv),
@@ -310,11 +315,19 @@ def rusage(argv: Sequence[str], env: Mapping[str, str], timeout: float = 120.0) 
         if proc.stderr is not None:
             proc.stderr.close()
     wall = time.perf_counter() - started
+    lines = err.decode(errors="replace").strip().splitlines()
     if proc.returncode != 0 or wall > timeout:
-        tail = err.decode(errors="replace").strip().splitlines()[-1:]
-        raise BenchError(f"{' '.join(argv[:3])}: exit {proc.returncode}: {' '.join(tail)}")
-    # ru_maxrss is the largest of the process and the children it waited for (xacro's too).
-    return Usage(wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss * 1024 / 1e6)
+        raise BenchError(f"{' '.join(argv[:3])}: exit {proc.returncode}: {' '.join(lines[-1:])}")
+    said = [line.split()[1] for line in lines if line.startswith("VmHWM:")]
+    peak = int(said[-1]) * 1024 / 1e6 if said else 0.0
+    return Usage(wall, usage.ru_utime + usage.ru_stime, peak)
+
+
+# Appended to a part's code: its own peak RSS, on stderr.
+HWM_LINE = (
+    "\nimport sys as _s\n"
+    "_s.stderr.write(next(l for l in open('/proc/self/status') if l.startswith('VmHWM')))"
+)
 
 
 @dataclass(frozen=True)
@@ -465,11 +478,14 @@ def part_figures(
 ) -> list[Figure]:
     """What each part costs alone: peak RSS and CPU of the interpreter, of resolving the tree
     (``--print``, xacro included), of importing rclpy, of one node (the DDS participant)."""
-    # Without the ROS wheels' re-exec (the harness's own environment has run it): ru_maxrss
-    # keeps the larger of the two images of a re-exec'd process, which hid the part itself.
+    # Without the ROS wheels' re-exec (the harness's own environment has run it): each part
+    # alone, in one interpreter.
     env = {**env, **{k: os.environ[k] for k in HOOK_VARIABLES if k in os.environ}}
-    commands = {name: [str(python), "-c", code] for name, code in PARTS.items()}
-    commands["resolve the tree (mlaunch --print)"] = [str(mlaunch), "--print", *launch]
+    codes = dict(PARTS)
+    codes["resolve the tree (mlaunch --print; xacro is a process of its own)"] = (
+        f"from mlaunch.cli import main\nmain({['--print', *launch]!r})"
+    )
+    commands = {name: [str(python), "-c", code + HWM_LINE] for name, code in codes.items()}
     figures: list[Figure] = []
     for name, argv in commands.items():
         usages = [rusage(argv, env) for _ in range(runs + 1)][1:]

@@ -1169,6 +1169,10 @@ class Bench:
         """benchmarks/autoware_bench.py: the real tree, mlaunch and ros2 launch alternating."""
         import autoware_bench
 
+        if self.reference is None:  # not built, or --no-reference: the figures are ratios to it
+            reason = "needs the reference ros2 launch (not found, or --no-reference)"
+            self.results.skip("autoware", venv.name, "Autoware tree", reason)
+            return
         env = {
             **self.env,
             "ROS_DOMAIN_ID": str(domain),
