@@ -11,7 +11,8 @@ guard, anything it starts to talk to the graph). Figures per run:
 
 - ``up``: exec of the launcher to everything up;
 - ``cpu``: the launcher's CPU (user + system) until everything is up: its own, its reaped
-  children's (xacro, run by both), and each helper's;
+  children's (ros2 launch runs the tree's xacro as a process, mlaunch runs it in-process), and
+  each helper's;
 - ``peak``: the sum of the peak RSS (VmHWM) of the launcher and each helper, the launcher's
   read once everything is up and again after the shutdown began (its peak may come later);
 - ``shutdown``: SIGINT to the launcher until it and every process below it are gone.
@@ -468,7 +469,7 @@ def print_figures(
     return [
         Figure("--print of the tree", "s", [u.wall for u in printed],
                "python -c pass", [u.wall for u in floor], target=0.5),
-        Figure("--print of the tree, CPU (with xacro)", "s", [u.cpu for u in printed],
+        Figure("--print of the tree, CPU (xacro in-process)", "s", [u.cpu for u in printed],
                "python -c pass", [u.cpu for u in floor]),
     ]  # fmt: skip
 
@@ -477,12 +478,13 @@ def part_figures(
     runs: int, python: Path, mlaunch: Path, launch: list[str], env: Mapping[str, str]
 ) -> list[Figure]:
     """What each part costs alone: peak RSS and CPU of the interpreter, of resolving the tree
-    (``--print``, xacro included), of importing rclpy, of one node (the DDS participant)."""
+    (``--print``, with xacro, which mlaunch runs in-process), of importing rclpy, of one node
+    (the DDS participant)."""
     # Without the ROS wheels' re-exec (the harness's own environment has run it): each part
     # alone, in one interpreter.
     env = {**env, **{k: os.environ[k] for k in HOOK_VARIABLES if k in os.environ}}
     codes = dict(PARTS)
-    codes["resolve the tree (mlaunch --print; xacro is a process of its own)"] = (
+    codes["resolve the tree (mlaunch --print, xacro in-process)"] = (
         f"from mlaunch.cli import main\nmain({['--print', *launch]!r})"
     )
     commands = {name: [str(python), "-c", code + HWM_LINE] for name, code in codes.items()}
