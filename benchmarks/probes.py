@@ -307,8 +307,11 @@ class ReadyProbe:
             pass
 
 
-def stop_and_time(proc: Launched, probe: ReadyProbe, sig: int, timeout: float) -> float:
-    """Send ``sig`` to the launcher; seconds until it and every descendant are gone.
+def stop_and_time(
+    proc: Launched, probe: ReadyProbe, sig: int, timeout: float, group: bool = False
+) -> float:
+    """Send ``sig`` to the launcher (``group``: to its process group, as a terminal sends
+    Ctrl-C to the foreground group); seconds until it and every descendant are gone.
 
     The benchmark children are seen on the FIFO, the launcher through its pidfd, and any other
     descendant (mlaunch's guard process, an orphan) after the launcher's exit: the harness is
@@ -317,7 +320,10 @@ def stop_and_time(proc: Launched, probe: ReadyProbe, sig: int, timeout: float) -
     deadline = time.perf_counter() + timeout
     probe.release()
     sent = time.perf_counter()
-    os.kill(proc.pid, sig)
+    if group:
+        os.killpg(proc.pid, sig)  # started in a session of its own: its group is its pid
+    else:
+        os.kill(proc.pid, sig)
     gone = probe.wait_gone(deadline)
     proc.reap(deadline)
     assert proc.exited_at is not None

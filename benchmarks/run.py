@@ -83,6 +83,7 @@ FULL = Config("full", 5, (1, 10, 100, 500), (10, 100, 500), 100, 2.0, 4, 250_000
 # The start-up sizes (Python files) ros2 launch is measured at beside mlaunch: its 500 children
 # take seconds a run and add nothing the 100 do not show.
 REFERENCE_NS = (1, 100)
+REFERENCE_TRIES = 3  # per run: see Bench.reference_turn
 
 
 @dataclass(frozen=True)
@@ -93,6 +94,10 @@ class Venv:
     python: Path
     mlaunch: Path
     about: str
+    # What the ROS wheels' .pth hook would re-exec Python for (their libraries on
+    # LD_LIBRARY_PATH, its guard), as the mlaunch command scripts/setup writes gives it to
+    # Python at its first exec: the floors get it too, so both skip the re-exec alike.
+    finished_env: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -269,12 +274,34 @@ def measured_env(base: dict[str, str], log_dir: Path) -> dict[str, str]:
     return env
 
 
+def merge_ld_path(finished: dict[str, str], env: dict[str, str]) -> dict[str, str]:
+    """``finished`` with the user's LD_LIBRARY_PATH after its own (as the hook keeps it)."""
+    if not finished:
+        return {}
+    own = env.get("LD_LIBRARY_PATH")
+    ld = finished["LD_LIBRARY_PATH"] + (os.pathsep + own if own else "")
+    return {**finished, "LD_LIBRARY_PATH": ld}
+
+
 def project_venv() -> Venv | str:
     python = REPO / ".venv" / "bin" / "python"
     mlaunch = REPO / ".venv" / "bin" / "mlaunch"
     if not mlaunch.exists():
         return f"{mlaunch} does not exist (pip install -e '.[ros,dev]' into {REPO / '.venv'})"
-    return Venv("ros", python, mlaunch, "project venv (.venv, ROS wheels' re-exec hook)")
+    about = "project venv (.venv, ROS wheels' re-exec hook)"
+    return Venv("ros", python, mlaunch, about, hook_finished_env(REPO / ".venv"))
+
+
+def hook_finished_env(venv: Path) -> dict[str, str]:
+    """The variables the ROS wheels' hook sets before its re-exec ({} without the hook)."""
+    found = sorted((venv / "lib").glob("python3*/site-packages/ros_wheels_bootstrapper.pth"))
+    if not found:
+        return {}
+    libs = [str(p.resolve()) for p in sorted(found[0].parent.glob("ros_*.libs")) if p.is_dir()]
+    return {
+        "LD_LIBRARY_PATH": os.pathsep.join([str(venv / "lib"), *libs]),
+        "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1",
+    }
 
 
 def plain_venv() -> Venv | str:
@@ -413,10 +440,17 @@ class Bench:
         """Run 0 is the warm-up (bytecode compiled, caches warm) and is not counted."""
         return range(self.config.runs + 1)
 
-    def wall(self, argv: Sequence[str], timeout: float = 60.0) -> float:
+    def wall(
+        self, argv: Sequence[str], timeout: float = 60.0, env: dict[str, str] | None = None
+    ) -> float:
         """Seconds from exec of ``argv`` to its exit; BenchError with its output if it fails."""
         with open(self.out_file, "wb") as out:
-            proc = pr.launch(argv, self.env, stdout=out.fileno(), stderr=subprocess.STDOUT)
+            proc = pr.launch(
+                argv,
+                self.env if env is None else env,
+                stdout=out.fileno(),
+                stderr=subprocess.STDOUT,
+            )
         try:
             code = proc.reap(time.perf_counter() + timeout)
         finally:
@@ -431,19 +465,27 @@ class Bench:
     ) -> None:
         """ros2 launch's run ``i`` of ``key``, right after mlaunch's (until it has them all).
 
-        A failure skips that figure's ros2 launch column (said once), never mlaunch's row.
+        On a loaded machine ros2 launch sometimes hangs at Ctrl-C (an exception in its process
+        start, then it never sees that child's exit): such a run is tried again, up to
+        REFERENCE_TRIES times, each failure listed (``meta.reference_retries``, the table's
+        notes). Failing every try skips that figure's ros2 launch column, never mlaunch's row.
         """
         if self.reference is None or key in self.reference_failed:
             return
         got = self.reference_runs.setdefault(key, [])
         if len(got) >= self.config.runs:
             return
-        try:
-            one = measure(self.reference)
-        except BenchError as e:
+        for _ in range(REFERENCE_TRIES):
+            try:
+                one = measure(self.reference)
+                break
+            except BenchError as e:
+                retries = self.results.meta.setdefault("reference_retries", [])
+                retries.append({"group": group, "figure": key, "reason": one_line(str(e))})
+        else:
             self.reference_failed.add(key)
             del self.reference_runs[key]
-            self.results.skip(group, "ros2 launch", key, str(e))
+            self.results.skip(group, "ros2 launch", key, f"{REFERENCE_TRIES} tries failed")
             return
         if i:
             got.append(one)
@@ -466,15 +508,31 @@ class Bench:
         except OSError:
             return ""
 
+    def floor_env(self, venv: Venv) -> dict[str, str]:
+        """The floors' environment: a user's shell, with what the hook would add given first."""
+        return {**self.env, **merge_ld_path(venv.finished_env, self.env)}
+
     def interpreter_floor(self, venv: Venv) -> list[float]:
-        """``python -c pass`` in this venv (measured once, used as the floor of several rows)."""
+        """``python -c pass`` in this venv (measured once, used as the floor of several rows);
+        where the ROS wheels' hook re-execs it, both ways (the floor: with the hook skipped)."""
         if venv.name not in self.interpreter:
             argv = [str(venv.python), "-c", "pass"]
-            samples = [self.wall(argv) for _ in self.runs()][1:]
-            self.interpreter[venv.name] = samples
+            hooked: list[float] = []
+            skipped: list[float] = []
+            for i in self.runs():  # alternating
+                one = self.wall(argv)
+                two = self.wall(argv, env=self.floor_env(venv)) if venv.finished_env else 0.0
+                if i:
+                    hooked.append(one)
+                    skipped.append(two)
             self.results.rows.append(
-                Row("startup", "python -c pass (exec to exit)", venv.name, "s", samples)
+                Row("startup", "python -c pass (exec to exit)", venv.name, "s", hooked)
             )
+            self.interpreter[venv.name] = hooked
+            if venv.finished_env:
+                name = "python -c pass, hook's environment given (no re-exec)"
+                self.results.rows.append(Row("startup", name, venv.name, "s", skipped))
+                self.interpreter[venv.name] = skipped
         return self.interpreter[venv.name]
 
     def children_run(
@@ -486,13 +544,16 @@ class Bench:
         sigint_exit: int = 128 + signal.SIGINT,
         noted: bytes | None = None,
         stop_timeout: float = 20.0,
+        stop_group: bool = False,
     ) -> dict[str, float]:
         """Start a launcher of N ready-children; time first/all running, idle CPU, RSS, stop.
 
         ``sigint_exit`` is the launcher's exit status after SIGINT (ros2 launch exits 0).
         ``noted``: before the idle window and the SIGINT, wait until the launcher's output holds
         this line N times (ros2 launch: a SIGINT before it has noted a start never reaches that
-        child, and it waits for it forever).
+        child, and it waits for it forever). ``stop_group``: the SIGINT goes to the launcher's
+        process group, as a terminal's Ctrl-C does (ros2 launch's children are in it; mlaunch's
+        each have a session of their own, so it alone would get it either way).
         """
         probe = pr.ReadyProbe(self.fifo).open()
         with open(self.out_file, "wb") as out:
@@ -505,6 +566,11 @@ class Bench:
         try:
             first, last = probe.wait_ready(n, proc, time.perf_counter() + 30 + n / 10)
             result = {"first": first - proc.started, "all": last - proc.started}
+            if n == 1:
+                # The launcher's CPU from its exec (the hook's re-exec included: same task) until
+                # its child said it runs, read as the line arrives: what a loaded machine's
+                # wall clock hides. The threads alive now only (a thread that ended is ~0).
+                result["first_cpu"] = pr.fine_cpu_seconds(proc.pid)
             if noted is not None:
                 self.wait_output(noted, n, proc, time.perf_counter() + 30 + n / 10)
             if idle > 0:
@@ -513,7 +579,9 @@ class Bench:
                 c1, t1 = pr.fine_cpu_seconds(proc.pid), time.perf_counter()
                 result["idle_cpu"] = (c1 - c0) / (t1 - t0)
             result["hwm"] = pr.vm_hwm_mb(proc.pid)
-            result["shutdown"] = pr.stop_and_time(proc, probe, signal.SIGINT, stop_timeout)
+            result["shutdown"] = pr.stop_and_time(
+                proc, probe, signal.SIGINT, stop_timeout, group=stop_group
+            )
             if proc.returncode != sigint_exit:
                 raise BenchError(f"exit {proc.returncode} after SIGINT: {self.output_tail()}")
             return result
@@ -544,7 +612,7 @@ class Bench:
                     for i in self.runs():
                         # The floor does not depend on the format: measured with the first.
                         if n not in floors or len(floors[n]) < i:
-                            floor = self.children_run(floor_argv, n, idle)
+                            floor = self.children_run(floor_argv, n, idle, self.floor_env(venv))
                             if i:
                                 floors.setdefault(n, []).append(floor)
                         one = self.children_run([str(venv.mlaunch), str(path)], n, idle)
@@ -579,6 +647,7 @@ class Bench:
             sigint_exit=0,
             noted=b"process started with pid [",
             stop_timeout=30 + n,  # it ends its children one at a time: ~0.1 s each under load
+            stop_group=True,
         )
 
     def node_startup(self, venv: Venv, floors: list[dict[str, float]]) -> None:
@@ -586,11 +655,13 @@ class Bench:
         path, prefix = gen.write_node_launch(self.launches / "node", self.scripts.ready, self.fifo)
         env = {**self.env, "AMENT_PREFIX_PATH": str(prefix)}
         samples: list[float] = []
+        cpu: list[float] = []
         try:
             for i in self.runs():
                 one = self.children_run([str(venv.mlaunch), str(path)], 1, env=env)
                 if i:
                     samples.append(one["first"])
+                    cpu.append(one["first_cpu"])
                 measure = functools.partial(self._reference_children, path, 1, 0.0, prefix=prefix)
                 self.reference_turn("startup", "py one Node", i, measure)
         except BenchError as e:
@@ -608,6 +679,20 @@ class Bench:
                 Target(0.06),
                 {"format": "py", "n": 1, "node": True},
                 reference_samples=[r["first"] for r in self.reference_samples("py one Node")],
+            )
+        )
+        self.results.rows.append(
+            Row(
+                "startup",
+                "CPU until the first child runs, py, one Node",
+                venv.name,
+                "s",
+                cpu,
+                "bare Popen loop",
+                [f["first_cpu"] for f in floors],
+                None,
+                {"format": "py", "n": 1, "node": True},
+                reference_samples=[r["first_cpu"] for r in self.reference_samples("py one Node")],
             )
         )
 
@@ -645,6 +730,21 @@ class Bench:
             ),
             "first",
         )
+        if "first_cpu" in samples[0] and (not floors or "first_cpu" in floors[0]):
+            add(
+                Row(
+                    "startup",
+                    f"CPU until the first child runs, {fmt}, N={n}",
+                    venv.name,
+                    "s",
+                    pick(samples, "first_cpu"),
+                    loop,
+                    pick(floors, "first_cpu"),
+                    None,
+                    params,
+                ),
+                "first_cpu",
+            )
         if n > 1:
             targets = {100: Target(0.15), 500: Target(0.6)}
             add(
@@ -1156,8 +1256,11 @@ class Bench:
 
     def importtime(self, venv: Venv) -> None:
         path = gen.write([gen.many_children("true1", 1, ["true"])], "py", self.launches / "true1")
-        argv = [str(venv.python), "-X", "importtime", str(venv.mlaunch), str(path)]
-        done = subprocess.run(argv, env=self.env, capture_output=True, text=True, timeout=60)
+        # As a user starts it (the mlaunch command scripts/setup writes is a shell script), with
+        # every interpreter reporting its imports (the last one's are parsed).
+        env = {**self.env, "PYTHONPROFILEIMPORTTIME": "1"}
+        argv = [str(venv.mlaunch), str(path)]
+        done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=60)
         if done.returncode != 0:
             self.results.skip("importtime", venv.name, "one-process launch", done.stderr)
             return
@@ -1389,6 +1492,10 @@ def format_table(results: Results) -> str:
         else:
             text.append("  ".join(c.ljust(w) for c, w in zip(cells, widths, strict=True)).rstrip())
     notes = sorted({f"[{r.group}] {r.venv}: {r.note}" for r in results.rows if r.note})
+    notes += [
+        f"[{t['group']}] ros2 launch failed a run of {t['figure']} (tried again): {t['reason']}"
+        for t in meta.get("reference_retries", [])
+    ]
     if notes:
         text += ["", "notes:"] + [f"  {n}" for n in notes]
     if results.skips:

@@ -108,8 +108,11 @@ def test_table_shows_ros2_launch_beside_mlaunch() -> None:
     row = bench.Row("startup", "demo", "ros", "s", [0.1, 0.1], "floor", [0.05, 0.05])
     row.reference_samples = [0.4, 0.3, 0.5]
     results.rows.append(row)
-    line = next(line for line in bench.format_table(results).splitlines() if "demo" in line)
+    results.meta["reference_retries"] = [{"group": "startup", "figure": "py N=1", "reason": "hung"}]
+    text = bench.format_table(results)
+    line = next(line for line in text.splitlines() if "demo" in line)
     assert "400.0 ms" in line and "0.25" in line and "2.00" in line
+    assert "[startup] ros2 launch failed a run of py N=1 (tried again): hung" in text
     data = row.to_json()
     assert data["reference"]["median"] == 0.4 and data["reference"]["best"] == 0.3
     assert data["reference_ratio"] == pytest.approx(0.25)

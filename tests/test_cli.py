@@ -508,3 +508,78 @@ def test_python_including_xml_reads_no_entry_points(tmp_path: Path, env: dict[st
     )
     assert done.returncode == 0, done.stderr
     assert "inner" in done.stdout and "LOADED False" in done.stdout
+
+
+SITE = Path(__import__("sysconfig").get_path("purelib"))
+HOOKED = (SITE / "ros_wheels_bootstrapper.pth").exists()
+
+
+def shell_env(env: dict[str, str]) -> dict[str, str]:
+    """A user's shell: without what the ROS wheels' hook put into this process's environment."""
+    out = {k: v for k, v in env.items() if k != "_ROS_WHEELS_BOOTSTRAP_COMPLETE"}
+    inside = os.path.realpath(sys.prefix) + os.sep
+    kept = [
+        e
+        for e in out.pop("LD_LIBRARY_PATH", "").split(os.pathsep)
+        if e and not (os.path.realpath(e) + os.sep).startswith(inside)
+    ]
+    if kept:
+        out["LD_LIBRARY_PATH"] = os.pathsep.join(kept)
+    return out
+
+
+@pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv: nothing to skip")
+def test_the_mlaunch_command_starts_python_once(tmp_path: Path, env: dict[str, str]) -> None:
+    """The hook re-executes every interpreter of the venv (~20 ms): the mlaunch command that
+    scripts/setup installs gives Python the finished environment at its first exec instead."""
+    script = Path(sys.executable).parent / "mlaunch"
+    path = launch_file(tmp_path, "LogInfo(msg='once'),")
+    done = __import__("subprocess").run(
+        [str(script), path, "--show-args"],
+        capture_output=True,
+        text=True,
+        env={**shell_env(env), "PYTHONPROFILEIMPORTTIME": "1"},
+        timeout=30,
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    # Each interpreter writes this header once: two would be the hook's re-exec.
+    assert done.stderr.count("import time: self [us] | cumulative | imported package") == 1
+
+
+@pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv")
+def test_the_mlaunch_command_has_the_ros_libraries(tmp_path: Path, env: dict[str, str]) -> None:
+    """What the hook gave before: rclpy loads in mlaunch itself (the launch file imports it here,
+    as the bridge does lazily) and in the venv's Python programs it starts, which get the
+    finished environment (every ros_*.libs folder on LD_LIBRARY_PATH, the guard) as before."""
+    script = Path(sys.executable).parent / "mlaunch"
+    child = (
+        "import os, rclpy._rclpy_pybind11;"
+        " print('CHILD', os.environ.get('_ROS_WHEELS_BOOTSTRAP_COMPLETE'),"
+        " os.environ.get('LD_LIBRARY_PATH'))"
+    )
+    path = tmp_path / "rclpy.launch.py"
+    path.write_text(
+        textwrap.dedent(
+            f"""
+            import sys
+            import rclpy._rclpy_pybind11
+            from launch import LaunchDescription
+            from launch.actions import ExecuteProcess
+
+            def generate_launch_description():
+                return LaunchDescription([
+                    ExecuteProcess(cmd=[sys.executable, "-c", {child!r}], output="screen"),
+                ])
+            """
+        )
+    )
+    done = __import__("subprocess").run(
+        [str(script), str(path)], capture_output=True, text=True, env=shell_env(env), timeout=60
+    )
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    (line,) = [x for x in done.stdout.splitlines() if "CHILD" in x]
+    guard, _, ld_path = line.partition("CHILD ")[2].partition(" ")
+    assert guard == "1"
+    entries = {os.path.realpath(e) for e in ld_path.split(os.pathsep)}
+    wanted = {os.path.realpath(p) for p in SITE.glob("ros_*.libs")}
+    assert wanted and wanted <= entries, (wanted - entries, ld_path)
