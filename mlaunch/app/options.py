@@ -72,6 +72,9 @@ class Options:
         self.log_levels: list[str] = []
         # --machine NAME: run only that machine's share (docs/machines.md); None: all of it
         self.machine: str | None = None
+        # --no-cache (or MLAUNCH_NO_CACHE=1): load and resolve again, neither reading nor
+        # writing the plan cache (mlaunch.app.plan_cache)
+        self.cache = True
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -153,7 +156,18 @@ def build_parser(prog: str = "mlaunch") -> argparse.ArgumentParser:
         help="how --print and --show-args write: text to read (default), or json for tools"
         " (the schemas: docs/plan-json.md)",
     )
-    parser.add_argument("-d", "--debug", action="store_true", help="tracebacks for errors")
+    parser.add_argument(
+        "-d",
+        "--debug",
+        action="store_true",
+        help="tracebacks for errors; what the plan cache did and why",
+    )
+    parser.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="load and resolve the launch file again, without the plan cache (also"
+        " MLAUNCH_NO_CACHE=1; docs/plan-cache.md)",
+    )
     parser.add_argument(
         "-n",
         "--noninteractive",
@@ -400,6 +414,7 @@ def parse_options(argv: Sequence[str]) -> Options:
         log_keep=_log_keep(ns.log_keep),
     )
     opts.capture = ns.capture_at_definition
+    opts.cache = not ns.no_cache
     opts.log_levels = [log_level(item) for item in ns.log_level]
     opts.noninteractive = ns.noninteractive
     opts.format = ns.format

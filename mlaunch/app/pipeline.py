@@ -22,6 +22,7 @@ from mlaunch.plan.steps import SHARE, Plan
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from mlaunch.app.plan_cache import PlanCache
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.launch.launch_description import LaunchDescription
     from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
@@ -187,43 +188,130 @@ def resolve_for_run(
 
 def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
     """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it."""
-    from mlaunch.engine.lifeline import Lifeline, write_stdout
+    from mlaunch.engine.lifeline import Lifeline
 
     # From here on a launch file's code and substitutions may start processes: signals, the
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
     with Lifeline() as life:
+        if opts.show_args:
+            return show_arguments(opts, life)
+        cache = plan_cache(opts)
+        if cache is not None:
+            entry = cache.lookup()
+            if entry is not None:
+                log_dir = run_log_dir(opts)
+                from mlaunch.app.plan_cache import places
+
+                cached = cache.take(entry, places(life.temp_dir, log_dir, life.run_id, os.environ))
+                if cached is not None:
+                    from mlaunch.frontends.python import set_launch_argv
+
+                    set_launch_argv(opts.target, opts.second, opts.launch_argv)
+                    plan, options, labels = cached.plan, cached.options, cached.labels
+                    return run_plan(opts, plan, options, labels, log_dir, life, attach, cached.path)
+            return resolve_recorded(opts, cache, life, attach)
         path, search = find_target(opts)
         description = load_file(opts, path, search, temp_dir=life.temp_dir)
         streams_back(path)
-        if opts.show_args:
-            from mlaunch.resolve.describe import format_arguments
-            from mlaunch.resolve.resolver import collect_arguments
-            from mlaunch.ros.search import searching
-
-            with searching(search):
-                infos = collect_arguments(
-                    description, path=path, arguments=opts.arguments, environ=os.environ
-                )
-            if opts.format == "json":
-                from mlaunch.resolve.plan_json import arguments_json
-
-                write_stdout(arguments_json(infos, path, opts.arguments))
-            else:
-                write_stdout(format_arguments(infos))
-            return 0
-        log_dir = ""
-        if not opts.print_plan:
-            from mlaunch.engine.logfiles import make_run_log_dir
-
-            log_dir = make_run_log_dir(os.environ)
+        log_dir = run_log_dir(opts)
         plan, options, labels = resolve_for_run(
             opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir, search=search
         )
         streams_back(path)
-        if opts.print_plan:
-            write_stdout(describe(opts, plan, path))
-            return 0
-        return supervise(opts, plan, options, labels, log_dir, life, attach, path=path)
+        return run_plan(opts, plan, options, labels, log_dir, life, attach, path)
+
+
+def plan_cache(opts: Options) -> PlanCache | None:
+    """The run's entry in the plan cache, or None (--no-cache, MLAUNCH_NO_CACHE)."""
+    from mlaunch.app.plan_cache import PlanCache
+    from mlaunch.engine.lifeline import say
+
+    return PlanCache.for_run(opts, os.environ, say)
+
+
+def resolve_recorded(
+    opts: Options, cache: PlanCache, life: Lifeline, attach: Sequence[PartMaker]
+) -> int:
+    """Load and resolve as ``launch`` does, noting every input, and store the plan when the
+    recording saw everything it depends on (``--debug`` and ``--print`` say when not)."""
+    from mlaunch.plan import inputs
+
+    path = ""
+    with cache.record(life.temp_dir) as recording:
+        path, search = find_target(opts)
+        if native_ros1(opts, path):
+            recording.refuse("a native ROS 1 run (its master and parameter server are the run's)")
+        description = load_file(opts, path, search, temp_dir=life.temp_dir)
+        streams_back(path)
+        with inputs.paused():
+            log_dir = run_log_dir(opts)
+        recording.own = (
+            (*recording.own, os.path.abspath(log_dir) + os.sep) if log_dir else recording.own
+        )
+        plan, options, labels = resolve_for_run(
+            opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir, search=search
+        )
+    streams_back(path)
+    from mlaunch.app.plan_cache import places
+
+    run_places = places(life.temp_dir, log_dir, life.run_id, os.environ)
+    stored = cache.store(recording, path, plan, options, labels, run_places)
+    if not stored and opts.print_plan and not opts.debug:
+        from mlaunch.engine.lifeline import say
+
+        say(f"mlaunch: plan cache: not stored: {cache.why_not}")
+    return run_plan(opts, plan, options, labels, log_dir, life, attach, path)
+
+
+def run_log_dir(opts: Options) -> str:
+    """The run's log folder (made now), or "" for --print."""
+    if opts.print_plan:
+        return ""
+    from mlaunch.engine.logfiles import make_run_log_dir
+
+    return make_run_log_dir(os.environ)
+
+
+def run_plan(
+    opts: Options,
+    plan: Plan,
+    options: ResolveOptions,
+    labels: LabelCounter,
+    log_dir: str,
+    life: Lifeline,
+    attach: Sequence[PartMaker],
+    path: str,
+) -> int:
+    """Print the plan (--print), or run it."""
+    if opts.print_plan:
+        from mlaunch.engine.lifeline import write_stdout
+
+        write_stdout(describe(opts, plan, path))
+        return 0
+    return supervise(opts, plan, options, labels, log_dir, life, attach, path=path)
+
+
+def show_arguments(opts: Options, life: Lifeline) -> int:
+    """``--show-args``: the launch arguments of the file and of what it includes."""
+    from mlaunch.engine.lifeline import write_stdout
+    from mlaunch.resolve.describe import format_arguments
+    from mlaunch.resolve.resolver import collect_arguments
+    from mlaunch.ros.search import searching
+
+    path, search = find_target(opts)
+    description = load_file(opts, path, search, temp_dir=life.temp_dir)
+    streams_back(path)
+    with searching(search):
+        infos = collect_arguments(
+            description, path=path, arguments=opts.arguments, environ=os.environ
+        )
+    if opts.format == "json":
+        from mlaunch.resolve.plan_json import arguments_json
+
+        write_stdout(arguments_json(infos, path, opts.arguments))
+    else:
+        write_stdout(format_arguments(infos))
+    return 0
 
 
 def streams_back(path: str) -> None:

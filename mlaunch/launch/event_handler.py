@@ -80,8 +80,8 @@ class EventHandler:
         if target is None:
             return self.custom_matcher
         if _is_predicate(target):
-            return lambda spec: bool(target(spec.action))
-        return lambda spec: spec.action is target
+            return _ActionMatches(target)
+        return _ActionIs(target)
 
     def describe_short(self) -> str:
         return type(self).__name__
@@ -182,3 +182,28 @@ def register_step(context: Any, handler: Any, origin: str) -> AddHandler | None:
 
 # launch's base classes, by the names extensions import.
 BaseEventHandler = EventHandler
+
+
+class _ActionIs:
+    """A process matcher: the process of this action (a class, not a lambda: a plan that holds
+    it can be stored in the plan cache)."""
+
+    __slots__ = ("target",)
+
+    def __init__(self, target: object) -> None:
+        self.target = target
+
+    def __call__(self, spec: Any) -> bool:
+        return spec.action is self.target
+
+
+class _ActionMatches:
+    """A process matcher: a process whose action the launch file's predicate accepts."""
+
+    __slots__ = ("predicate",)
+
+    def __init__(self, predicate: Callable[[Any], object]) -> None:
+        self.predicate = predicate
+
+    def __call__(self, spec: Any) -> bool:
+        return bool(self.predicate(spec.action))

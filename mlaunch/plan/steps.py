@@ -75,6 +75,11 @@ class RespawnPolicy(Value):
     def __hash__(self) -> int:
         return hash(self._values())
 
+    def __reduce__(self) -> tuple[type[RespawnPolicy], tuple[Any, ...]]:
+        # Made again through __init__: pickle's default sets the slots, which a frozen class
+        # refuses (a cached plan holds its processes' policies).
+        return (RespawnPolicy, self._values())
+
     def describe(self) -> str:
         if self.mode == "never":
             return "no"

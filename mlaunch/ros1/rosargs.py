@@ -87,6 +87,9 @@ class Substitutions:
     def anon_name(self, name: str) -> str:
         """rosgraph's anonymous name, the same for every use of ``name`` in this context."""
         if name not in self.anon:
+            from mlaunch.plan.inputs import volatile
+
+            volatile(f"$(anon {name}) is a new name in every run")
             unique = int.from_bytes(os.urandom(8), "big") >> 1
             raw = f"{name}_{os.uname().nodename}_{os.getpid()}_{unique}"
             self.anon[name] = re.sub(r"[.\-:]", "_", raw)

@@ -26,5 +26,21 @@ def _sees_process(match: ProcessMatcher) -> ProcessMatcher:
     return match
 
 
+class _ProcessOfAction:
+    """The matcher of a running process by its action (a class, not a lambda: a plan that holds
+    it can be stored in the plan cache)."""
+
+    __slots__ = ("target_action",)
+
+    def __init__(self, target_action: Any) -> None:
+        self.target_action = target_action
+
+    def __call__(self, process: object) -> bool:
+        return getattr(process, "action", None) is self.target_action
+
+
+setattr(_ProcessOfAction, SEES_PROCESS, True)
+
+
 def matches_action(target_action: Any) -> ProcessMatcher:
-    return _sees_process(lambda process: getattr(process, "action", None) is target_action)
+    return _ProcessOfAction(target_action)

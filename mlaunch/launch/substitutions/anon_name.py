@@ -29,6 +29,9 @@ class AnonName(Substitution):
         cached = context.launch_configurations.get(key)
         if isinstance(cached, str):
             return cached
+        from mlaunch.plan.inputs import volatile
+
+        volatile(f"$(anon {name}) is a new name in every run")
         unique = int.from_bytes(os.urandom(8), "big") >> 1
         raw = f"{name}_{os.uname().nodename}_{os.getpid()}_{unique}"
         value = raw.replace(".", "_").replace("-", "_").replace(":", "_")

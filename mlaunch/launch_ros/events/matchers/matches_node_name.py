@@ -14,14 +14,23 @@ def matches_node_name(node_name: str) -> LifecycleNodeMatcher:
     a name without the leading '/' is taken from the root, as launch_ros does."""
     if not node_name.startswith("/"):
         node_name = "/" + node_name
+    return _NodeNamed(node_name)
 
-    def match(target: Any) -> bool:
+
+class _NodeNamed:
+    """The matcher ``matches_node_name`` returns (a class, not a closure: a plan that holds it
+    can be stored in the plan cache)."""
+
+    __slots__ = ("node_name",)
+
+    def __init__(self, node_name: str) -> None:
+        self.node_name = node_name
+
+    def __call__(self, target: Any) -> bool:
         info = getattr(target, "node", None)  # a ProcessSpec carries NodeInfo
         if info is not None and hasattr(info, "fully_qualified_name"):
-            return bool(info.fully_qualified_name == node_name)
+            return bool(info.fully_qualified_name == self.node_name)
         try:
-            return bool(getattr(target, "node_name", None) == node_name)
+            return bool(getattr(target, "node_name", None) == self.node_name)
         except RuntimeError:  # a Node not resolved yet has no name
             return False
-
-    return match
