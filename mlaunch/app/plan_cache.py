@@ -350,8 +350,7 @@ class PlanCache:
             return f"the plan takes {len(data) >> 20} MiB, more than {MAX_ENTRY_BYTES >> 20}"
         problem = self._private_folder()
         if problem:
-            self._say(f"mlaunch: plan cache: {problem}; plans are not cached")
-            return problem
+            return problem  # said with --debug: a home folder that cannot be written is common
         temporary = f"{self.file}.{os.getpid()}.tmp"
         try:
             fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
