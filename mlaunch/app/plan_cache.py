@@ -82,6 +82,26 @@ def cache_folder(environ: Mapping[str, str]) -> str:
     return os.path.join(base, "mlaunch", "plans")
 
 
+# Options that do not change the plan (how it is shown, how the run looks, logs, metrics): every
+# other option is in the key, an option added later too.
+NOT_IN_KEY = frozenset(
+    {
+        "format",
+        "debug",
+        "cache",
+        "show_args",
+        "check",
+        "status",
+        "quiet",
+        "color",
+        "log_max_bytes",
+        "log_keep",
+        "dashboard_port",
+        "metrics",
+    }
+)
+
+
 def run_key(opts: Options, environ: Mapping[str, str]) -> str:
     """The digest of everything a plan depends on that is known before the launch file is read."""
     uname = os.uname()
@@ -96,20 +116,7 @@ def run_key(opts: Options, environ: Mapping[str, str]) -> str:
         (os.getuid(), os.getgid()),
         os.getcwd(),
         _environment_key(environ),
-        opts.target,
-        opts.second,
-        list(opts.arguments.items()),
-        opts.launch_argv,
-        opts.use_sim_time,
-        opts.package_path,
-        opts.standins,
-        opts.capture,
-        opts.scoped_parameters,
-        opts.scoped_file_locals,
-        opts.ros,
-        opts.print_plan,
-        opts.log_levels,
-        opts.noninteractive,
+        [(name, value) for name, value in vars(opts).items() if name not in NOT_IN_KEY],
     )
     return plan_inputs.digest(repr(parts).encode("utf-8", "surrogateescape"))
 
