@@ -24,6 +24,7 @@ import sys
 import time
 
 from mlaunch.plan import inputs as plan_inputs
+from mlaunch.ros.files import write_all
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -362,9 +363,7 @@ class PlanCache:
         try:
             fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
             try:
-                view = memoryview(data)
-                while view:
-                    view = view[os.write(fd, view) :]
+                write_all(fd, data)
             finally:
                 os.close(fd)
             os.replace(temporary, self.file)
@@ -522,7 +521,7 @@ def _write_made_files(made: dict[str, bytes], temp_dir: str) -> None:
         os.makedirs(os.path.dirname(full), mode=0o700, exist_ok=True)
         fd = os.open(full, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
         try:
-            os.write(fd, data)
+            write_all(fd, data)
         finally:
             os.close(fd)
 

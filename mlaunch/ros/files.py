@@ -27,10 +27,15 @@ def write_temp(prefix: str, text: str, temp_dir: str | None) -> str:
         except FileExistsError:
             continue
         try:
-            view = memoryview(data)
-            while view:
-                view = view[os.write(fd, view) :]
+            write_all(fd, data)
         finally:
             os.close(fd)
         return path
     raise FileExistsError(f"no unused file name {prefix}XXXXXXXX in {temp_dir}")
+
+
+def write_all(fd: int, data: bytes) -> None:
+    """Write all of ``data`` to ``fd`` (os.write may take only part of it)."""
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
