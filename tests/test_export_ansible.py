@@ -13,28 +13,17 @@ import getpass
 import json
 import os
 import re
-import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
 
+import fleet
 import pytest
 import sshd
-from procutil import REPO, clean_env, run_mlaunch, wait_until
+from fleet import PYTHON, SPLIT, TALKER, export, fleet_vars, play, split_inventory, strip_comments
+from procutil import clean_env, run_mlaunch, wait_until
 
-PLAYBOOK = Path(sys.executable).parent / "ansible-playbook"
-MLAUNCH = Path(sys.executable).parent / "mlaunch"
-TALKER = REPO / "tests" / "nodes" / "talker.py"
-# The hosts' Python for Ansible's modules: the system's, as on a robot (else this one)
-PYTHON = "/usr/bin/python3" if os.path.exists("/usr/bin/python3") else sys.executable
-# ssh's control sockets: a short path (108 bytes at most), one per test process
-CONTROL = f"/tmp/mlaunch-ansible-{os.getpid()}-%C"
-
-pytestmark = pytest.mark.skipif(
-    not PLAYBOOK.exists() or sshd.SSHD is None or shutil.which("ssh") is None,
-    reason="needs ansible-core in the venv (scripts/setup installs it) and openssh-server",
-)
+pytestmark = pytest.mark.skipif(fleet.missing() is not None, reason=fleet.missing() or "")
 
 LAUNCH = f"""\
 import sys
@@ -96,20 +85,6 @@ def robots(tmp_path_factory: pytest.TempPathFactory) -> object:
             sshd.stop(server)
 
 
-def fleet_vars(path: Path, ros_env: dict[str, str]) -> dict[str, object]:
-    """The inventory's variables for every host: this mlaunch, a folder under the test's, one
-    shared ROS domain, the system's Python for Ansible's modules."""
-    names = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", "RMW_IMPLEMENTATION")
-    environment: dict[str, str] = {k: ros_env[k] for k in names if k in ros_env}
-    return {
-        "mlaunch": str(MLAUNCH),
-        "install_root": str(path.parent / "robots"),
-        "ready_timeout": 90,
-        "launch_environment": environment,
-        "ansible_python_interpreter": PYTHON,
-    }
-
-
 def inventory(
     path: Path, servers: list[sshd.Server], ros_env: dict[str, str], hosts: dict[str, dict]
 ) -> Path:
@@ -125,47 +100,11 @@ def inventory(
                 }
                 for name, arguments in hosts.items()
             },
-            "vars": fleet_vars(path, ros_env),
+            "vars": fleet_vars(path.parent / "robots", ros_env),
         }
     }
     path.write_text(json.dumps(data, indent=2))
     return path
-
-
-def play(out: Path, inv: Path, book: str, *extra: str) -> subprocess.CompletedProcess[str]:
-    home = out.parent / "ansible-home"
-    env = clean_env(
-        ANSIBLE_HOME=str(home),
-        ANSIBLE_LOCAL_TEMP=str(home / "tmp"),
-        ANSIBLE_REMOTE_TEMP=str(home / "remote"),
-        ANSIBLE_NOCOLOR="1",
-        ANSIBLE_RETRY_FILES_ENABLED="0",
-        ANSIBLE_PIPELINING="1",  # one connection per task, not five
-        # Connections shared within a play; an idle master ends 2 s after the play's last use.
-        ANSIBLE_SSH_ARGS=f"-o ControlMaster=auto -o ControlPersist=2s -o ControlPath={CONTROL}",
-        ANSIBLE_SSH_TRANSFER_METHOD="piped",  # the test's sshd has no sftp subsystem
-    )
-    return subprocess.run(
-        [str(PLAYBOOK), "-i", str(inv), book, *extra],
-        cwd=out,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        stdin=subprocess.DEVNULL,
-    )
-
-
-def export(tmp_path: Path, name: str, text: str) -> Path:
-    """``text`` as launch/NAME.launch.py, exported to NAME/ (its programs are this venv's)."""
-    launch = tmp_path / "launch" / f"{name}.launch.py"
-    launch.parent.mkdir()
-    launch.write_text(text)
-    out = tmp_path / name
-    done = run_mlaunch("export", str(launch), "--to", "ansible", str(out), "--allow-standins",
-                       env=clean_env())  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    return out
 
 
 def test_an_export_of_programs_only_this_computer_has_is_refused_unless_allowed(
@@ -190,7 +129,7 @@ def test_an_export_of_programs_only_this_computer_has_is_refused_unless_allowed(
 def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     tmp_path: Path, ros_env: dict[str, str], robots: list[sshd.Server]
 ) -> None:
-    out = export(tmp_path, "fleet", LAUNCH)
+    out = export(tmp_path, "fleet", LAUNCH, clean_env())
     root = tmp_path / "robots" / "fleet"
     # Each robot's readiness includes the other's node: both pass only in one shared graph.
     # r3's launch dies at once.
@@ -201,13 +140,13 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
     }
     inv = inventory(tmp_path / "inventory.yml", robots, ros_env, hosts)
 
-    checked = play(out, inv, "deploy.yml", "--check")
+    checked = play(out, inv, "deploy.yml", "--check", env=clean_env())
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert all(c["changed"] > 0 for c in recap(checked.stdout).values()), checked.stdout
     assert not talkers(root) and not root.exists()  # check mode starts and writes nothing
 
     started = time.monotonic()
-    deployed = play(out, inv, "deploy.yml")
+    deployed = play(out, inv, "deploy.yml", env=clean_env())
     took = time.monotonic() - started
     try:
         assert deployed.returncode == 2, deployed.stdout + deployed.stderr  # a host failed
@@ -226,38 +165,17 @@ def test_deploy_to_two_hosts_wait_ready_idempotent_teardown_and_a_failing_host(
             assert (root / host / "log").is_dir()
         print(f"deploy to three hosts (two ready, one failed): {took:.1f} s")
 
-        again = play(out, inv, "deploy.yml")
+        again = play(out, inv, "deploy.yml", env=clean_env())
         counts = recap(again.stdout)
         assert counts["r1"]["changed"] == counts["r2"]["changed"] == 0, again.stdout
         assert counts["r1"]["failed"] == counts["r2"]["failed"] == 0, again.stdout
         assert counts["r3"]["failed"] == 1, again.stdout  # started again, dead again
         assert sorted(talkers(root)) == sorted(running)  # the same processes, untouched
     finally:
-        down = play(out, inv, "teardown.yml")
+        down = play(out, inv, "teardown.yml", env=clean_env())
     assert down.returncode == 0, down.stdout + down.stderr
     assert wait_until(lambda: not talkers(root), 30), talkers(root)
     assert not root.exists(), list(root.rglob("*"))
-
-
-SPLIT = f"""\
-import sys
-from launch import LaunchDescription
-from launch_ros.actions import Node
-from mlaunch.actions import Machine
-
-def talker(namespace, **machine):
-    return Node(executable=sys.executable, arguments=[{str(TALKER)!r}], name="talker",
-                namespace=namespace, exec_name="talker", **machine)
-
-def generate_launch_description():
-    return LaunchDescription([
-        Machine(name="r1", address="r1"),
-        Machine(name="r2", address="r2", user="{getpass.getuser()}"),
-        talker("r1", machine="r1"),
-        talker("r2", machine="r2"),
-        talker("base"),
-    ])
-"""
 
 
 def test_a_launch_with_machines_is_split_one_host_per_machine(tmp_path: Path) -> None:
@@ -295,36 +213,41 @@ def test_a_launch_with_machines_is_split_one_host_per_machine(tmp_path: Path) ->
     assert not (out / "files" / "launch" / "out").exists()  # the export is not copied into itself
 
 
-def strip_comments(text: str) -> str:
-    return "\n".join(line for line in text.splitlines() if not line.startswith("#"))
+def test_a_host_whose_share_is_not_the_launchs_fails_before_anything_is_copied(
+    tmp_path: Path,
+) -> None:
+    out = export(tmp_path, "split", SPLIT, clean_env())
+    inv = tmp_path / "inventory.yml"
+    hosts = {
+        "r1": {"ansible_connection": "local"},  # its share: by its name
+        "robot9": {"ansible_connection": "local", "mlaunch_machine": "r9"},
+    }
+    variables = {"install_root": str(tmp_path / "robots"), "ansible_python_interpreter": PYTHON}
+    inv.write_text(json.dumps({"all": {"hosts": hosts, "vars": variables}}))
+    done = play(out, inv, "deploy.yml", "--check", env=clean_env())
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert "robot9 runs share r9 (mlaunch_machine" in done.stdout, done.stdout
+    assert "not one of the launch's: r1, r2, local" in done.stdout, done.stdout
+    assert re.search(r"^robot9\s+:.*failed=1", done.stdout, re.M), done.stdout
+    assert re.search(r"^r1\s+:.*failed=0", done.stdout, re.M), done.stdout
+    assert not (tmp_path / "robots").exists()  # check mode, and robot9 stopped at once
 
 
 @pytest.mark.timeout(400)  # two playbook runs: about a minute on a loaded 2-core machine
 def test_a_launch_split_by_machine_runs_each_share_on_its_host(
     tmp_path: Path, ros_env: dict[str, str], robots: list[sshd.Server]
 ) -> None:
-    out = export(tmp_path, "split", SPLIT)
-    # The exported inventory as it is, with what reaches the test's daemons added: 'local' (the
-    # processes given no machine) on r1's computer too, in a folder of its own.
-    data = json.loads(strip_comments((out / "inventory.yml").read_text()))
-    hosts = data["all"]["hosts"]
+    out = export(tmp_path, "split", SPLIT, clean_env())
+    root = tmp_path / "robots" / "split"
+    inv, hosts = split_inventory(out, robots, ros_env, root.parent)
+    # The example inventory: a host per machine with its address and user, and 'local'.
     assert {h: v.get("ansible_host") for h, v in hosts.items()} == {
         "r1": "r1", "r2": "r2", "local": "192.0.2.10"
     }  # fmt: skip
     assert hosts["r2"]["ansible_user"] == getpass.getuser()
-    hosts["local"]["ansible_host"] = "r1"
-    # Each host's readiness waits for another host's node: all ready means one ROS graph.
-    peers = {"r1": "/r2/talker", "r2": "/base/talker", "local": "/r1/talker"}
-    for name, server in (("r1", robots[0]), ("r2", robots[1]), ("local", robots[0])):
-        hosts[name]["ansible_ssh_common_args"] = f"-F {server.client_config}"
-        hosts[name]["launch_arguments"] = {"mlaunch_expect_peer": f"node {peers[name]}"}
-    data["all"]["vars"] = fleet_vars(tmp_path / "inventory.yml", ros_env)
-    inv = tmp_path / "inventory.yml"
-    inv.write_text(json.dumps(data, indent=2))
-    root = tmp_path / "robots" / "split"
 
     started = time.monotonic()
-    deployed = play(out, inv, "deploy.yml")
+    deployed = play(out, inv, "deploy.yml", env=clean_env())
     took = time.monotonic() - started
     try:
         assert deployed.returncode == 0, deployed.stdout + deployed.stderr
@@ -349,7 +272,7 @@ def test_a_launch_split_by_machine_runs_each_share_on_its_host(
             assert f" --machine {host}" in command, command
         print(f"deploy of a launch split over three hosts: {took:.1f} s")
     finally:
-        down = play(out, inv, "teardown.yml")
+        down = play(out, inv, "teardown.yml", env=clean_env())
     assert down.returncode == 0, down.stdout + down.stderr
     assert wait_until(lambda: not talkers(root), 30), talkers(root)
     assert not root.exists(), list(root.rglob("*"))
