@@ -48,11 +48,14 @@ from reference import HOME as REFERENCE_HOME  # noqa: E402
 from reference import MISSING as REFERENCE_MISSING  # noqa: E402
 from ros_domain import private_domain  # noqa: E402
 
-GROUPS = ("startup", "print", "output", "memory", "sim", "importtime", "autoware")  # --only
-# Minutes long, and needs sources fetched beforehand: only when --only names it.
-DEFAULT_GROUPS = tuple(g for g in GROUPS if g != "autoware")
+GROUPS = ("startup", "print", "output", "memory", "sim", "importtime", "autoware", "fleet")
+# Minutes long, and needing what a run does not always have (sources fetched beforehand;
+# ansible-core and sshd for fleet, a deploy over private sshd daemons, tests/fleet.py): only
+# when --only names them.
+OPT_IN_GROUPS = ("autoware", "fleet")
+DEFAULT_GROUPS = tuple(g for g in GROUPS if g not in OPT_IN_GROUPS)
 # The table's sections: shutdown and memory are measured in the start-up runs.
-SECTIONS = ("startup", "shutdown", "memory", "print", "output", "sim", "autoware")
+SECTIONS = ("startup", "shutdown", "memory", "print", "output", "sim", "autoware", "fleet")
 SIM_LAUNCH = REPO / "launches" / "jtbot_sim.launch.py"
 SIM_WORLD = REPO / "robots" / "jtbot_description" / "world" / "jt.world"
 SIM_XACRO = REPO / "robots" / "jtbot_description" / "urdf" / "jtbot.urdf.xacro"
@@ -1066,6 +1069,86 @@ class Bench:
 
     # --- simulation ---------------------------------------------------------------------------
 
+    def fleet(self, venv: Venv, domain: int) -> None:
+        """``mlaunch export --to ansible`` of a launch split by machine (two machines and a node
+        given none), deployed by ansible-playbook to three hosts on two private sshd daemons
+        and torn down again, each run; the floor is a one-task play (ping) on the same hosts:
+        Ansible's own cost of reaching them. Wall time: the load of the machine is in it."""
+        import fleet as fl
+        import sshd
+
+        why = fl.missing()
+        if why is None and Path(sys.executable).parent != venv.python.parent:
+            why = f"runs with the ros venv's interpreter ({venv.python})"
+        if why is not None:
+            self.results.skip("fleet", venv.name, "ansible deploy", why)
+            return
+        env = {
+            **self.env,
+            "ROS_DOMAIN_ID": str(domain),
+            "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        }
+        work = self.tmp / "fleet"
+        work.mkdir()
+        servers: list[sshd.Server] = []
+        deploys: list[float] = []
+        teardowns: list[float] = []
+        pings: list[float] = []
+        try:
+            for name in ("r1", "r2"):
+                (work / f"sshd-{name}").mkdir()
+                servers.append(sshd.start(work / f"sshd-{name}", alias=name))
+            out = fl.export(work, "split", fl.SPLIT, env)
+            inv, _hosts = fl.split_inventory(out, servers, env, work / "robots")
+            (out / "ping.yml").write_text(
+                "- hosts: all\n  gather_facts: false\n  tasks:\n    - ansible.builtin.ping:\n"
+            )
+            for _ in range(self.config.runs):
+                pings.append(self._play(fl, out, inv, "ping.yml", env))
+                deploys.append(self._play(fl, out, inv, "deploy.yml", env))
+                teardowns.append(self._play(fl, out, inv, "teardown.yml", env))
+        except BenchError as e:
+            self.results.skip("fleet", venv.name, "ansible deploy", str(e))
+            return
+        finally:
+            for server in servers:
+                sshd.stop(server)
+        params = {"hosts": 3, "shares": ["r1", "r2", "local"], "load": list(os.getloadavg())}
+        floor = "ansible ping play, same hosts"
+        self.results.rows.append(
+            Row(
+                "fleet",
+                "ansible deploy, launch split over 3 hosts, until all ready",
+                venv.name,
+                "s",
+                deploys,
+                floor,
+                pings,
+                params=params,
+            )
+        )
+        self.results.rows.append(
+            Row(
+                "fleet",
+                "ansible teardown, 3 hosts",
+                venv.name,
+                "s",
+                teardowns,
+                floor,
+                pings,
+                params=params,
+            )
+        )
+
+    @staticmethod
+    def _play(fl: Any, out: Path, inv: Path, book: str, env: dict[str, str]) -> float:
+        started = time.perf_counter()
+        done = fl.play(out, inv, book, env=env)
+        took = time.perf_counter() - started
+        if done.returncode != 0:
+            raise BenchError(f"{book} failed: {one_line(done.stdout[-600:] + done.stderr)}")
+        return took
+
     def sim(self, venv: Venv, domain: int) -> None:
         probe_ok = subprocess.run(
             [str(venv.python), "-c", "import rclpy, rosgraph_msgs.msg"],
@@ -1609,7 +1692,12 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
     parser.add_argument("--quick", action="store_true", help="few runs, small N (~1 min)")
     parser.add_argument("--json", metavar="FILE", help="write the JSON here ('-' for stdout)")
     parser.add_argument("--venv", choices=("ros", "plain", "both"), default="both")
-    parser.add_argument("--only", metavar="GROUPS", help=f"comma list of {', '.join(GROUPS)}")
+    parser.add_argument(
+        "--only",
+        metavar="GROUPS",
+        help=f"comma list of {', '.join(GROUPS)} (default: all but"
+        f" {', '.join(OPT_IN_GROUPS)}, measured only when named)",
+    )
     parser.add_argument("--runs", type=int, help="measured runs per figure (after a warm-up)")
     parser.add_argument("--ros-domain", type=int, help="ROS_DOMAIN_ID for the simulation")
     parser.add_argument("--keep-temp", action="store_true", help="keep the generated files")
@@ -1692,6 +1780,9 @@ def run(args: argparse.Namespace) -> Results:
             else:
                 with ros_domain(args.ros_domain) as domain:
                     bench.autoware(ros, domain)
+        if "fleet" in groups and ros is not None:
+            with ros_domain(args.ros_domain) as domain:
+                bench.fleet(ros, domain)
     finally:
         pr.kill_descendants()
         if args.keep_temp:

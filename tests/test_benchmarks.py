@@ -326,6 +326,14 @@ def test_quick_run(tmp_path: Path, ros_env: dict[str, str]) -> None:
     _check_table(done.stdout, rows)
 
 
+def test_the_fleet_group_is_measured_only_when_named() -> None:
+    # (a deploy with Ansible takes minutes: a quick run of every group leaves it out)
+    assert "fleet" in bench.GROUPS and "fleet" not in bench.DEFAULT_GROUPS
+    assert bench.parse_args(["--only", "fleet"]).only == "fleet"
+    with pytest.raises(SystemExit):
+        bench.parse_args(["--only", "fleets"])
+
+
 def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
     """benchmarks/bisect_revs.py runs a revision's mlaunch from a temporary worktree (and
     removes it): each round's sample has the launcher's CPU and both wall times."""
