@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 import re
 
-from mlaunch.check.portability import Finding
+from mlaunch.check.finding import Finding
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

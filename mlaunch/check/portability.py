@@ -23,6 +23,7 @@ import os
 import re
 
 from mlaunch.check import jazzy
+from mlaunch.check.finding import Finding, reads_as_bool
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:
@@ -37,22 +38,6 @@ _YAML_TYPES = {
     "float": ("tag:yaml.org,2002:float",),  # Jazzy refuses a YAML int where it reads a float
 }
 _SUBSTITUTION = re.compile(r"\$\(\s*([A-Za-z0-9_-]+)")
-
-
-class Finding:
-    """One thing Jazzy would reject or read differently, and where."""
-
-    __slots__ = ("message", "where")
-
-    def __init__(self, where: str, message: str) -> None:
-        self.where = where
-        self.message = message
-
-    def __str__(self) -> str:
-        return f"{self.where}: {self.message}"
-
-    def __repr__(self) -> str:
-        return f"Finding({self.where!r}, {self.message!r})"
 
 
 def check(path: str) -> list[Finding]:
@@ -89,7 +74,7 @@ def _check_one(path: str) -> tuple[list[Finding], list[str]]:
             )
         ], []
     if module == "mlaunch.frontends.python":
-        # portability_python builds on this module's Finding; it loads only for Python files.
+        # portability_python loads only for Python files.
         from mlaunch.check.portability_python import check_python
 
         return check_python(path)
@@ -277,7 +262,7 @@ def exposed() -> tuple[dict[str, Any], dict[str, Any]]:
     """The tags and the substitutions installed packages expose (``launch.frontend``), which
     ros2 launch accepts as it does its own; the extensions are loaded on the first question."""
     from mlaunch import compat
-    from mlaunch.frontends.markup import load_extensions
+    from mlaunch.frontends.element import load_extensions
     from mlaunch.launch.frontend.expose import action_parse_methods, substitution_parse_methods
 
     compat.install()  # the extensions import the ROS 2 names
@@ -295,17 +280,6 @@ def _type_message(name: str, node: Any, kind: str) -> str:
         f"Jazzy reads {name!r} as {want}: {shown!r} is YAML {_yaml_kind(node)} there,"
         f" a TypeError; write {fix}"
     )
-
-
-def reads_as_bool(text: str) -> bool:
-    import yaml
-
-    if text in ("1", "0"):
-        return True
-    try:
-        return isinstance(yaml.safe_load(text), bool)
-    except yaml.YAMLError:
-        return False
 
 
 def _yaml_kind(node: Any) -> str:

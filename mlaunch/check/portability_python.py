@@ -15,7 +15,7 @@ import json
 import os
 
 from mlaunch.check import jazzy
-from mlaunch.check.portability import Finding, reads_as_bool
+from mlaunch.check.finding import Finding, reads_as_bool
 
 TYPE_CHECKING = False  # mypy reads this as typing.TYPE_CHECKING; typing costs ~3 ms
 if TYPE_CHECKING:

@@ -17,11 +17,12 @@ import re
 import socket
 import sys
 
+from mlaunch.commands.ctl_error import CtlError
 from mlaunch.engine.logfiles import log_base_dir
 from mlaunch.parts.control import DEFAULT_LINES, OPERATIONS
 from mlaunch.parts.control_socket import FOLDER, NAME, PROTOCOL, READY, Address
 from mlaunch.plan.argparser import ArgumentParser
-from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, MlaunchError, did_you_mean
+from mlaunch.plan.errors import EXIT_FAILURE, EXIT_OK, EXIT_USAGE, did_you_mean
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING
 if TYPE_CHECKING:
@@ -83,14 +84,6 @@ Ctrl-C ends it. The launch file's exit handlers see each stop as they would see 
 ShutdownProcess: a process with on_exit=Shutdown() (XML on_exit="shutdown") ends the launch
 when it is stopped or restarted, with exit status 0.
 """
-
-
-class CtlError(MlaunchError):
-    """``mlaunch ctl`` cannot reach the run or the run refused; ``exit_code`` from the table."""
-
-    def __init__(self, message: str, exit_code: int = EXIT_FAILURE) -> None:
-        super().__init__(message)
-        self.exit_code = exit_code
 
 
 def parser() -> argparse.ArgumentParser:

@@ -19,7 +19,7 @@ import socket
 import stat
 import struct
 
-from mlaunch.commands.ctl import CtlError
+from mlaunch.commands.ctl_error import CtlError
 from mlaunch.engine.ownership import user_name as _user
 from mlaunch.parts.control_socket import FOLDER, NAME, WHERE
 

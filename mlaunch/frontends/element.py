@@ -350,7 +350,7 @@ class Element:
         try:
             parts = parse_template(text)
         except TemplateError as e:
-            if e.unknown is None or not _extensions_loaded():
+            if e.unknown is None or not load_extensions():
                 raise self.error(f"{e.message} in {_excerpt(text, e.index)}", attr, e.index)
             return self.template(attr, text)  # a package's extension may expose the name
         if len(parts) == 1 and isinstance(parts[0], str):
@@ -377,14 +377,20 @@ class Element:
         return self.yaml_construct(node)
 
 
-def _extensions_loaded() -> bool:
-    """Load the launch extensions (entry points) if that was not done yet; whether it was now.
+def load_extensions() -> bool:
+    """Import the packages that expose tags and substitutions (entry points
+    ``launch.frontend.launch_extension``), once; whether this call loaded them.
 
-    Only a tag or substitution name outside the built-in tables pays for it.
+    Only a tag or substitution name outside the built-in tables pays for it. They import
+    ``launch.*``: the application serves those names from mlaunch before it loads a launch file
+    (``mlaunch.compat``), as for a Python launch file.
     """
-    from mlaunch.frontends.markup import load_extensions
+    from mlaunch.launch.frontend.parser import Parser
 
-    return load_extensions()
+    if Parser.extensions_loaded:
+        return False
+    Parser.load_launch_extensions()
+    return True
 
 
 def _did_you_mean(name: str, options: Any) -> str:

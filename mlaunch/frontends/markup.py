@@ -20,6 +20,7 @@ from mlaunch.frontends.element import (
 from mlaunch.frontends.element import (
     MissingAttributeError,
     UnexpectedEntityError,
+    load_extensions,
 )
 from mlaunch.launch.frontend.coercion import get_typed_value, is_instance_of
 from mlaunch.launch.frontend.entity import Entity as FrontendEntity
@@ -227,16 +228,3 @@ def build_exposed(e: ReaderEntity, parser: Parser | None, unknown: Callable[[str
         raise e.error(f"{type(err).__name__}: {err}") from err
     action.origin = e.origin
     return action
-
-
-def load_extensions() -> bool:
-    """Import the packages that expose tags and substitutions (entry points
-    ``launch.frontend.launch_extension``), once; whether this call loaded them.
-
-    They import ``launch.*``: the application serves those names from mlaunch before it loads
-    a launch file (``mlaunch.compat``), as for a Python launch file.
-    """
-    if Parser.extensions_loaded:
-        return False
-    Parser.load_launch_extensions()
-    return True

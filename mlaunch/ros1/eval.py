@@ -28,9 +28,23 @@ from mlaunch.ros1.model import (
 from mlaunch.ros1.values import convert_value
 
 if TYPE_CHECKING:
+    from typing import Protocol
+
     from mlaunch.launch.launch_context import LaunchContext
-    from mlaunch.ros1.elements import Element, ElementReader
+    from mlaunch.plan.errors import LaunchFileError
     from mlaunch.ros1.scope import Scope
+
+    class ArgChecks(Protocol):
+        """What the cutter asks of the file's reader (mlaunch.ros1.elements' ElementReader is
+        one) about an argument an expression reads; ``el`` is the reader's element, passed back
+        as it came."""
+
+        def arg_kind(self, name: str, scope: Scope) -> str: ...
+
+        def check_arg(self, name: str, el: Any, scope: Scope) -> None: ...
+
+        def error(self, el: Any, message: str) -> LaunchFileError: ...
+
 
 EVAL_FUNCTIONS = ("arg", "find", "env", "optenv", "dirname", "anon")
 
@@ -38,7 +52,7 @@ EVAL_FUNCTIONS = ("arg", "find", "env", "optenv", "dirname", "anon")
 class EvalCutter:
     """Cuts an ``$(eval)`` expression at the names and calls that read launch state."""
 
-    def __init__(self, reader: ElementReader, el: Element, scope: Scope, expression: str) -> None:
+    def __init__(self, reader: ArgChecks, el: object, scope: Scope, expression: str) -> None:
         self.reader = reader
         self.el = el
         self.scope = scope

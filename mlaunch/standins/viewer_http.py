@@ -31,7 +31,17 @@ from typing import TYPE_CHECKING, Any, Protocol
 from mlaunch.standins.viewer_config import PORT_ENV, RUN_ID_ENV, ViewerError, dashboard_socket
 
 if TYPE_CHECKING:
-    from mlaunch.standins.viewer import ViewerState
+
+    class PageState(Protocol):
+        """What the page server reads of the viewer (mlaunch.standins.viewer's ViewerState is
+        one): a page's poll noted, the state as JSON, the depth picture."""
+
+        def note_poll(self, now: float) -> None: ...
+
+        def snapshot(self, now: float) -> dict[str, Any]: ...
+
+        def depth_png(self) -> bytes | None: ...
+
 
 PAGE = Path(__file__).with_name("viewer.html")
 IDLE_TIMEOUT = 5.0  # seconds a connection may stay silent (the page polls every 0.1 s)
@@ -54,7 +64,7 @@ class Drive(Protocol):
 
 
 def make_handler(
-    state: ViewerState, page: bytes, clock: Any, drive: Drive | None = None
+    state: PageState, page: bytes, clock: Any, drive: Drive | None = None
 ) -> type[BaseHTTPRequestHandler]:
     """A request handler class serving the page and its JSON for this ``state``; ``drive``
     publishes the page's velocity commands (None: driving is off)."""
@@ -282,7 +292,7 @@ class DeadMan:
         self._stopped.set()
 
 
-def serve(state: ViewerState, port: int, clock: Any, drive: Drive | None = None) -> PageServer:
+def serve(state: PageState, port: int, clock: Any, drive: Drive | None = None) -> PageServer:
     """Start the page server on 127.0.0.1:port in a daemon thread and return it."""
     page = PAGE.read_bytes()
     deadman = None if drive is None else DeadMan(drive, clock)
