@@ -375,3 +375,43 @@ def test_a_normal_run_leaves_no_cgroup_behind(tmp_path: Path) -> None:
         assert not ours, ours
     finally:
         m.close()
+
+
+SLOW_MOVE = """
+import os, sys
+from mlaunch.engine import cgroup
+from mlaunch.engine.lifeline import Lifeline
+
+r, w = os.pipe()
+write, held = cgroup._write, []
+
+def slow_write(path, text):
+    # The first move into the run's cgroup waits until the main thread lets it go: the kernel's
+    # RCU wait, made as long as the test needs.
+    if path.endswith("cgroup.procs") and not held:
+        held.append(path)
+        os.read(r, 1)
+    return write(path, text)
+
+cgroup._write = slow_write
+with Lifeline() as life:
+    # The program goes on while the move waits (it cannot be done before the write below).
+    moving = life.cgroup is not None and not life.cgroup.entered
+    print("ENTERED", moving and not life.cgroup.path.endswith(cgroup.own_cgroup()), flush=True)
+    os.write(w, b"x")
+    life.settle()
+    inside = cgroup.own_cgroup() or ""
+    print("SETTLED", life.cgroup is not None and life.cgroup.path.endswith(inside), flush=True)
+print("LEFT", cgroup.own_cgroup() != inside, flush=True)
+"""
+
+
+def test_mlaunch_goes_on_while_the_move_into_its_cgroup_waits() -> None:
+    """Writing cgroup.procs waits for an RCU grace period (2-15 ms of wall time before the
+    first child): a thread makes the move while the launch file loads; the supervisor starts
+    nothing before it is done. Before, the launch waited for it."""
+    if run_cgroup_available():
+        pytest.skip(f"no run cgroup here: {run_cgroup_available()}")
+    done = subprocess.run([PY, "-c", SLOW_MOVE], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["ENTERED", "True", "SETTLED", "True", "LEFT", "True"]

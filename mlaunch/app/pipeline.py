@@ -384,6 +384,7 @@ def supervise(
     supervisor.records.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
     run = Run(opts, plan, supervisor, printer, launch_file=path)
     try:
+        life.settle()  # mlaunch is in the run's cgroup before it starts anything itself
         if spawner is not None:
             spawner.connect(plan.processes())
         for maker in attach:

@@ -14,6 +14,7 @@ to root; a user's own ``user@.service`` tree is delegated), or ``MLAUNCH_CGROUP=
 
 from __future__ import annotations
 
+import _thread
 import os
 import signal
 import time
@@ -57,6 +58,7 @@ class RunCgroup:
         self.path = path
         self.parent = parent
         self.entered = False
+        self._moving: _thread.LockType | None = None  # held while enter_soon's thread moves us
 
     @classmethod
     def create(cls, environ: os._Environ[str] | dict[str, str]) -> tuple[RunCgroup | None, str]:
@@ -82,6 +84,34 @@ class RunCgroup:
         """Move ``pid`` (0: this process, with all its threads) into the run's cgroup."""
         if _write(os.path.join(self.path, "cgroup.procs"), str(pid or os.getpid())):
             self.entered = True
+        return self.entered
+
+    def enter_soon(self) -> None:
+        """Move this process into the run's cgroup in a thread of its own (``settle`` waits).
+
+        Writing cgroup.procs waits for an RCU grace period in the kernel (milliseconds of wall
+        time, no CPU, the GIL released): the program goes on meanwhile. A bare _thread, not
+        threading: nothing else needs it this early.
+        """
+        moving = _thread.allocate_lock()
+        moving.acquire()
+        self._moving = moving
+
+        def move() -> None:
+            try:
+                self.enter()
+            finally:
+                moving.release()
+
+        _thread.start_new_thread(move, ())
+
+    def settle(self) -> bool:
+        """Wait for ``enter_soon``'s move; whether this process is in the run's cgroup."""
+        moving = self._moving
+        if moving is not None:
+            moving.acquire()
+            moving.release()
+            self._moving = None
         return self.entered
 
     def members(self) -> list[int]:

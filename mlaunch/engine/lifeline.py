@@ -86,12 +86,22 @@ class Lifeline:
         self.cgroup, self.no_cgroup = RunCgroup.create(self.environ)
         cgroup_path = self.cgroup.path if self.cgroup is not None else None
         self.guard = guards.Guard.start(self.run_id, temp_dir=self.temp_dir, cgroup=cgroup_path)
-        # In after the guard is forked: it must outlive (and kill) the cgroup.
-        if self.cgroup is not None and not self.cgroup.enter():
+        # In after the guard is forked: it must outlive (and kill) the cgroup. The move waits in
+        # the kernel for an RCU grace period (2-15 ms, no CPU): a thread makes it while the
+        # launch file loads and resolves, and settle() waits for it before the supervisor
+        # starts anything. What the launch file's own code or a Command substitution starts in
+        # those milliseconds may start outside the cgroup: it carries the run's marker (set
+        # above), by which the guard and the stray sweep find it, as in a run without a cgroup.
+        if self.cgroup is not None:
+            self.cgroup.enter_soon()
+        return self
+
+    def settle(self) -> None:
+        """Wait until mlaunch is in the run's cgroup (or the run has none, saying why)."""
+        if self.cgroup is not None and not self.cgroup.settle():
             self.no_cgroup = f"cannot move into {self.cgroup.path}"
             self.cgroup.remove()
             self.cgroup = None
-        return self
 
     def _on_signal(self, signum: int, frame: object) -> None:
         self.received.append(signum)
@@ -123,6 +133,7 @@ class Lifeline:
         self._raising = False
         signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
         try:
+            self.settle()
             if kind is not None:
                 if isinstance(error, Stopped):
                     say(
