@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import selectors
 from collections.abc import Callable, Iterator, Mapping
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 import pytest
 
@@ -16,7 +16,6 @@ from mlaunch.plan.records import Controlled, Exited, Record, RecordStream
 from mlaunch.plan.steps import ProcessSpec
 
 if TYPE_CHECKING:
-    from mlaunch.engine.output import Printer
     from mlaunch.engine.timers import Timer
 
 
@@ -68,11 +67,19 @@ class FakeRun:
 
 
 class FakePrinter:
+    """The members of ``Muting``: what runtime control asks of the printer."""
+
     def __init__(self) -> None:
         self.muted: set[str] = set()
 
     def is_muted(self, label: str) -> bool:
         return label in self.muted
+
+    def mute(self, label: str, muted: bool = True) -> None:
+        (self.muted.add if muted else self.muted.discard)(label)
+
+    def log_tail(self, label: str, count: int) -> list[bytes] | None:
+        return None  # a run without log files
 
 
 @pytest.fixture
@@ -84,7 +91,7 @@ def run() -> Iterator[FakeRun]:
 def control_of(run: FakeRun) -> tuple[Control, list[Record]]:
     seen: list[Record] = []
     run.records.subscribe(seen.append)
-    return Control(run, cast("Printer", FakePrinter())), seen
+    return Control(run, FakePrinter()), seen
 
 
 def test_a_stop_asks_the_run_and_calls_back_at_the_exit(run: FakeRun) -> None:
@@ -121,3 +128,15 @@ def test_nothing_is_started_once_the_run_shuts_down(run: FakeRun) -> None:
     with pytest.raises(ControlError, match="shutting down"):
         control.start("worker-1")
     assert run.started == [] and seen == []
+
+
+def test_mute_and_the_logs_go_to_the_printer(run: FakeRun) -> None:
+    run.running("talker-1", 5)
+    control, seen = control_of(run)
+    assert control.mute("talker", by="keys").muted
+    assert [(r.label, r.action) for r in seen if isinstance(r, Controlled)] == [
+        ("talker-1", "mute")
+    ]
+    assert control.mute("talker-1").muted and len(seen) == 1  # already muted: nothing said
+    with pytest.raises(ControlError, match="writes no log files"):
+        control.logs("talker")

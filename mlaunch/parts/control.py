@@ -58,7 +58,6 @@ if TYPE_CHECKING:
     from collections.abc import Mapping
     from typing import Any, Protocol, TypeVar
 
-    from mlaunch.engine.output import Printer
     from mlaunch.engine.part import AttachedRun
     from mlaunch.plan.records import ProcessView
 
@@ -81,6 +80,16 @@ if TYPE_CHECKING:
         def start_again(self, old: Process) -> object: ...
 
         def cancel_respawn(self, label: str, outcome: str) -> None: ...
+
+    class Muting(Protocol):
+        """What runtime control uses of the printer (mlaunch.engine.output's Printer is one):
+        a label's output kept off the screen or shown again, and its last lines."""
+
+        def is_muted(self, label: str) -> bool: ...
+
+        def mute(self, label: str, muted: bool = True) -> None: ...
+
+        def log_tail(self, label: str, count: int) -> list[bytes] | None: ...
 
     class ComponentLoads(Protocol):
         """What runtime control uses of the LoadNode driver (mlaunch.parts.components)."""
@@ -232,7 +241,7 @@ class Control(Part):
     def __init__(
         self,
         supervisor: ControlledRun,
-        printer: Printer,
+        printer: Muting,
         components: Callable[[], ComponentLoads | None] = lambda: None,
         lifecycle: Callable[[], LifecycleRequests[Any] | None] = lambda: None,
     ) -> None:

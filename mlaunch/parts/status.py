@@ -41,10 +41,20 @@ if TYPE_CHECKING:
 
     from mlaunch.engine.guard import Guard
     from mlaunch.engine.keyboard import Keyboard
-    from mlaunch.engine.output import Printer
     from mlaunch.engine.part import AttachedRun
     from mlaunch.engine.process import Process
     from mlaunch.engine.process_state import ProcessState
+
+    class ScreenOwner(Protocol):
+        """What the status view uses of the printer (mlaunch.engine.output's Printer is one): the
+        screen taken and given back, whether a label is muted, whether it writes in colour."""
+
+        @property
+        def color(self) -> bool: ...
+
+        def set_screen(self, out: Callable[[bytes], object]) -> Callable[[bytes], object]: ...
+
+        def is_muted(self, label: str) -> bool: ...
 
     class ViewedRun(AttachedRun, Protocol):
         """What the status view uses of the run (the Supervisor is one): what it knows of each
@@ -110,7 +120,7 @@ class StatusView(Part):
     def __init__(
         self,
         supervisor: ViewedRun,
-        printer: Printer,
+        printer: ScreenOwner,
         control: Callable[[], Control],
         *,
         size: Callable[[], tuple[int, int]] = terminal_size,
@@ -443,7 +453,7 @@ def _printable(raw: bytes, *, strip: bool = True) -> str:
 
 
 def attach_status_view(
-    supervisor: ViewedRun, printer: Printer, control: Callable[[], Control]
+    supervisor: ViewedRun, printer: ScreenOwner, control: Callable[[], Control]
 ) -> StatusView | None:
     """The view on a terminal; on anything else a warning (redrawing would fill a log file).
 
