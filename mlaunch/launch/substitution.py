@@ -56,15 +56,28 @@ def normalize(value: Any) -> Subs:
         return (value,)
     if isinstance(value, str):
         return (TextSubstitution(text=value),)
+    if type(value) is list or type(value) is tuple:
+        # The usual case (a cmd, a list of text and substitutions), taken before the checks
+        # against os.PathLike and Iterable below: those are ABCs, whose isinstance costs about
+        # a microsecond each time, and a plain list or tuple is never path-like.
+        out: list[Substitution] = []
+        for item in value:
+            if isinstance(item, Substitution):
+                out.append(item)
+            elif isinstance(item, str):
+                out.append(TextSubstitution(text=item))
+            else:
+                out.extend(normalize(item))
+        return tuple(out)
     if isinstance(value, os.PathLike):
         return (TextSubstitution(text=os.fspath(value)),)
     if isinstance(value, (int, float, bool)):
         return (TextSubstitution(text=str(value)),)
     if isinstance(value, Iterable):
-        out: list[Substitution] = []
+        items: list[Substitution] = []
         for item in value:
-            out.extend(normalize(item))
-        return tuple(out)
+            items.extend(normalize(item))
+        return tuple(items)
     raise TypeError(
         f"expected a str, a Substitution or a list of them, got {type(value).__name__}: {value!r}"
     )
