@@ -36,6 +36,9 @@ if TYPE_CHECKING:
 # (mlaunch.machines); here so that a launch without machines never imports that package.
 PUSHED_MACHINE = "mlaunch.machine"
 
+_SIGTERM_DEFAULT = LaunchConfiguration("sigterm_timeout", default=5)
+_SIGKILL_DEFAULT = LaunchConfiguration("sigkill_timeout", default=5)
+
 
 def _number(context: LaunchContext, value: Any, what: str, origin: str) -> float:
     planner = context.planner
@@ -102,16 +105,13 @@ class ExecuteProcess(Action):
         self._env = _pairs(env)
         self.additional_env = _pairs(additional_env)
         self.shell = shell
-        # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s.
-        self.sigterm_timeout = _subs(
-            LaunchConfiguration("sigterm_timeout", default=5)
-            if sigterm_timeout is None
-            else sigterm_timeout
+        # ROS 2's defaults: the launch configurations sigterm_timeout/sigkill_timeout, else 5 s
+        # (one substitution each, shared by every process, as upstream's default arguments).
+        self.sigterm_timeout = (
+            [_SIGTERM_DEFAULT] if sigterm_timeout is None else _subs(sigterm_timeout)
         )
-        self.sigkill_timeout = _subs(
-            LaunchConfiguration("sigkill_timeout", default=5)
-            if sigkill_timeout is None
-            else sigkill_timeout
+        self.sigkill_timeout = (
+            [_SIGKILL_DEFAULT] if sigkill_timeout is None else _subs(sigkill_timeout)
         )
         self.emulate_tty = emulate_tty
         # A dict of streams to destinations stays a dict, as upstream's.
