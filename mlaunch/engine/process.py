@@ -191,6 +191,7 @@ class Process:
         "signals_sent",
         "spec",
         "started_at",
+        "stdin_fd",
         "stopping",
         "streams",
         "user_stop",
@@ -206,6 +207,8 @@ class Process:
         self.ended_at = 0.0
         self.streams: dict[int, Stream] = {}
         self.popen: subprocess.Popen[bytes] | None = None
+        # The write end of the child's stdin pipe, held open while the child lives; -1: none.
+        self.stdin_fd = -1
         self.stopping = False
         # "stop" or "restart" when the user asked for its stop (mlaunch.parts.control), else "".
         self.user_stop = ""
@@ -256,12 +259,20 @@ class Process:
         ttys = _ptys() if spec.emulate_tty else None
         from mlaunch.engine import fdlimit
 
+        # A pipe nobody writes to, open while the child lives, as launch gives: a child that
+        # reads its stdin waits (DEVNULL would hand it EOF at once). Made here rather than by
+        # stdin=PIPE, which wraps the write end in a file object (three more system calls and
+        # an object per child, for an end that is only ever closed).
+        try:
+            stdin_read, stdin_write = os.pipe()  # close-on-exec; the child gets a copy as fd 0
+        except BaseException:
+            for fd in [fd for pair in ttys or () for fd in pair]:
+                os.close(fd)
+            raise
         try:
             self.popen = subprocess.Popen(
                 args,
-                # A pipe nobody writes to, open while the child lives, as launch gives: a
-                # child that reads its stdin waits (DEVNULL would hand it EOF at once).
-                stdin=subprocess.PIPE,
+                stdin=stdin_read,
                 stdout=subprocess.PIPE if ttys is None else ttys[0][1],
                 stderr=subprocess.PIPE if ttys is None else ttys[1][1],
                 env=env,
@@ -273,9 +284,12 @@ class Process:
                 preexec_fn=fdlimit.LIMIT.child_setup() if fdlimit.LIMIT is not None else None,
             )
         except BaseException:
-            for fd in [fd for pair in ttys or () for fd in pair]:
+            for fd in [stdin_write, *(fd for pair in ttys or () for fd in pair)]:
                 os.close(fd)
             raise
+        finally:
+            os.close(stdin_read)
+        self.stdin_fd = stdin_write
         self.pid = self.popen.pid
         self.started_at = clock()
         if ttys is None:
@@ -346,6 +360,9 @@ class Process:
         if self.popen is not None:
             # We reaped it ourselves; tell Popen so it never waits for this pid again.
             self.popen.returncode = code
+            if self.stdin_fd >= 0:  # what is left of its group reads EOF from now on
+                os.close(self.stdin_fd)
+                self.stdin_fd = -1
             if self.popen.stdin is not None:
                 try:  # what is left of its group reads EOF from now on
                     self.popen.stdin.close()
