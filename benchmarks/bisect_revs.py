@@ -1,15 +1,16 @@
 """Which commit made start-up slower: several revisions of mlaunch side by side, in one run.
 
     .venv/bin/python benchmarks/bisect_revs.py [--runs N] [--n 100] [--format py|yaml|xml]
-                                          [--ros2] [--json FILE] REV [REV ...]
+                                               [--ros2] [--calls] [--cache] [--json FILE] REV ...
     .venv/bin/python benchmarks/bisect_revs.py --between OLD NEW --steps K [...]
 
 Each revision is checked out into a temporary worktree (``git worktree add --detach``, removed
 at the end) and run by this interpreter with ``PYTHONPATH`` at that tree, so nothing is
-reinstalled: the venv's packages are shared, only mlaunch's code differs. Every revision starts
-the same generated launch of N children (``ready_child.sh``, as ``run.py`` does); the rounds
-alternate the revisions (rotating the order each round, so a burst of load from elsewhere hits
-them all) and the table gives best and median over the rounds of:
+reinstalled: the venv's packages are shared, only mlaunch's code differs. Every revision is
+started as the ``mlaunch`` command scripts/setup writes starts it (the ROS wheels' hook's
+environment given, no re-exec), on the same generated launch of N children (``ready_child.sh``,
+as ``run.py``'s); the rounds alternate the revisions (rotating the order each round, so a burst
+of load from elsewhere hits them all) and the table gives best and median over the rounds of:
 
 - CPU ms: user + system time of the launcher, read the moment the N-th child reports running:
   mlaunch and every descendant running the same executable (its guard, a fork), each thread to
@@ -18,10 +19,14 @@ them all) and the table gives best and median over the rounds of:
 - all ms: wall time from exec of the launcher to the N-th child running (confirms the CPU);
 - first ms: to the first child running.
 
-``--ros2`` adds the reference ros2 launch as one more column of the same rounds (the folder
-``scripts/reference`` built, or ``MLAUNCH_REFERENCE``), and the ratios of each revision to it.
-``--between OLD NEW --steps K`` measures K+1 revisions evenly spread over OLD..NEW's first-parent
-history (both ends included): bisect by narrowing it run after run.
+``--calls`` adds one run of each revision that counts the Python calls (and C calls made from
+Python) until the first and the N-th child were started, and the modules loaded by then: the
+same on an idle or a loaded machine, so one run says what a change costs. The plan cache is
+off (``MLAUNCH_NO_CACHE=1``) unless ``--cache``: revisions before it always resolve the file.
+``--ros2`` adds the reference ros2 launch (found as ``run.py`` finds it) as one more column of
+the same rounds, and the ratios of each revision to it. ``--between OLD NEW --steps K`` measures
+K+1 revisions evenly spread over OLD..NEW's first-parent history (both ends included): bisect by
+narrowing it run after run.
 """
 
 from __future__ import annotations
@@ -29,7 +34,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shlex
 import signal
 import statistics
 import subprocess
@@ -42,6 +46,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
+VENV = Path(sys.prefix)  # the interpreter's venv: its ROS wheels' hook is given its environment
 if str(HERE) not in sys.path:
     sys.path.insert(0, str(HERE))
 
@@ -50,12 +55,34 @@ import probes as pr  # noqa: E402
 import run as bench  # noqa: E402
 from probes import BenchError  # noqa: E402
 
-# What pip writes as the ``mlaunch`` console script (entry point mlaunch.cli:program).
+# What the mlaunch command scripts/setup writes runs (site without the ROS wheels' hook, whose
+# environment the harness gives), the same for every revision. With MLAUNCH_BISECT_CALLS=FILE it
+# also counts the Python calls (and C calls from Python) until the first and the N-th child were
+# started, and the modules loaded by then: figures that do not depend on the machine's load.
 LAUNCHER = """\
 import sys
+sys.modules.setdefault("ros_wheels_bootstrapper", type(sys)("ros_wheels_bootstrapper"))
+import site
+site.main()
+import os
+if os.environ.get("MLAUNCH_BISECT_CALLS"):
+    import subprocess
+    out, want, calls, marks = os.environ.pop("MLAUNCH_BISECT_CALLS"), {n}, [0], []
+    def count(frame, event, arg):
+        if event == "call" or event == "c_call":
+            calls[0] += 1
+    init = subprocess.Popen.__init__
+    def counted(self, *args, **kwargs):
+        marks.append(calls[0])
+        init(self, *args, **kwargs)
+        if len(marks) == want:
+            sys.setprofile(None)
+            with open(out, "w") as f:
+                f.write(f"{{marks[0]}} {{calls[0]}} {{len(sys.modules)}}\\n")
+    subprocess.Popen.__init__ = counted
+    sys.setprofile(count)
 from mlaunch.cli import program
-sys.argv[0] = "mlaunch"
-sys.exit(program())
+program()
 """
 
 
@@ -71,6 +98,8 @@ class Subject:
     # stop 100 children: it is killed, with its process group and every descendant, instead).
     graceful: bool = True
     samples: list[dict[str, float]] = field(default_factory=list)
+    # Python calls until the first and the N-th child were started, modules loaded by then.
+    calls: tuple[int, int, int] | None = None
 
     def best(self, key: str) -> float:
         return min(s[key] for s in self.samples)
@@ -179,44 +208,22 @@ def one_run(subject: Subject, n: int, fifo: Path, out_file: Path) -> dict[str, f
 # --- the subjects ----------------------------------------------------------------------------
 
 
-def revision_subject(rev: str, trees: Path, env: dict[str, str], launch: Path) -> Subject:
+def revision_subject(rev: str, trees: Path, env: dict[str, str], argv: list[str]) -> Subject:
     sha = git("rev-parse", "--verify", f"{rev}^{{commit}}")
     tree = trees / sha[:10]
     if not tree.exists():
         git("worktree", "add", "--detach", "--quiet", str(tree), sha)
-    script = tree / ".bisect-mlaunch"
-    script.write_text(LAUNCHER)
     subject_env = {**env, "PYTHONPATH": str(tree)}
     title = git("log", "-1", "--format=%s", sha)
-    return Subject(sha[:7], [sys.executable, str(script), str(launch)], subject_env, title)
+    return Subject(sha[:7], argv, subject_env, title)
 
 
 def reference_subject(env: dict[str, str], launch: Path) -> Subject:
-    """ros2 launch as a user runs it: env.sh sourced, then ``ros2 launch FILE``."""
-    home = os.environ.get("MLAUNCH_REFERENCE")
-    if not home:
-        setup = os.environ.get("MLAUNCH_REFERENCE_SETUP", "")
-        built = subprocess.run(
-            [str(REPO / "scripts" / "reference"), setup], capture_output=True, text=True
-        )
-        if built.returncode != 0:
-            raise SystemExit(
-                "bisect_revs: --ros2 needs the reference ros2 launch: set MLAUNCH_REFERENCE=FOLDER"
-                " (what scripts/reference SETUP_SH prints) or MLAUNCH_REFERENCE_SETUP=SETUP_SH;"
-                f" scripts/reference said: {bench.one_line(built.stderr)}"
-            )
-        home = built.stdout.strip()
-    env_sh = Path(home) / "env.sh"
-    dumped = subprocess.run(
-        ["bash", "-c", f"source {shlex.quote(str(env_sh))} && env -0"],
-        env=env,
-        capture_output=True,
-        check=True,
-    ).stdout
-    ref_env = dict(item.split("=", 1) for item in dumped.decode().split("\0") if "=" in item)
-    ros2 = Path(home) / "venv" / "bin" / "ros2"
-    argv = [str(ros2), "launch", str(launch)]
-    return Subject("ros2", argv, ref_env, f"ros2 launch ({home})", graceful=False)
+    """ros2 launch as a user runs it (run.py's: env.sh sourced once, then ``ros2 launch``)."""
+    found = bench.find_reference(env)
+    if isinstance(found, str):
+        raise SystemExit(f"bisect_revs: --ros2: {found}")
+    return Subject("ros2", found.argv(launch), found.env, found.about, graceful=False)
 
 
 # --- the table -------------------------------------------------------------------------------
@@ -229,6 +236,9 @@ def table(subjects: Sequence[Subject], ref: Subject | None, meta: dict[str, obje
         "",
     ]
     head = f"{'rev':8} {'CPU ms best/med':>16} {'all ms best/med':>16} {'first ms':>9}"
+    counted = any(s.calls for s in subjects)
+    if counted:
+        head += f" {'calls first/all':>16} {'modules':>7}"
     if ref is not None:
         head += f" {'CPU/ros2':>9} {'all/ros2':>9}"
     lines.append(head + "  subject")
@@ -238,6 +248,9 @@ def table(subjects: Sequence[Subject], ref: Subject | None, meta: dict[str, obje
             f"  {s.best('all') * 1e3:7.1f}/{s.median('all') * 1e3:7.1f}"
             f" {s.best('first') * 1e3:9.1f}"
         )
+        if counted:
+            first, every, modules = s.calls or (0, 0, 0)
+            row += f" {first:7d}/{every:8d} {modules:7d}" if s.calls else " " * 25
         if ref is not None:
             row += (
                 f" {s.median('cpu') / ref.median('cpu'):9.3f}"
@@ -256,6 +269,17 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
     p.add_argument("--n", type=int, default=100, help="children in the launch (100)")
     p.add_argument("--format", choices=gen.FORMATS, default="py")
     p.add_argument("--ros2", action="store_true", help="add the reference ros2 launch")
+    p.add_argument(
+        "--cache",
+        action="store_true",
+        help="let revisions that have the plan cache use it (off: MLAUNCH_NO_CACHE=1, so every"
+        " revision loads and resolves the file, as those before the cache did)",
+    )
+    p.add_argument(
+        "--calls",
+        action="store_true",
+        help="one more run of each revision counting Python calls to the first and N-th child",
+    )
     p.add_argument("--json", help="also write the samples as JSON to FILE")
     args = p.parse_args(argv)
     if not args.revs and not args.between:
@@ -276,13 +300,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     trees.mkdir()
     try:
         env = bench.measured_env(dict(os.environ), tmp / "logs")
+        env["XDG_CACHE_HOME"] = str(tmp / "cache")  # a plan cache of this run's own
+        mlaunch_env = {**env, **bench.merge_ld_path(bench.hook_finished_env(VENV), env)}
+        if not args.cache:
+            mlaunch_env["MLAUNCH_NO_CACHE"] = "1"
         scripts = gen.write_child_scripts(tmp / "bin")
         fifo, out_file = tmp / "ready.fifo", tmp / "out.txt"
         child = [str(scripts.ready), str(fifo)]
         launch = gen.write(
             [gen.many_children(f"start_{args.n}", args.n, child)], args.format, tmp / "launch"
         )
-        subjects = [revision_subject(rev, trees, env, launch) for rev in dict.fromkeys(revs)]
+        argv = [sys.executable, "-S", "-P", "-c", LAUNCHER.format(n=args.n), str(launch)]
+        subjects = [revision_subject(rev, trees, mlaunch_env, argv) for rev in dict.fromkeys(revs)]
         ref = None
         if args.ros2:
             with bench.ros_domain(None) as domain:
@@ -316,6 +345,15 @@ def measure(
             if round_no:
                 subject.samples.append(one)
         print(f"round {round_no}/{args.runs} done", file=sys.stderr, flush=True)
+    if args.calls:
+        counts = out_file.with_name("calls.txt")
+        for subject in revisions:
+            counting = Subject(subject.label, subject.argv, subject.env, subject.about)
+            counting.env = {**subject.env, "MLAUNCH_BISECT_CALLS": str(counts)}
+            one_run(counting, args.n, fifo, out_file)
+            first, every, modules = (int(x) for x in counts.read_text().split())
+            subject.calls = (first, every, modules)
+            counts.unlink()
     meta: dict[str, object] = {
         "n": args.n,
         "format": args.format,
@@ -323,13 +361,14 @@ def measure(
         "load_before": load_before,
         "load_after": [round(x, 2) for x in os.getloadavg()],
         "python": sys.executable,
+        "plan_cache": args.cache,
     }
     sys.stdout.write(table(revisions, ref, meta))
     if args.json:
         document = {
             "meta": meta,
             "subjects": [
-                {"label": s.label, "about": s.about, "samples": s.samples}
+                {"label": s.label, "about": s.about, "samples": s.samples, "calls": s.calls}
                 for s in ([*revisions, ref] if ref else revisions)
             ],
         }

@@ -349,7 +349,7 @@ def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
         return [line for line in listed.stdout.splitlines() if line.startswith("worktree ")]
 
     before = worktrees()
-    argv = [sys.executable, str(BENCH / "bisect_revs.py"), "--runs", "2", "--n", "3"]
+    argv = [sys.executable, str(BENCH / "bisect_revs.py"), "--runs", "2", "--n", "3", "--calls"]
     done = subprocess.run(
         [*argv, "--json", str(out), "HEAD"], capture_output=True, text=True, timeout=120
     )
@@ -363,6 +363,9 @@ def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
     assert subject["label"] == head and len(subject["samples"]) == 2
     for sample in subject["samples"]:
         assert sample["cpu"] > 0 and 0 < sample["first"] <= sample["all"]
+    # Python calls to the first and to the third child started, and the modules loaded by then.
+    first, every, modules = subject["calls"]
+    assert 0 < first < every and modules > 50
     assert f"\n{head} " in done.stdout
 
 
