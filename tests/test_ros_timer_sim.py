@@ -17,7 +17,7 @@ from mlaunch.app.launch_service import LaunchService
 from mlaunch.launch.actions import LaunchDescription, OpaqueFunction
 from mlaunch.launch_ros.actions import SetUseSimTime
 from mlaunch.launch_ros.actions.ros_timer import ROSTimer
-from mlaunch.parts.ros_clock import RosClock
+from mlaunch.parts.ros_clock import SimTimeWaits
 
 pytestmark = requires_rclpy
 
@@ -109,13 +109,13 @@ def test_a_waiting_sim_time_timer_is_cancelled_by_shutdown(
     # The part's thread ends once its graph is up: ~20 ms when an earlier test of this process
     # imported rclpy (under xdist, a polling check missed it). Its start is noted instead.
     graph_started = threading.Event()
-    start_graph = RosClock._start_graph
+    start_graph = SimTimeWaits._start_graph
 
-    def noted(part: RosClock) -> None:
+    def noted(part: SimTimeWaits) -> None:
         graph_started.set()
         start_graph(part)
 
-    monkeypatch.setattr(RosClock, "_start_graph", noted)
+    monkeypatch.setattr(SimTimeWaits, "_start_graph", noted)
     service, fired = timed_launch(True, 5.0)
     thread = service.run_in_thread()
     # The wait was handed to the ROS clock part, and keeps the otherwise idle launch running.

@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from mlaunch.parts.dashboard import Dashboard
     from mlaunch.parts.lifecycle import LifecycleManager
     from mlaunch.parts.metrics import Metrics
-    from mlaunch.parts.ros_clock import RosClock
+    from mlaunch.parts.ros_clock import SimTimeWaits
 
 
 class Run:
@@ -251,10 +251,10 @@ def ros_clock_part(supervisor: Supervisor) -> Part:
     time the supervisor hands over (``SimTimeWait``): only whether SetUseSimTime ran when the
     timer starts tells, and a launch without one never imports it."""
 
-    def clock() -> RosClock:
-        from mlaunch.parts.ros_clock import RosClock
+    def clock() -> SimTimeWaits:
+        from mlaunch.parts.ros_clock import SimTimeWaits
 
-        return RosClock(supervisor)
+        return SimTimeWaits(supervisor)
 
     return _AttachOnDemand(supervisor, lambda event: isinstance(event, SimTimeWait), clock)
 
@@ -270,12 +270,12 @@ class _AttachOnDemand(Part):
         self,
         supervisor: Supervisor,
         wants: Callable[[Record], bool],
-        make: Callable[[], ComponentDriver | RosClock | LifecycleManager],
+        make: Callable[[], ComponentDriver | SimTimeWaits | LifecycleManager],
     ) -> None:
         self.supervisor = supervisor
         self.wants = wants
         self.make = make
-        self.driver: ComponentDriver | RosClock | LifecycleManager | None = None
+        self.driver: ComponentDriver | SimTimeWaits | LifecycleManager | None = None
         supervisor.records.subscribe(self._on_record)
 
     def _on_record(self, record: Record) -> None:

@@ -51,7 +51,7 @@ class _Wait:
         self.due = due
 
 
-class RosClock(Part):
+class SimTimeWaits(Part):
     """Takes every ``SimTimeWait`` handed over and ends it when /clock says so."""
 
     def __init__(self, supervisor: ClockedRun) -> None:
