@@ -70,6 +70,9 @@ PACKAGES: tuple[tuple[str, str, str], ...] = (
     ("robot_state_publisher", ".", "robot_state_publisher"),
     ("demos", "demo_nodes_cpp", "demo_nodes_cpp"),
     ("demos", "composition", "composition"),
+    # The lifecycle demo (lifecycle_talker, _listener, _service_client), upstream CMakeLists as is:
+    # three programs on rclcpp_lifecycle and the wheels' lifecycle_msgs.
+    ("demos", "lifecycle", "lifecycle"),
 )
 NOT_BUILT = ("install", "python_packages.py")
 JOBS = 2  # the machines this runs on share 2 cores between several builds and test runs
