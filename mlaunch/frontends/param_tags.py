@@ -142,8 +142,8 @@ def _typed_value(
     if "$(" in text:
         return p.template(attr, text)
     if keep_text and element is None:
-        return text
-    return _coerce(p, attr, text, element, is_list)
+        return _unescaped(p, attr, text)
+    return _unescaped(p, attr, _coerce(p, attr, text, element, is_list))
 
 
 def _is_text(node: Any) -> bool:
@@ -158,7 +158,8 @@ def _yaml_item(p: Element, attr: Attr, item: Any, element: type | None) -> Any:
         return p.template(attr, item)
     if isinstance(item, (dict, list)) or item is None:
         raise p.error(f"a list parameter holds plain values, not {item!r}", attr)
-    return _coerce(p, attr, item, element, False) if element is not None else item
+    typed = _coerce(p, attr, item, element, False) if element is not None else item
+    return _unescaped(p, attr, typed)
 
 
 def _text_item(p: Element, attr: Attr, piece: str, element: type | None) -> Any:
@@ -166,8 +167,19 @@ def _text_item(p: Element, attr: Attr, piece: str, element: type | None) -> Any:
     if "$(" in piece:
         return p.template(attr, piece)
     if element is None:
-        return _guess(piece)
-    return _coerce(p, attr, piece, element, False)
+        return _unescaped(p, attr, _guess(piece))
+    return _unescaped(p, attr, _coerce(p, attr, piece, element, False))
+
+
+def _unescaped(p: Element, attr: Attr, value: Any) -> Any:
+    """The value with each text in it read as launch_ros reads it after typing the value: as
+    substitutions, so its escapes count (``\\'2\\'`` is the text ``'2'``, ``\\\\`` one backslash).
+    A text with no backslash (nor ``$(``, handled before) is the same either way."""
+    if isinstance(value, str) and "\\" in value:
+        return p.template(attr, value)
+    if isinstance(value, list):
+        return [_unescaped(p, attr, item) for item in value]
+    return value
 
 
 def _uniform_list(p: Element, attr: Attr, items: list[Any]) -> list[Any]:
