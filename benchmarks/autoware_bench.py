@@ -176,6 +176,9 @@ class Watch:
 
 
 def _label(argv: Sequence[str]) -> str:
+    """A helper's name, the same in every run (a process title's ``[run PID]`` left out)."""
+    if len(argv) == 1 and " [" in argv[0]:
+        return argv[0].split(" [", 1)[0]
     words = [a for a in argv[:4] if not a.startswith("-")]
     for word in words[1:]:
         if "mlaunch" in word or word.endswith(".py"):

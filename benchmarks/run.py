@@ -1364,7 +1364,7 @@ class Bench:
             "ROS_DOMAIN_ID": str(domain),
             "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
         }
-        runs = 1 if self.config.mode == "quick" else 3
+        runs = self.config.runs  # each ros2 launch start takes 15 s (quiet) to 100 s (loaded)
         say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
         try:
             figures = autoware_bench.measure(runs, venv.mlaunch, venv.python, env, self.tmp, say)

@@ -412,6 +412,7 @@ def test_autoware_watch_tells_the_launch_from_the_launcher(tmp_path: Path) -> No
     assert ab.is_fixture(["/bin/sh", str(prefix / "lib/pkg/exe"), "--ros-args"], prefix)
     assert ab.is_fixture(["/venv/bin/python", "/x/benchmarks/autoware_container.py"], prefix)
     assert not ab.is_fixture(["launch-guard [run 12]"], prefix)
+    assert ab._label(["launch-guard [run 12]"]) == "launch-guard"  # one name in every run
     assert not ab.is_fixture(["/bin/sh", "/usr/lib/other"], prefix)
     assert ab.is_tree_command(["/venv/bin/python", "/venv/bin/xacro", "vehicle.xacro"])
     assert not ab.is_tree_command(["/venv/bin/python", "/venv/bin/mlaunch", "x.launch.xml"])
