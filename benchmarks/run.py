@@ -1605,6 +1605,7 @@ README_END = "<!-- benchmarks/run.py --readme: end -->"
 # (what the README calls it, the row's group and name in the results); ros venv first.
 README_ROWS = (
     ("first child running, one-process launch", "startup", "first child running, py, N=1"),
+    ("its CPU until then (from exec)", "startup", "CPU until the first child runs, py, N=1"),
     ("first child running, one-Node launch", "startup", "first child running, py, one Node"),
     ("all 100 children running", "startup", "all 100 children running, py"),
     ("100 children gone after Ctrl-C", "shutdown", "SIGINT until all gone, N=100"),
@@ -1645,10 +1646,7 @@ def readme_table(data: dict[str, Any]) -> str:
             fmt_value(row["mlaunch"]["median"], unit),
             f"{fmt_value(floor['median'], unit)} ({floor['name']})" if floor else "-",
             fmt_value(ref["median"], unit) if ref else "-",
-            " / ".join(
-                "-" if x is None else f"{x:.2f}x"
-                for x in (row["ratio"], row.get("reference_ratio"))
-            ),
+            " / ".join(_ratio_text(x) for x in (row["ratio"], row.get("reference_ratio"))),
             ""
             if row["target"] is None
             else f"{'≥' if row['target']['op'] == '>=' else '≤'} "
@@ -1667,6 +1665,12 @@ def readme_table(data: dict[str, Any]) -> str:
         " Regenerate: `benchmarks/run.py --json FILE`, then `benchmarks/run.py --readme FILE`.",
     ]
     return "\n".join(out) + "\n"
+
+
+def _ratio_text(ratio: float | None) -> str:
+    if ratio is None:
+        return "-"
+    return f"{ratio:.3f}x" if ratio < 0.1 else f"{ratio:.2f}x"
 
 
 def render_readme(results_json: Path, readme: Path = README) -> None:

@@ -176,6 +176,8 @@ def test_readme_table_is_written_between_the_markers(tmp_path: Path) -> None:
 def test_readme_table_without_ros2_launch_or_rows_or_markers(tmp_path: Path) -> None:
     table = bench.readme_table(_results_json(with_reference=False))
     assert "| 20.0 ms | 10.0 ms (floor) | - | 2.00x / - |" in table
+    # A ratio far below 1 (shutdown against ros2 launch) keeps its digits.
+    assert [bench._ratio_text(x) for x in (0.0021, 0.5, None)] == ["0.002x", "0.50x", "-"]
     data = _results_json(with_reference=True)
     data["rows"] = [r for r in data["rows"] if r["group"] != "shutdown"]
     with pytest.raises(bench.BenchError, match="lack the rows of: 100 children gone"):

@@ -14,7 +14,8 @@ from __future__ import annotations
 import os
 import re
 
-_NAME = re.compile(r"mlaunch-([0-9]+)-[0-9a-f]{8}")
+# Matched in the guard's sweep only (re's cache compiles it there, not before the first child).
+_NAME = r"mlaunch-([0-9]+)-[0-9a-f]{8}"
 _locks: dict[str, int] = {}  # this process's private folders -> the descriptor holding the lock
 
 
@@ -83,7 +84,7 @@ def sweep_dead_runs(base: str | None = None) -> list[str]:
     removed = []
     uid = os.getuid()
     for name in names:
-        m = _NAME.fullmatch(name)
+        m = re.fullmatch(_NAME, name)
         if m is None or _alive(int(m.group(1))):
             continue
         path = os.path.join(base, name)

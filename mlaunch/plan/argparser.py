@@ -17,7 +17,8 @@ TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing c
 if TYPE_CHECKING:
     from typing import Any, NoReturn
 
-_UNRECOGNIZED = re.compile(r"unrecognized arguments: (\S+)")
+# Compiled on the first error only: nothing is compiled on a run's way to its first child.
+_UNRECOGNIZED = r"unrecognized arguments: (\S+)"
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -27,7 +28,7 @@ class ArgumentParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message}{self._hint(message)}\n")
 
     def _hint(self, message: str) -> str:
-        unknown = _UNRECOGNIZED.match(message)
+        unknown = re.match(_UNRECOGNIZED, message)
         hint = ""
         if unknown and unknown.group(1).startswith("-"):
             # Compared without the dashes, which every option shares (--bogus is not --ros2).
