@@ -131,8 +131,14 @@ def prefix_key(sources: Path, python: str) -> str:
     return digest.hexdigest()[:16]
 
 
-def build(sources: Path, cache: Path = CACHE, python: str = sys.executable) -> Tree:
-    """The prefix of the tree from the archives in ``sources``, built once per key."""
+def build(
+    sources: Path,
+    cache: Path = CACHE,
+    python: str = sys.executable,
+    size: tuple[int, int] = (PROCESSES, COMPOSABLES),
+) -> Tree:
+    """The prefix of the tree from the archives in ``sources``, built once per key and checked
+    to start ``size`` (processes, composable nodes)."""
     if not (sources / "MANIFEST.tsv").is_file():
         raise FixtureError(f"{sources} holds no MANIFEST.tsv: get the sources first")
     prefix = cache / f"prefix-{prefix_key(sources, python)}"
@@ -146,7 +152,7 @@ def build(sources: Path, cache: Path = CACHE, python: str = sys.executable) -> T
         _lay_out(sources, staging, python)
         made = Tree(staging, tree.map_path)
         _add_executables(made, python)
-        check(made, python)
+        check(made, python, size)
         (staging / ".built").write_text("")
         for old in cache.glob("prefix-*"):  # of other sources or an older builder
             shutil.rmtree(old)
@@ -246,7 +252,9 @@ def _add_executables(tree: Tree, python: str) -> None:
         path.chmod(path.stat().st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
 
 
-def check(tree: Tree, python: str) -> tuple[int, int]:
+def check(
+    tree: Tree, python: str, size: tuple[int, int] = (PROCESSES, COMPOSABLES)
+) -> tuple[int, int]:
     """The tree's size as mlaunch resolves it; a FixtureError if it is not planning_simulator's."""
     plan = plan_json(tree, python)
     warnings = [str(w) for w in plan.get("warnings", []) if "executable" in str(w)]  # type: ignore[attr-defined]
@@ -256,10 +264,10 @@ def check(tree: Tree, python: str) -> tuple[int, int]:
     assert isinstance(steps, list)
     processes = sum(1 for s in steps if s.get("kind") == "process")
     composables = sum(len(s.get("nodes", [])) for s in steps if s.get("kind") == "load_components")
-    if (processes, composables) != (PROCESSES, COMPOSABLES):
+    if (processes, composables) != size:
         raise FixtureError(
             f"the tree resolves to {processes} processes and {composables} composable nodes,"
-            f" not planning_simulator's {PROCESSES} and {COMPOSABLES}"
+            f" not planning_simulator's {size[0]} and {size[1]}"
         )
     return processes, composables
 

@@ -421,3 +421,50 @@ def test_autoware_watch_tells_the_launch_from_the_launcher(tmp_path: Path) -> No
     assert autoware_container.default_name("autoware::planning::PlannerNode") == "plannernode"
     plugins = autoware_container.AnyPlugin()
     assert plugins.get(("any_pkg", "ns::Thing"))[0] == "thing" and len(plugins) == 0
+
+
+def test_autoware_fixture_lays_out_a_prefix_of_stand_ins(tmp_path: Path) -> None:
+    """From pinned archives to an ament prefix: each package's share folder and index entry,
+    a recorder for every executable the tree starts (a stub package for one the sources lack),
+    the container stand-in for rclcpp_components' containers; a tree of the wrong size is said."""
+    import tarfile
+
+    import autoware_tree as fixture
+
+    top = tmp_path / "src" / "autoware_launch"
+    (top / "autoware_launch" / "launch").mkdir(parents=True)
+    (top / "autoware_launch" / "src").mkdir()
+    (top / "autoware_launch" / "package.xml").write_text(
+        "<package><name>autoware_launch</name></package>"
+    )
+    (top / "autoware_launch" / "src" / "main.cpp").write_text("int main() {}")
+    (top / "autoware_launch" / "launch" / "planning_simulator.launch.xml").write_text(
+        '<launch>\n  <arg name="map_path"/>\n'
+        '  <node pkg="autoware_launch" exec="planner" name="planner"/>\n'
+        '  <node pkg="robot_state_publisher" exec="robot_state_publisher"/>\n'
+        '  <node_container pkg="rclcpp_components" exec="component_container" name="c"'
+        ' namespace="">\n'
+        '    <composable_node pkg="x" plugin="x::Y" name="y"/>\n  </node_container>\n</launch>\n'
+    )
+    sources = tmp_path / "sources"
+    sources.mkdir()
+    with tarfile.open(sources / "autoware_launch.tar.gz", "w:gz") as tar:
+        tar.add(top, arcname="autoware_launch")
+    (sources / "MANIFEST.tsv").write_text("archive\nautoware_launch.tar.gz\n")
+    cache = tmp_path / "cache"
+    with pytest.raises(fixture.FixtureError, match="3 processes and 1 composable nodes, not"):
+        fixture.build(sources, cache)
+    tree = fixture.build(sources, cache, size=(3, 1))
+    prefix = tree.prefix
+    assert (prefix / ".built").is_file() and tree.launch_file.is_file()
+    assert not (prefix / "share/autoware_launch/src").exists()  # compiled, not installed
+    index = prefix / "share/ament_index/resource_index/packages"
+    assert sorted(p.name for p in index.iterdir()) == [
+        "autoware_launch", "rclcpp_components", "robot_state_publisher"]  # fmt: skip
+    for recorder in ("autoware_launch/planner", "robot_state_publisher/robot_state_publisher"):
+        text = (prefix / "lib" / recorder).read_text()
+        assert os.access(prefix / "lib" / recorder, os.X_OK) and f"p {recorder}" in text
+    container = (prefix / "lib/rclcpp_components/component_container").read_text()
+    assert str(fixture.CONTAINER) in container
+    # Built once: a second call finds it.
+    assert fixture.build(sources, cache, size=(3, 1)) == tree
