@@ -123,12 +123,12 @@ def test_a_share_the_launch_does_not_have_is_refused(
 ROS1 = """<launch>
   <machine name="robot" address="robot-alias" env-loader="/opt/env.sh"/>
   <node pkg="mlaunch_demo" type="talker" name="first"/>
-  <machine name="gpu" address="gpu-alias" default="true"/>
-  <node pkg="mlaunch_demo" type="talker" name="a"/>
   <group ns="g">
+    <machine name="gpu" address="gpu-alias" default="true"/>
+    <node pkg="mlaunch_demo" type="talker" name="a"/>
     <node pkg="mlaunch_demo" type="talker" name="b" machine="robot"/>
-    <node pkg="mlaunch_demo" type="talker" name="c"/>
   </group>
+  <node pkg="mlaunch_demo" type="talker" name="c"/>
   <machine name="never" address="never-alias" default="never"/>
   <node pkg="mlaunch_demo" type="talker" name="d"/>
 </launch>
@@ -136,8 +136,9 @@ ROS1 = """<launch>
 
 
 def test_ros1_machines_split_by_roslaunchs_rules(tmp_path: Path) -> None:
-    # roslaunch: default="true" gives its machine to the nodes after it that name none,
-    # inside groups too; default="never" does not take it over; machine= wins.
+    # roslaunch 1.15: default="true" gives its machine to the nodes after it that name none,
+    # in the file's order: past the end of its <group> too (the loader hands the default back
+    # up); default="never" does not take it over; machine= wins.
     shares = {}
     for share in ("local", "gpu", "robot"):
         plan = resolve_share(tmp_path, ROS1, share, suffix="launch")
@@ -257,3 +258,22 @@ def test_a_load_is_done_by_the_run_that_starts_its_container(tmp_path: Path) -> 
     assert loads(local) == (["/elsewhere_box"], ["/box"])
     assert [s.label for s in gpu.processes()] == ["component_container-1"]
     assert local.processes() == []
+
+
+def test_ros1_default_machine_holds_past_an_include(tmp_path: Path) -> None:
+    (tmp_path / "inc.launch").write_text(
+        '<launch>\n  <machine name="gpu" address="gpu-alias" default="true"/>\n'
+        '  <node pkg="mlaunch_demo" type="talker" name="inside"/>\n</launch>\n'
+    )
+    text = (
+        '<launch>\n  <node pkg="mlaunch_demo" type="talker" name="before"/>\n'
+        '  <include file="$(dirname)/inc.launch"/>\n'
+        '  <node pkg="mlaunch_demo" type="talker" name="after"/>\n</launch>\n'
+    )
+    plan = resolve_share(tmp_path, text, None, suffix="launch")
+    placed = {
+        str(s.node.name): s.machine.name if s.machine else "local"
+        for s in plan.processes()
+        if s.node is not None
+    }
+    assert placed == {"before": "local", "inside": "gpu", "after": "gpu"}  # as roslaunch 1.15

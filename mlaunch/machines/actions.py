@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from mlaunch.launch.action import Action
 from mlaunch.launch.actions.execute_process import PUSHED_MACHINE as PUSHED
+from mlaunch.launch.actions.execute_process import ROS1_DEFAULT_MACHINE
 from mlaunch.launch.substitution import describe, normalize, perform_substitutions
 from mlaunch.launch.substitutions.boolean_substitution import to_bool
 from mlaunch.plan.errors import LaunchFileError
@@ -45,9 +46,13 @@ class Machine(Action):
         env_loader: SomeSubstitutionsType | None = None,
         default: Any = False,
         timeout: Any = DEFAULT_TIMEOUT,
+        ros1_default: bool = False,
         **kwargs: Any,
     ) -> None:
         super().__init__(**kwargs)
+        # roslaunch's <machine default="true"> (mlaunch.ros1.build): the default holds for the
+        # nodes after it in the file's order, past its group, instead of in its scope.
+        self.ros1_default = ros1_default
         self.name = normalize(name)
         self.address = normalize(address)
         self.user = None if user is None else normalize(user)
@@ -68,7 +73,10 @@ class Machine(Action):
             )
         table.setdefault(spec.name, spec)
         if _flag(context, self.default):
-            context.launch_configurations[PUSHED] = spec.name
+            if self.ros1_default:
+                context.run_state[ROS1_DEFAULT_MACHINE] = spec.name
+            else:
+                context.launch_configurations[PUSHED] = spec.name
 
     def resolve_spec(self, context: LaunchContext) -> MachineSpec:
         planner = context.planner

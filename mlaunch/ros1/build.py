@@ -145,7 +145,9 @@ def _action(item: Item) -> Any:
         from mlaunch.machines.actions import Machine
 
         optional = {k: subs(getattr(item, k)) for k, _ in MACHINE_FIELDS if getattr(item, k)}
-        return Machine(name=subs(item.name), address=subs(item.address), **optional)
+        return Machine(
+            name=subs(item.name), address=subs(item.address), ros1_default=True, **optional
+        )
     if isinstance(item, NodeItem):
         keywords = node_keywords(item)
         shell_args = None
@@ -153,9 +155,13 @@ def _action(item: Item) -> Any:
             keywords.pop("arguments", None)
             shell_args = subs(item.shell_args)
         package = static_text(item.package) or ""
-        return RoslaunchNode(shell_args=shell_args, ros1_package=package, **keywords)
+        node = RoslaunchNode(shell_args=shell_args, ros1_package=package, **keywords)
+        node.follows_ros1_default = True
+        return node
     if isinstance(item, ProcessItem):
-        return core.ExecuteProcess(cmd=[subs(c) for c in item.cmd], **process_keywords(item))
+        process = core.ExecuteProcess(cmd=[subs(c) for c in item.cmd], **process_keywords(item))
+        process.follows_ros1_default = True
+        return process
     raise TypeError(f"unknown item {item!r}")
 
 

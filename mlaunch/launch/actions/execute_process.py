@@ -35,6 +35,10 @@ if TYPE_CHECKING:
 # The launch configuration PushMachine (or a default Machine) sets for the rest of its scope
 # (mlaunch.machines); here so that a launch without machines never imports that package.
 PUSHED_MACHINE = "mlaunch.machine"
+# The run state's key for roslaunch's default machine: a <machine default="true"> gives its
+# machine to the nodes after it in the file's order, past the end of its <group> or <include>
+# (roslaunch's loader hands the default back up), not in a launch configuration's scope.
+ROS1_DEFAULT_MACHINE = "ros1_default_machine"
 
 _SIGTERM_DEFAULT = LaunchConfiguration("sigterm_timeout", default=5)
 _SIGKILL_DEFAULT = LaunchConfiguration("sigkill_timeout", default=5)
@@ -279,9 +283,15 @@ class ExecuteProcess(Action):
                 return True
         return machine is not None and not machine.local
 
+    # A roslaunch <node>/<executable> (mlaunch.ros1.build): given no machine, it takes the
+    # file's default machine in roslaunch's order (ROS1_DEFAULT_MACHINE).
+    follows_ros1_default = False
+
     def _machine(self, context: LaunchContext) -> Any:
         """The MachineSpec this process runs on, or None (no machine given or pushed)."""
         pushed = context.launch_configurations.get(PUSHED_MACHINE)
+        if not pushed and self.follows_ros1_default:
+            pushed = context.run_state.get(ROS1_DEFAULT_MACHINE)
         if self.machine is None and not pushed:
             return None  # the common case: nothing of mlaunch.machines is imported
         from mlaunch.plan.machine import lookup
