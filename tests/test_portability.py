@@ -9,6 +9,7 @@ and ``test_jazzy_accepts_what_passes`` runs the clean ones. Every file in launch
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -242,9 +243,8 @@ def _ros2(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:
     env = dict(
         REFERENCE, AMENT_PREFIX_PATH=REFERENCE["AMENT_PREFIX_PATH"], ROS_LOG_DIR=str(cwd / "log")
     )
-    return subprocess.run(
-        ["ros2", "launch", *args], env=env, cwd=cwd, capture_output=True, text=True, timeout=60
-    )
+    ros2 = shutil.which("ros2", path=env["PATH"]) or "ros2"
+    return harness.reference.run_ros2([ros2, "launch", *args], env=env, cwd=cwd, timeout=60)
 
 
 def _failed(run: subprocess.CompletedProcess[str]) -> bool:

@@ -37,6 +37,7 @@ REPO = HERE.parent.parent
 PACKAGE = "conf_pkg"
 sys.path.insert(0, str(HERE.parent))  # tests/, when record.py runs this outside pytest
 import reference  # noqa: E402
+from reference import run_ros2  # noqa: E402
 
 REFERENCE_ENV_SH = reference.ENV_SH
 SUFFIXES = (".launch.py", ".launch.yaml", ".launch.xml")
@@ -169,16 +170,18 @@ def run_case(
     argv = launcher_argv(launcher, name, prefix, opts["args"], opts["pkg"])
     if launcher == "ros2":
         argv[0] = shutil.which("ros2", path=env["PATH"]) or "ros2"
-    proc = subprocess.run(
-        argv,
-        env=env,
-        cwd=str(work),
-        stdin=subprocess.DEVNULL,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        start_new_session=True,
-    )
+        proc = run_ros2(argv, env=env, cwd=work, timeout=60)
+    else:
+        proc = subprocess.run(
+            argv,
+            env=env,
+            cwd=str(work),
+            stdin=subprocess.DEVNULL,
+            capture_output=True,
+            text=True,
+            timeout=60,
+            start_new_session=True,
+        )
     lines = (
         (records / "records.jsonl").read_text().splitlines()
         if (records / "records.jsonl").exists()
