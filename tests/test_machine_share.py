@@ -277,3 +277,39 @@ def test_ros1_default_machine_holds_past_an_include(tmp_path: Path) -> None:
         if s.node is not None
     }
     assert placed == {"before": "local", "inside": "gpu", "after": "gpu"}  # as roslaunch 1.15
+
+
+def test_a_shares_print_matches_what_the_ssh_path_prints_for_its_node(tmp_path: Path) -> None:
+    # The same node, as the launcher would start it over ssh (--print of the whole launch) and
+    # as its machine's share starts it here: the same parameters, remaps, names and launch-set
+    # environment; argv differs only by the env-loader in front and the program found here.
+    path = tmp_path / "node.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch.actions import SetEnvironmentVariable\n"
+        "from launch_ros.actions import Node, SetParameter\n"
+        "from mlaunch.actions import Machine\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([\n"
+        "        Machine(name='robot', address='robot-alias', env_loader='/opt/env.sh'),\n"
+        "        SetEnvironmentVariable('SET_BY_LAUNCH', 'set'), SetParameter('g', 2.5),\n"
+        "        Node(package='mlaunch_demo', executable='talker', name='t', namespace='r',\n"
+        "             machine='robot', parameters=[{'rate': 5, 'frame': 'base'}],\n"
+        "             remappings=[('a', 'b')], arguments=['x y']),\n"
+        "    ])\n"
+    )
+    env = clean_env(AMENT_PREFIX_PATH=str(EXAMPLES_PREFIX))
+
+    def process(*extra: str) -> dict[str, object]:
+        done = run_mlaunch(str(path), "--print", "--format", "json", *extra, env=env)
+        assert done.returncode == 0, done.stderr
+        steps = json.loads(done.stdout)["steps"]
+        found: dict[str, object] = next(s for s in steps if s["kind"] == "process")
+        return found
+
+    over_ssh, share = process(), process("--machine", "robot")
+    for key in ("label", "parameters", "remaps", "node", "env", "cwd", "respawn", "stop"):
+        assert share[key] == over_ssh[key], key
+    program = str(EXAMPLES_PREFIX / "lib" / "mlaunch_demo" / "talker")
+    assert share["argv"] == ["/opt/env.sh", program, *over_ssh["argv"][1:]]  # type: ignore[index]
+    assert over_ssh["machine"]["local"] is False and share["machine"]["local"] is True  # type: ignore[index]
