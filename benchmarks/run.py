@@ -43,19 +43,40 @@ if str(HERE) not in sys.path:
 sys.path.append(str(REPO / "tests"))  # the ROS-domain lock the tests take (tests/ros_domain.py)
 import launchgen as gen  # noqa: E402
 import probes as pr  # noqa: E402
+import startup_profile  # noqa: E402
 from probes import BenchError  # noqa: E402
 from reference import HOME as REFERENCE_HOME  # noqa: E402
 from reference import MISSING as REFERENCE_MISSING  # noqa: E402
 from ros_domain import private_domain  # noqa: E402
 
-GROUPS = ("startup", "print", "output", "memory", "sim", "importtime", "autoware", "fleet")
+GROUPS = (
+    "startup",
+    "print",
+    "output",
+    "memory",
+    "sim",
+    "importtime",
+    "profile",
+    "autoware",
+    "fleet",
+)
 # Minutes long, and needing what a run does not always have (sources fetched beforehand;
 # ansible-core and sshd for fleet, a deploy over private sshd daemons, tests/fleet.py): only
 # when --only names them.
 OPT_IN_GROUPS = ("autoware", "fleet")
 DEFAULT_GROUPS = tuple(g for g in GROUPS if g not in OPT_IN_GROUPS)
 # The table's sections: shutdown and memory are measured in the start-up runs.
-SECTIONS = ("startup", "shutdown", "memory", "print", "output", "sim", "autoware", "fleet")
+SECTIONS = (
+    "startup",
+    "profile",
+    "shutdown",
+    "memory",
+    "print",
+    "output",
+    "sim",
+    "autoware",
+    "fleet",
+)
 SIM_LAUNCH = REPO / "launches" / "jtbot_sim.launch.py"
 SIM_WORLD = REPO / "robots" / "jtbot_description" / "world" / "jt.world"
 SIM_XACRO = REPO / "robots" / "jtbot_description" / "urdf" / "jtbot.urdf.xacro"
@@ -1335,6 +1356,31 @@ class Bench:
         except OSError:
             return False
 
+    # --- where the CPU goes until the first child ---------------------------------------------
+
+    def profile(self, venv: Venv) -> None:
+        """mlaunch's CPU until its first child, bucket by bucket (benchmarks/startup_profile.py),
+        for a one-process and a one-Node launch whose child is ``true``."""
+        true = shutil.which("true") or "/bin/true"
+        one = gen.write([gen.many_children("true1", 1, [true])], "py", self.launches / "true1")
+        node, prefix = gen.write_node_launch(self.launches / "node_true", Path(true), self.fifo)
+        cases = (
+            ("one-process launch", one, self.env),
+            ("one-Node launch", node, {**self.env, "AMENT_PREFIX_PATH": str(prefix)}),
+        )
+        for what, path, env in cases:
+            try:
+                found = startup_profile.profile(
+                    [str(venv.mlaunch), str(path)], env, self.config.runs
+                )
+            except (RuntimeError, subprocess.TimeoutExpired) as e:
+                self.results.skip("profile", venv.name, what, str(e))
+                continue
+            for bucket, samples in found.items():
+                self.results.rows.append(
+                    Row("profile", f"{what}: {bucket}", venv.name, "s", samples, note="CPU")
+                )
+
     # --- import time ---------------------------------------------------------------------------
 
     def importtime(self, venv: Venv) -> None:
@@ -1768,6 +1814,8 @@ def run(args: argparse.Namespace) -> Results:
             print(f"measuring in the {venv.name} venv ...", file=sys.stderr, flush=True)
             if "importtime" in groups:
                 bench.importtime(venv)
+            if "profile" in groups:
+                bench.profile(venv)
             if "startup" in groups:
                 bench.startup(venv)
             if "print" in groups:

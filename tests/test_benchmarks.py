@@ -468,3 +468,40 @@ def test_autoware_fixture_lays_out_a_prefix_of_stand_ins(tmp_path: Path) -> None
     assert str(fixture.CONTAINER) in container
     # Built once: a second call finds it.
     assert fixture.build(sources, cache, size=(3, 1)) == tree
+
+
+def test_startup_buckets_add_up_to_the_marks() -> None:
+    import startup_profile
+
+    found = startup_profile.buckets([("interpreter", 0.010), ("imports", 0.025), ("spawn", 0.026)])
+    assert found == pytest.approx(
+        {
+            "interpreter": 0.010,
+            "imports": 0.015,
+            "spawn": 0.001,
+            "total until the first child runs": 0.026,
+        }
+    )
+
+
+def test_startup_profile_follows_mlaunch_to_its_first_child(tmp_path: Path) -> None:
+    """Every step of a run's way to its first child is a bucket, from the process's exec."""
+    import startup_profile
+
+    path = gen.write([gen.many_children("t", 1, ["true"])], "py", tmp_path / "launch")
+    env = {**os.environ, "ROS_LOG_DIR": str(tmp_path / "logs"), "MLAUNCH_NO_CACHE": "1"}
+    found = startup_profile.profile([sys.executable, "-m", "mlaunch", str(path)], env, 1)
+    steps = [
+        "interpreter and site (from exec)",
+        "import mlaunch.cli (argparse, options)",
+        "parse the command line",
+        "lifeline (params folder, cgroup, guard fork)",
+        "load the launch file",
+        "resolve",
+        "supervisor: imports, set-up, parts",
+        "spawn of the first child",
+    ]
+    assert [s for s in steps if s not in found] == []
+    assert all(len(v) == 1 and v[0] >= 0 for v in found.values())
+    total = found.pop("total until the first child runs")[0]
+    assert sum(v[0] for v in found.values()) == pytest.approx(total)

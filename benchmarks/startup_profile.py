@@ -1,0 +1,172 @@
+"""Where mlaunch's CPU goes on its way to the first child, bucket by bucket.
+
+    .venv/bin/python benchmarks/startup_profile.py [--runs N] [--tree DIR] -- MLAUNCH [ARGS...]
+
+Runs the command as given (the mlaunch command of the venv, with its shell script and without
+the ROS wheels' re-exec, or pip's console script, or ``python -m mlaunch``) N times with a
+``sitecustomize`` on ``PYTHONPATH`` (``--tree DIR`` first: another checkout of mlaunch, to compare
+revisions in one run). ``site`` imports it after the ``.pth`` files, so it runs in the interpreter
+that goes on to run mlaunch (the hook's re-exec, where there is one, happened before). It takes
+the process's CPU time (``CLOCK_PROCESS_CPUTIME_ID``: everything since the fork, the shell
+script and the re-exec included) at each step and writes them to a file when the supervisor's
+first ``start`` returns; mlaunch then runs on (the launch's child should end by itself: ``true``).
+
+Prints the buckets (CPU, min and median over the runs) and, with ``--json``, writes them. The
+bucket names are the steps of ``mlaunch.app.pipeline.launch``; a step the revision does not have
+is absent. ``benchmarks/run.py --only profile`` runs it on the one-process and one-Node launches.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+# Written to a folder of its own on PYTHONPATH as sitecustomize.py. The marks are CPU seconds of
+# the whole process; each bucket is the difference between two marks.
+SITECUSTOMIZE = r"""
+import os, sys, time
+_out = os.environ.pop("MLAUNCH_STARTUP_PROFILE", "")
+if _out:  # popped: the Python programs mlaunch starts are not profiled
+    _marks = [("interpreter and site (from exec)", time.process_time())]
+
+    def _mark(name):
+        _marks.append((name, time.process_time()))
+
+    def _wrap(owner, name, label):
+        original = getattr(owner, name, None)
+        if original is None:
+            return
+
+        def wrapped(*args, **kwargs):
+            _mark("before " + label)
+            try:
+                return original(*args, **kwargs)
+            finally:
+                _mark(label)
+
+        setattr(owner, name, wrapped)
+
+    def _setup():
+        import mlaunch.cli
+        _mark("import mlaunch.cli (argparse, options)")
+        import mlaunch.app.pipeline as pipeline
+        import mlaunch.engine.lifeline as lifeline
+        _mark("import app.pipeline, engine.lifeline")
+        _wrap(mlaunch.cli, "parse_options", "parse the command line")
+        _wrap(lifeline.Lifeline, "__enter__", "lifeline (params folder, cgroup, guard fork)")
+        _wrap(pipeline, "plan_cache", "plan cache: open")
+        _wrap(pipeline, "load_file", "load the launch file")
+        _wrap(pipeline, "resolve_for_run", "resolve")
+        supervise = pipeline.supervise
+
+        def first_spawn(*args, **kwargs):
+            _mark("before supervise")
+            import mlaunch.engine.supervisor as sup
+            start = sup.Supervisor.start
+
+            def started(self, *a, **k):
+                _mark("supervisor: imports, set-up, parts")
+                result = start(self, *a, **k)
+                _mark("spawn of the first child")
+                sup.Supervisor.start = start
+                text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
+                with open(_out + ".tmp", "w") as f:
+                    f.write(text + "\n")
+                os.rename(_out + ".tmp", _out)
+                return result
+
+            sup.Supervisor.start = started
+            return supervise(*args, **kwargs)
+
+        pipeline.supervise = first_spawn
+
+    _setup()
+"""
+
+
+def buckets(marks: list[tuple[str, float]]) -> dict[str, float]:
+    """CPU seconds per step: the first mark itself, then the differences; the time between a
+    step's end and the next step's start is its own bucket ("before X": the code in between)."""
+    out: dict[str, float] = {}
+    previous = 0.0
+    for name, cpu in marks:
+        out[name] = out.get(name, 0.0) + cpu - previous
+        previous = cpu
+    out["total until the first child runs"] = previous
+    return out
+
+
+def profile(
+    argv: Sequence[str], env: dict[str, str], runs: int, tree: str | None = None
+) -> dict[str, list[float]]:
+    """Run ``argv`` ``runs`` times (plus a warm-up); each bucket's CPU seconds per run."""
+    found: dict[str, list[float]] = {}
+    with tempfile.TemporaryDirectory(prefix="mlaunch-profile-") as tmp:
+        site = Path(tmp) / "site"
+        site.mkdir()
+        (site / "sitecustomize.py").write_text(SITECUSTOMIZE)
+        paths = [p for p in (tree, str(site), env.get("PYTHONPATH")) if p]
+        for i in range(runs + 1):
+            out = Path(tmp) / f"marks-{i}.txt"
+            run_env = {**env, "PYTHONPATH": os.pathsep.join(paths)}
+            run_env["MLAUNCH_STARTUP_PROFILE"] = str(out)
+            done = subprocess.run(
+                list(argv), env=run_env, capture_output=True, text=True, timeout=120
+            )
+            if not out.exists():
+                raise RuntimeError(
+                    f"no marks from {' '.join(argv)} (exit {done.returncode}):"
+                    f" {done.stderr.strip()[-500:] or done.stdout.strip()[-500:]}"
+                )
+            if i == 0:
+                continue  # the warm-up: bytecode written, caches warm
+            marks = []
+            for line in out.read_text().splitlines():
+                name, _, cpu = line.rpartition("\t")
+                marks.append((name, float(cpu)))
+            for name, value in buckets(marks).items():
+                found.setdefault(name, []).append(value)
+    return found
+
+
+def table(found: dict[str, list[float]]) -> str:
+    lines = [f"{'bucket':52s} {'CPU min':>9s} {'median':>9s}"]
+    for name, values in found.items():
+        lines.append(
+            f"{name:52s} {min(values) * 1000:7.2f} ms {statistics.median(values) * 1000:6.2f} ms"
+        )
+    return "\n".join(lines) + f"\n(load average {os.getloadavg()[0]:.2f})\n"
+
+
+def main(args: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="benchmarks/startup_profile.py", description=__doc__)
+    parser.add_argument("--runs", type=int, default=9)
+    parser.add_argument("--tree", help="a checkout of mlaunch to run instead (put on PYTHONPATH)")
+    parser.add_argument("--json", help="write the buckets' samples here")
+    parser.add_argument("command", nargs=argparse.REMAINDER)
+    opts = parser.parse_args(args)
+    command = [c for c in opts.command if c != "--"] if opts.command[:1] == ["--"] else opts.command
+    if not command:
+        parser.error("give the mlaunch command to run after --")
+    # As benchmarks/run.py measures: bytecode written and read, buffered output.
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONUNBUFFERED")
+    }
+    found = profile(command, env, opts.runs, opts.tree)
+    sys.stdout.write(table(found))
+    if opts.json:
+        Path(opts.json).write_text(json.dumps(found, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
