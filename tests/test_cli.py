@@ -544,6 +544,9 @@ def test_the_mlaunch_command_starts_python_once(tmp_path: Path, env: dict[str, s
     assert done.returncode == 0, done.stderr[-2000:]
     # Each interpreter writes this header once: two would be the hook's re-exec.
     assert done.stderr.count("import time: self [us] | cumulative | imported package") == 1
+    # Nor is the hook imported (with its guard set it would import pathlib, for nothing).
+    imported = {line.rpartition("|")[2].strip() for line in done.stderr.splitlines()}
+    assert not {"ros_wheels_bootstrapper", "pathlib"} & imported
 
 
 @pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv")
