@@ -93,24 +93,10 @@ def _hwm(pid: int) -> float:
 
 
 def descendants(root: int) -> list[int]:
-    """Every live process below ``root`` (from /proc/PID/task/*/children)."""
-    found: list[int] = []
-    todo = [root]
-    while todo:
-        pid = todo.pop()
-        try:
-            tasks = os.listdir(f"/proc/{pid}/task")
-        except OSError:
-            continue
-        for tid in tasks:
-            try:
-                with open(f"/proc/{pid}/task/{tid}/children") as f:
-                    kids = [int(x) for x in f.read().split()]
-            except OSError:
-                continue
-            found += kids
-            todo += kids
-    return found
+    """Every live process below ``root`` (the engine's walk of /proc/PID/task/*/children)."""
+    from mlaunch.engine.proctable import tree
+
+    return [info.pid for info in tree(root)]
 
 
 def is_fixture(argv: Sequence[str], prefix: Path) -> bool:
