@@ -393,20 +393,42 @@ def measure(
     if ros2 is None:
         return "the reference environment has no ros2 command"
     launch = [str(tree.launch_file), *tree.arguments]
-    ml: list[Sample] = []
+    # mlaunch twice a run: as a user starts it (the plan cache on: from run 1 on, the plan
+    # the warm-up stored) and resolving the files again (--no-cache).
+    cold = {**ours, "MLAUNCH_NO_CACHE": "1"}
+    ml: dict[str, list[Sample]] = {"": [], ", --no-cache": []}
     ref: list[Sample] = []
     for i in range(runs + 1):
         say(f"autoware: run {i} of {runs} (0 is the warm-up): ros2 launch ...")
         one_ref = start_tree([ros2, "launch", *launch], theirs, tree, tmp, tmp / "ros2.out")
-        say(f"autoware: run {i}: mlaunch ...")
-        one_ml = start_tree([str(mlaunch), *launch], ours, tree, tmp, tmp / "mlaunch.out")
+        say(f"autoware: run {i}: mlaunch, mlaunch --no-cache ...")
+        warm = start_tree([str(mlaunch), *launch], ours, tree, tmp, tmp / "mlaunch.out")
+        fresh = start_tree([str(mlaunch), *launch], cold, tree, tmp, tmp / "mlaunch.out")
         if i:
             ref.append(one_ref)
-            ml.append(one_ml)
+            ml[""].append(warm)
+            ml[", --no-cache"].append(fresh)
+    figures = [
+        Figure(
+            "planning_simulator: 55 processes and 53 components up",
+            "s",
+            [s.up for s in ml[""]],
+            reference_samples=[s.up for s in ref],
+        )
+    ]
+    for variant, samples in ml.items():
+        figures += tree_figures(variant, samples, ref)
+    figures += print_figures(runs, mlaunch, python, launch, ours)
+    figures += part_figures(runs, python, mlaunch, launch, ours)
+    return figures
+
+
+def tree_figures(variant: str, ml: Sequence[Sample], ref: Sequence[Sample]) -> list[Figure]:
+    """The launcher's CPU and memory (with their ratios to ros2 launch's) and Ctrl-C."""
 
     def both(name: str, attr: str, unit: str, note: str = "") -> Figure:
         return Figure(
-            name,
+            name + variant,
             unit,
             [getattr(s, attr) for s in ml],
             note=note,
@@ -415,21 +437,16 @@ def measure(
 
     def ratio(name: str, attr: str, target: float) -> Figure:
         pairs = zip(ml, ref, strict=True)
-        return Figure(
-            name, "x", [getattr(m, attr) / getattr(r, attr) for m, r in pairs], target=target
-        )
+        values = [getattr(m, attr) / getattr(r, attr) for m, r in pairs]
+        return Figure(name + variant + ", mlaunch / ros2 launch", "x", values, target=target)
 
-    figures = [
-        both("planning_simulator: 55 processes and 53 components up", "up", "s"),
+    return [
         both("launcher CPU until all up", "cpu", "s"),
-        ratio("launcher CPU until all up, mlaunch / ros2 launch", "cpu", 0.05),
+        ratio("launcher CPU until all up", "cpu", 0.05),
         both("peak RSS, launcher and its helpers", "peak_mb", "MB", _helpers_note(ml, ref)),
-        ratio("peak RSS, mlaunch / ros2 launch", "peak_mb", 0.7),
+        ratio("peak RSS", "peak_mb", 0.7),
         both("SIGINT until all gone", "shutdown", "s"),
     ]
-    figures += print_figures(runs, mlaunch, python, launch, ours)
-    figures += part_figures(runs, python, mlaunch, launch, ours)
-    return figures
 
 
 def _helpers_note(ml: Sequence[Sample], ref: Sequence[Sample]) -> str:
@@ -447,20 +464,25 @@ def print_figures(
     runs: int, mlaunch: Path, python: Path, launch: list[str], env: Mapping[str, str]
 ) -> list[Figure]:
     """``mlaunch --print`` of the tree (wall and CPU), ``python -c pass`` its floor."""
-    printed: list[Usage] = []
+    printed: dict[str, list[Usage]] = {"": [], ", --no-cache": []}
     floor: list[Usage] = []
     for i in range(runs + 1):
         one = rusage([str(mlaunch), "--print", *launch], env)
+        again = rusage([str(mlaunch), "--print", "--no-cache", *launch], env)
         bare = rusage([str(python), "-c", "pass"], env)
         if i:
-            printed.append(one)
+            printed[""].append(one)
+            printed[", --no-cache"].append(again)
             floor.append(bare)
-    return [
-        Figure("--print of the tree", "s", [u.wall for u in printed],
-               "python -c pass", [u.wall for u in floor], target=0.5),
-        Figure("--print of the tree, CPU (xacro in-process)", "s", [u.cpu for u in printed],
-               "python -c pass", [u.cpu for u in floor]),
-    ]  # fmt: skip
+    figures: list[Figure] = []
+    for variant, usages in printed.items():
+        figures += [
+            Figure(f"--print of the tree{variant}", "s", [u.wall for u in usages],
+                   "python -c pass", [u.wall for u in floor], target=0.5),
+            Figure(f"--print of the tree{variant}, CPU", "s", [u.cpu for u in usages],
+                   "python -c pass", [u.cpu for u in floor]),
+        ]  # fmt: skip
+    return figures
 
 
 def part_figures(
@@ -473,7 +495,10 @@ def part_figures(
     # alone, in one interpreter.
     env = {**env, **{k: os.environ[k] for k in HOOK_VARIABLES if k in os.environ}}
     codes = dict(PARTS)
-    codes["resolve the tree (mlaunch --print, xacro in-process)"] = (
+    codes["resolve the tree (mlaunch --print --no-cache, xacro in-process)"] = (
+        f"from mlaunch.cli import main\nmain({['--print', '--no-cache', *launch]!r})"
+    )
+    codes["the plan of the tree from the cache (mlaunch --print)"] = (
         f"from mlaunch.cli import main\nmain({['--print', *launch]!r})"
     )
     commands = {name: [str(python), "-c", code + HWM_LINE] for name, code in codes.items()}
