@@ -273,9 +273,16 @@ def check(
 
 
 def ensure(sources: Path | None = None, git: Path | None = None, cache: Path = CACHE) -> Tree:
-    """The built tree: sources fetched (or taken from ``sources``/``git``), prefix built."""
-    folder = get_sources(sources or cache / "sources", git)
-    return build(folder, cache)
+    """The built tree: sources fetched (or taken from ``sources``/``git``), prefix built.
+
+    The archives end up in ``cache/sources`` either way, where the benchmark looks for them
+    (those of ``sources`` are copied there, then checked against the pins like a download)."""
+    folder = cache / "sources"
+    if sources is not None and sources.resolve() != folder.resolve():
+        folder.mkdir(parents=True, exist_ok=True)
+        for archive in sources.glob("*.tar.gz"):
+            shutil.copyfile(archive, folder / archive.name)
+    return build(get_sources(folder, git), cache)
 
 
 def main(argv: list[str]) -> int:
