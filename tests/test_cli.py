@@ -312,6 +312,9 @@ HEAVY_AT_START = (
     "mlaunch.parts.control",
     "mlaunch.parts.control_socket",
     "json",  # only --print --format json (mlaunch.resolve.plan_json) and the ROS bridge need it
+    # With re, fnmatch, urllib.parse, ipaddress (~3 ms): the ROS wheels' hook imports it in every
+    # interpreter, which is why the check runs site without the hook, as the mlaunch command does.
+    "pathlib",
 )
 
 
@@ -323,6 +326,11 @@ def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
     """
     code = (
         "import sys\n"
+        # site as the mlaunch command runs it: without the ROS wheels' hook (mlaunch's own imports
+        # are what is checked; a plain 'python' would have loaded pathlib for the hook).
+        "sys.modules.setdefault('ros_wheels_bootstrapper', type(sys)('ros_wheels_bootstrapper'))\n"
+        "import site\n"
+        "site.main()\n"
         "import mlaunch.engine.supervisor as sup\n"
         "seen = []\n"
         "original = sup.Supervisor.start\n"
@@ -337,7 +345,7 @@ def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
         "sys.exit(rc)\n"
     )
     done = __import__("subprocess").run(
-        [PY, "-c", code, path], capture_output=True, text=True, env=env, timeout=30
+        [PY, "-S", "-c", code, path], capture_output=True, text=True, env=env, timeout=30
     )
     assert done.returncode == 0, done.stderr
     (line,) = [x for x in done.stdout.splitlines() if x.startswith("AT-FIRST-CHILD")]

@@ -209,6 +209,24 @@ def test_full_order_of_a_node_command_line(prefix: Path, temp_dir: str) -> None:
     assert Path(written).read_text() == "/ns/talker:\n  ros__parameters:\n    a: 1\n"
 
 
+def test_pathlib_paths_as_parameters(prefix: Path, temp_dir: str) -> None:
+    """A pathlib.Path is a params file, a parameter's value and a name part, as in launch_ros
+    (found without mlaunch importing pathlib itself: the launch file made the Path)."""
+    given = Path(temp_dir) / "given.yaml"
+    given.write_text("/**:\n  ros__parameters:\n    g: 1\n")
+    node = Node(
+        package="demo",
+        executable="talker",
+        name="talker",
+        parameters=[{"where": Path("/a/b")}, given, Parameter(Path("p"), Path("/c"))],
+    )
+    spec = only(run([node], prefix, temp_dir))
+    files = [spec.argv[i + 1] for i, word in enumerate(spec.argv) if word == "--params-file"]
+    assert files[1] == str(given)
+    assert Path(files[0]).read_text() == "/**:\n  ros__parameters:\n    where: /a/b\n"
+    assert [w for w in spec.argv if w.startswith("p:=")] == ["p:=/c\n...\n"]  # as p:=5 is
+
+
 @pytest.mark.parametrize(
     ("pushed", "namespace", "expected"),
     [

@@ -17,8 +17,8 @@ with Python's conversion, ``bool`` and lists with YAML, ``str`` as is).
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Iterable
-from pathlib import Path
 
 from mlaunch.launch.substitution import Substitution, describe, normalize, perform_substitutions
 from mlaunch.plan.errors import (
@@ -30,11 +30,22 @@ from mlaunch.plan.errors import (
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from pathlib import Path
     from typing import Any
 
     from mlaunch.launch.launch_context import LaunchContext
 
 SCALAR_TYPES = (int, float, bool, str)
+
+
+def is_path(value: object) -> bool:
+    """``isinstance(value, pathlib.Path)`` without importing pathlib (with re, fnmatch,
+    urllib.parse and ipaddress: ~3 ms before a Node launch's first child): there is no Path
+    before pathlib is imported."""
+    pathlib = sys.modules.get("pathlib")
+    return pathlib is not None and isinstance(value, pathlib.Path)
+
+
 Subs = tuple[Substitution, ...]
 
 
@@ -109,7 +120,7 @@ def normalize_typed(value: Any, value_type: Any) -> Any:
     ``Subs`` tuples.
     """
     scalar, is_list = extract_type(value_type)
-    if isinstance(value, Path):
+    if is_path(value):
         value = str(value)
     if isinstance(value, SCALAR_TYPES):
         if not _is_instance(value, scalar, is_list):
@@ -275,7 +286,7 @@ class Parameter:
     """One parameter given on the command line as ``-p name:=value``."""
 
     def __init__(self, name: Any, value: Any, *, value_type: Any = None) -> None:
-        if not isinstance(name, (str, Path, Substitution, list, tuple)):
+        if not (isinstance(name, (str, Substitution, list, tuple)) or is_path(name)):
             raise LaunchFileError(f"parameter name must be text or substitutions, got {name!r}")
         self._name = normalize(name)
         self._value = ParameterValue(value, value_type=value_type)
@@ -335,6 +346,8 @@ class ParameterFile:
 
     def evaluate(self, context: LaunchContext, temp_dir: str | None = None) -> Path:
         """The file to pass: the file itself, or its substituted copy in ``temp_dir``."""
+        from pathlib import Path
+
         path = Path(perform_substitutions(context, self._param_file))
         self.created = bool(perform_typed(context, self._allow_substs, bool))
         if self.created:

@@ -25,7 +25,6 @@ from __future__ import annotations
 import os
 import re
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 from mlaunch.launch.substitution import (
     Substitution,
@@ -39,6 +38,7 @@ from mlaunch.launch_ros.parameter_descriptions import (
     Parameter,
     ParameterFile,
     ParameterValue,
+    is_path,
     is_substitution,
 )
 from mlaunch.plan.errors import LaunchFileTypeError, SubstitutionFailure, SubstitutionTypeError
@@ -115,7 +115,7 @@ def normalize_parameters(
             out.append((dict_normalizer or normalize_dict)(entry))
         elif isinstance(entry, (Parameter, ParameterFile)):
             out.append(entry)
-        elif isinstance(entry, (str, Path, Substitution)) or is_substitution(entry):
+        elif isinstance(entry, (str, Substitution)) or is_path(entry) or is_substitution(entry):
             out.append(ParameterFile(entry))
         else:
             raise LaunchFileTypeError(
@@ -156,7 +156,7 @@ def normalize_value(value: Any, name: Subs = ()) -> NormalizedValue:
         return value
     if isinstance(value, (bool, int, float, bytes, str)):
         return Plain(value)
-    if isinstance(value, Path):
+    if is_path(value):
         return Plain(str(value))
     if isinstance(value, Substitution):
         return Text((value,))
