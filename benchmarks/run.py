@@ -57,9 +57,10 @@ GROUPS = (
     "sim",
     "importtime",
     "profile",
+    "plancache",
     "autoware",
     "fleet",
-)
+)  # --only
 # Minutes long, and needing what a run does not always have (sources fetched beforehand;
 # ansible-core and sshd for fleet, a deploy over private sshd daemons, tests/fleet.py): only
 # when --only names them.
@@ -72,6 +73,7 @@ SECTIONS = (
     "shutdown",
     "memory",
     "print",
+    "plancache",
     "output",
     "sim",
     "autoware",
@@ -295,6 +297,9 @@ def measured_env(base: dict[str, str], log_dir: Path) -> dict[str, str]:
     else:
         env.pop("LD_LIBRARY_PATH", None)
     env["ROS_LOG_DIR"] = str(log_dir)
+    # Every figure but the plancache group's is of a launch loaded and resolved: repeated runs
+    # of one file would otherwise take the plan from the cache (docs/plan-cache.md).
+    env["MLAUNCH_NO_CACHE"] = "1"
     return env
 
 
@@ -1395,6 +1400,49 @@ class Bench:
             return
         self.results.importtime[venv.name] = parse_importtime(done.stderr)
 
+    # --- the plan cache: cold and warm resolves ------------------------------------------------
+
+    def plan_cache(self, venv: Venv) -> None:
+        """benchmarks/plan_cache_bench.py: big trees resolved cold and from the cache."""
+        import plan_cache_bench
+
+        cases = []
+        for fmt in self.formats if self.config.mode == "full" else ["py"]:
+            top = gen.write(gen.big_system(), fmt, self.launches / f"cache_big_{fmt}")
+            cases.append(plan_cache_bench.Case(f"big synthetic {fmt}", [str(top)], self.env))
+        tree = self._autoware_tree() if self.config.mode == "full" else "not in --quick runs"
+        if isinstance(tree, str):
+            self.results.skip("plancache", venv.name, "Autoware tree", tree)
+        else:
+            argv = [str(tree.launch_file), *tree.arguments]
+            cases.append(
+                plan_cache_bench.Case("Autoware planning_simulator", argv, tree.environ(self.env))
+            )
+        say = lambda line: print(line, file=sys.stderr, flush=True)  # noqa: E731
+        try:
+            figures = plan_cache_bench.measure(self.config.runs, venv.mlaunch, cases, self.tmp, say)
+        except BenchError as e:
+            self.results.skip("plancache", venv.name, "plan cache", str(e))
+            return
+        for f in figures:
+            target = None if f.target is None else Target(f.target)
+            self.results.rows.append(
+                Row("plancache", f.name, venv.name, f.unit, f.samples, f.floor_name,
+                    f.floor_samples, target, {"runs": self.config.runs}, f.note)
+            )  # fmt: skip
+
+    def _autoware_tree(self) -> Any:
+        """The Autoware fixture (built once from its fetched sources), or why not."""
+        import autoware_tree as fixture
+
+        sources = fixture.CACHE / "sources"
+        if not fixture.have_sources(sources):
+            return f"no Autoware sources in {sources}: run 'benchmarks/autoware_tree.py' once"
+        try:
+            return fixture.build(sources)
+        except fixture.FixtureError as e:
+            return f"the fixture cannot be built: {e}"
+
     # --- Autoware's planning_simulator, beside ros2 launch -------------------------------------
 
     def autoware(self, venv: Venv, domain: int) -> None:
@@ -1820,6 +1868,8 @@ def run(args: argparse.Namespace) -> Results:
                 bench.startup(venv)
             if "print" in groups:
                 bench.print_cases(venv)
+            if "plancache" in groups:
+                bench.plan_cache(venv)
             if "output" in groups:
                 bench.output(venv, output_floors)
         ros = next((v for v in venvs if v.name == "ros"), None)

@@ -428,3 +428,24 @@ def test_the_clock_and_programs_refuse_the_plan() -> None:
     with inputs.record() as recording:
         subprocess.run([sys.executable, "-c", code], check=True)
     assert any("runs a program" in r for r in recording.refusals)
+
+
+def test_an_edit_that_keeps_size_and_time_is_seen(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A file's identity spares reading it again only while its change time (the kernel's,
+    which no one can set back) is the same: an edit of the same size, with its modification
+    time put back, still reads as a change."""
+    monkeypatch.setattr(inputs, "RACY_NS", 0)  # every file settled at once
+    path = tmp_path / "params.yaml"
+    path.write_text("speed: 1\n")
+    with inputs.record() as recording:
+        path.read_text()
+    found = inputs.Inputs.from_data(recording.inputs.as_data())
+    assert str(path) in found.unchanged
+    assert found.changed() is None
+    before = path.stat()
+    path.write_text("speed: 2\n")
+    os.utime(path, ns=(before.st_atime_ns, before.st_mtime_ns))
+    assert path.stat().st_size == before.st_size
+    assert found.changed() == f"{path} changed"

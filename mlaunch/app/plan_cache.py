@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from mlaunch.plan.steps import Plan
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
 
-FORMAT = b"mlaunch plan cache 1\n"
+FORMAT = b"mlaunch plan cache 2\n"
 DISABLE_ENV = "MLAUNCH_NO_CACHE"
 MAX_ENTRY_BYTES = 32 << 20
 MAX_TOTAL_BYTES = 256 << 20
@@ -187,7 +187,8 @@ class PlanCache:
         self._say = say
         self._debug = debug
         self.why_not = ""  # why the last resolution was not stored ("" when it was)
-        self._started = time.perf_counter()  # --debug says how long finding the plan took
+        # --debug says how long finding the plan took, in wall-clock and CPU time
+        self._started = (time.perf_counter(), time.process_time())
 
     @classmethod
     def for_run(
@@ -197,9 +198,13 @@ class PlanCache:
             return None
         return cls(cache_folder(environ), run_key(opts, environ), say, opts.debug)
 
-    def _elapsed(self) -> int:
-        """Milliseconds since this run's cache was looked for."""
-        return round((time.perf_counter() - self._started) * 1000)
+    def _elapsed(self) -> tuple[int, int]:
+        """Milliseconds since this run's cache was looked for: wall-clock, CPU."""
+        wall, cpu = self._started
+        return (
+            round((time.perf_counter() - wall) * 1000),
+            round((time.process_time() - cpu) * 1000),
+        )
 
     def debug(self, text: str) -> None:
         if self._debug:
@@ -251,7 +256,7 @@ class PlanCache:
         self._touch()
         self.debug(
             f"the plan of {path} from {self.file} ({entry.inputs} inputs unchanged;"
-            f" {self._elapsed()} ms)"
+            f" {_ms(self._elapsed())})"
         )
         return Cached(path, plan, options, labels)
 
@@ -346,9 +351,11 @@ class PlanCache:
         if self.why_not:
             self.debug(f"not stored: {self.why_not}")
             return False
+        done = self._elapsed()
+        stored = (done[0] - resolved[0], done[1] - resolved[1])
         self.debug(
             f"stored {self.file} ({len(recording.inputs)} inputs; loaded and resolved in"
-            f" {resolved} ms, stored in {self._elapsed() - resolved} ms)"
+            f" {_ms(resolved)}; stored in {_ms(stored)})"
         )
         return True
 
@@ -412,6 +419,10 @@ class PlanCache:
             except OSError:
                 pass
             total -= size
+
+
+def _ms(elapsed: tuple[int, int]) -> str:
+    return f"{elapsed[0]} ms, CPU {elapsed[1]} ms"
 
 
 # --- the entry's bytes ---------------------------------------------------------------------------

@@ -98,6 +98,8 @@ _STDLIB_DIRS = tuple(
 )
 # Read at most this much of a file for its digest; a bigger input makes the plan uncacheable.
 MAX_FILE_BYTES = 64 << 20
+# A file changed less than this before its entry is stored is read again at every check.
+RACY_NS = 2_000_000_000
 # At most this many refusals are kept (the first one is what --debug says).
 MAX_REFUSALS = 5
 
@@ -130,33 +132,51 @@ def digest(data: bytes) -> str:
 class Inputs:
     """The answers a resolution got: files (path -> digest, None when missing), directory
     listings (path -> digest of the names, None when not a folder), stats (kind, path ->
-    signature). Plain data (marshal writes it), checked again by ``changed``."""
+    signature). Plain data (marshal writes it), checked again by ``changed``.
 
-    __slots__ = ("files", "listings", "probes")
+    ``unchanged`` holds, for a file read, its identity (device, inode, size, modification and
+    change times) when the digest was taken: while the file still has it, its content is the
+    one digested (the change time is the kernel's, set by every write). As git's index does,
+    a file changed less than ``RACY_NS`` before the entry is made gets none: a write in the same
+    tick of the file system's clock could leave it alike, so it is read again each time.
+    """
+
+    __slots__ = ("files", "listings", "probes", "unchanged")
 
     def __init__(
         self,
         files: dict[str, str | None] | None = None,
         listings: dict[str, str | None] | None = None,
         probes: dict[tuple[str, str], object] | None = None,
+        unchanged: dict[str, tuple[int, ...]] | None = None,
     ) -> None:
         self.files: dict[str, str | None] = {} if files is None else files
         self.listings: dict[str, str | None] = {} if listings is None else listings
         self.probes: dict[tuple[str, str], object] = {} if probes is None else probes
+        self.unchanged: dict[str, tuple[int, ...]] = {} if unchanged is None else unchanged
 
     def as_data(self) -> tuple[Any, ...]:
-        return (self.files, self.listings, [(k, p, v) for (k, p), v in self.probes.items()])
+        import time
+
+        settled = time.time_ns() - RACY_NS
+        unchanged = {p: ident for p, ident in self.unchanged.items() if ident[4] < settled}
+        probes = [(k, p, v) for (k, p), v in self.probes.items()]
+        return (self.files, self.listings, probes, unchanged)
 
     @classmethod
     def from_data(cls, data: Any) -> Inputs:
-        files, listings, probes = data
-        if not isinstance(files, dict) or not isinstance(listings, dict):
-            raise ValueError("inputs are not two tables")
-        return cls(files, listings, {(k, p): v for k, p, v in probes})
+        files, listings, probes, unchanged = data
+        tables = (files, listings, unchanged)
+        if not all(isinstance(table, dict) for table in tables):
+            raise ValueError("inputs are not three tables")
+        return cls(files, listings, {(k, p): v for k, p, v in probes}, unchanged)
 
     def changed(self) -> str | None:
         """What now answers differently (one phrase), or None when every input is the same."""
         for path, want in self.files.items():
+            known = self.unchanged.get(path)
+            if known is not None and known == identity(path):
+                continue
             if file_digest(path) != want:
                 return f"{path} changed"
         for path, want in self.listings.items():
@@ -169,6 +189,15 @@ class Inputs:
 
     def __len__(self) -> int:
         return len(self.files) + len(self.listings) + len(self.probes)
+
+
+def identity(path: str) -> tuple[int, ...] | None:
+    """(device, inode, size, modification ns, change ns) of a file, None when it has none."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns)
 
 
 def file_digest(path: str) -> str | None:
@@ -268,10 +297,13 @@ class Recording:
         if os.path.isdir(absolute):
             self.listed(absolute)
             return
+        before = identity(absolute)
         found = file_digest(absolute)
-        if found is not None and os.path.getsize(absolute) > MAX_FILE_BYTES:
+        if before is not None and before[2] > MAX_FILE_BYTES:
             self.refuse(f"reads {absolute}, larger than {MAX_FILE_BYTES >> 20} MiB")
         self.inputs.files[absolute] = found
+        if before is not None and found is not None and identity(absolute) == before:
+            self.inputs.unchanged[absolute] = before
 
     def listed(self, path: object) -> None:
         absolute = self._absolute("." if path is None else path)
