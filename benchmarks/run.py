@@ -62,9 +62,10 @@ GROUPS = (
     "fleet",
 )  # --only
 # Minutes long, and needing what a run does not always have (sources fetched beforehand;
-# ansible-core and sshd for fleet, a deploy over private sshd daemons, tests/fleet.py): only
-# when --only names them.
-OPT_IN_GROUPS = ("autoware", "fleet")
+# ansible-core and sshd for fleet, a deploy over private sshd daemons, tests/fleet.py), or a
+# figure of its own (plancache: cold against warm resolves, Autoware's too when its sources are
+# there): only when --only names them.
+OPT_IN_GROUPS = ("plancache", "autoware", "fleet")
 DEFAULT_GROUPS = tuple(g for g in GROUPS if g not in OPT_IN_GROUPS)
 # The table's sections: shutdown and memory are measured in the start-up runs.
 SECTIONS = (
