@@ -524,16 +524,9 @@ HOOKED = (SITE / "ros_wheels_bootstrapper.pth").exists()
 
 def shell_env(env: dict[str, str]) -> dict[str, str]:
     """A user's shell: without what the ROS wheels' hook put into this process's environment."""
-    out = {k: v for k, v in env.items() if k != "_ROS_WHEELS_BOOTSTRAP_COMPLETE"}
-    inside = os.path.realpath(sys.prefix) + os.sep
-    kept = [
-        e
-        for e in out.pop("LD_LIBRARY_PATH", "").split(os.pathsep)
-        if e and not (os.path.realpath(e) + os.sep).startswith(inside)
-    ]
-    if kept:
-        out["LD_LIBRARY_PATH"] = os.pathsep.join(kept)
-    return out
+    from mlaunch.parts.ros1_environ import shell_environ
+
+    return shell_environ(env)
 
 
 @pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv: nothing to skip")
