@@ -460,3 +460,20 @@ def test_an_edit_that_keeps_size_and_time_is_seen(
     os.utime(path, ns=(before.st_atime_ns, before.st_mtime_ns))
     assert path.stat().st_size == before.st_size
     assert found.changed() == f"{path} changed"
+
+
+def test_code_imported_before_the_window_is_an_input(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A module of a user's or of site-packages that was imported before loading began (so no
+    open() shows it) is an input too: an upgrade of it is a change."""
+    (tmp_path / "helper_for_the_cache_test.py").write_text("VALUE = 1\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    __import__("helper_for_the_cache_test")
+    try:
+        with inputs.record() as recording:
+            pass
+    finally:
+        del sys.modules["helper_for_the_cache_test"]
+    assert str(tmp_path / "helper_for_the_cache_test.py") in recording.inputs.files
+    assert not any(path.startswith(os.path.dirname(os.__file__)) for path in recording.inputs.files)

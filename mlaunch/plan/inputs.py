@@ -88,14 +88,7 @@ CHANGING_EVENTS = frozenset(
 _EVENTS = frozenset({"exec", "open", "os.listdir", "os.scandir", *CHANGING_EVENTS, *REFUSED_EVENTS})
 
 _OWN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep  # mlaunch/
-_STDLIB_DIRS = tuple(
-    d + os.sep
-    for d in {
-        os.path.dirname(os.__file__),
-        os.path.dirname(os.path.dirname(os.__file__)),  # lib/ for lib/python3.X/
-    }
-    if "site-packages" not in d
-)
+_STDLIB_DIRS = (os.path.dirname(os.__file__) + os.sep,)  # lib/python3.X/ (and lib-dynload)
 # Read at most this much of a file for its digest; a bigger input makes the plan uncacheable.
 MAX_FILE_BYTES = 64 << 20
 # A file changed less than this before its entry is stored is read again at every check.
@@ -328,6 +321,20 @@ class Recording:
             return
         self.inputs.probes.setdefault((kind, absolute), answer)
 
+    def note_loaded_modules(self, names: set[str]) -> None:
+        """The code of modules imported before the window that launch-file code may use and
+        the key does not cover (not mlaunch's, not the standard library's: site-packages, a
+        user's own): a package upgraded is a change."""
+        for name in names:
+            path = getattr(sys.modules.get(name), "__file__", None)
+            if not isinstance(path, str) or path.startswith(_OWN_DIR) or _stdlib(path):
+                continue
+            if path.endswith(".py"):
+                if path not in self.inputs.files:
+                    self.inputs.files[path] = file_digest(path)
+            else:
+                self.inputs.probes.setdefault(("stat", path), probe("stat", path))
+
     def finish_writes(self) -> None:
         """Refuse the plan for each file written outside the run's folders and left there."""
         for path in sorted(self.written):
@@ -406,7 +413,7 @@ def _scan_code(recording: Recording, code: CodeType) -> None:
     """Refuse the plan when launch-file or package code executed in the window names a clock
     method (``datetime.now()``): the C call itself has no hook, its name in the code does."""
     name = code.co_filename
-    if name.startswith((_OWN_DIR, *_STDLIB_DIRS)) or name.startswith("<frozen"):
+    if name.startswith((_OWN_DIR, "<frozen")) or _stdlib(name):
         return
     stack = [code]
     while stack:
@@ -419,12 +426,17 @@ def _scan_code(recording: Recording, code: CodeType) -> None:
         stack.extend(c for c in current.co_consts if hasattr(c, "co_names"))
 
 
+def _stdlib(path: str) -> bool:
+    """Whether ``path`` is the standard library's (not a site-packages below it)."""
+    return path.startswith(_STDLIB_DIRS) and "-packages" + os.sep not in path
+
+
 def _caller(depth: int = 2) -> str:
     """`` at FILE:LINE`` of the first frame outside mlaunch and the standard library."""
     frame = sys._getframe(depth)
     while frame is not None:
         name = frame.f_code.co_filename
-        if not name.startswith((_OWN_DIR, *_STDLIB_DIRS)) and not name.startswith("<frozen"):
+        if not name.startswith(_OWN_DIR) and not _stdlib(name) and not name.startswith("<frozen"):
             return f" at {name}:{frame.f_lineno}"
         frame = frame.f_back  # type: ignore[assignment]
     return ""
@@ -437,7 +449,7 @@ def _from_outside(stdlib_too: bool) -> bool:
     name = frame.f_code.co_filename
     if name.startswith(_OWN_DIR):
         return False
-    return stdlib_too or not name.startswith(_STDLIB_DIRS)
+    return stdlib_too or not _stdlib(name)
 
 
 # --- the wrappers of calls no audit event covers ----------------------------------------------
@@ -562,6 +574,7 @@ class record:
         _local.busy = True
         try:
             recording.finish_modules(self._modules)
+            recording.note_loaded_modules(self._modules)
             recording.finish_writes()
         finally:
             _local.busy = False
