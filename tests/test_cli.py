@@ -551,6 +551,19 @@ def test_the_mlaunch_command_starts_python_once(tmp_path: Path, env: dict[str, s
 
 
 @pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv")
+def test_no_interpreter_of_the_venv_imports_the_hook_for_nothing(env: dict[str, str]) -> None:
+    """Where its guard is set the hook does nothing but import pathlib (with re, fnmatch,
+    urllib.parse, ipaddress): mlaunch_ros_hook.pth, which scripts/setup writes, keeps it out."""
+    guarded = {**env, "_ROS_WHEELS_BOOTSTRAP_COMPLETE": "1"}
+    code = "import sys; print(sorted(m for m in ('pathlib', 'ros_wheels_bootstrapper') if m in sys.modules and getattr(sys.modules[m], '__file__', None)))"
+    done = __import__("subprocess").run(
+        [PY, "-c", code], capture_output=True, text=True, env=guarded, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"
+
+
+@pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv")
 def test_the_mlaunch_command_has_the_ros_libraries(tmp_path: Path, env: dict[str, str]) -> None:
     """What the hook gave before: rclpy loads in mlaunch itself (the launch file imports it here,
     as the bridge does lazily) and in the venv's Python programs it starts, which get the
