@@ -600,3 +600,21 @@ def test_the_mlaunch_command_has_the_ros_libraries(tmp_path: Path, env: dict[str
     entries = {os.path.realpath(e) for e in ld_path.split(os.pathsep)}
     wanted = {os.path.realpath(p) for p in SITE.glob("ros_*.libs")}
     assert wanted and wanted <= entries, (wanted - entries, ld_path)
+
+
+@pytest.mark.skipif(not HOOKED, reason="no ROS wheels' .pth hook in this venv")
+def test_the_mlaunch_command_runs_python_as_the_console_script(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    """No interpreter flags (multiprocessing passes sys.flags on to its spawned workers: -S left
+    them without site-packages) and sys.path[0] the command's folder, as pip's script has it."""
+    script = Path(sys.executable).parent / "mlaunch"
+    path = launch_file(
+        tmp_path,
+        "LogInfo(msg=f'FLAGS {sys.flags.no_site}{int(sys.flags.safe_path)}{sys.flags.isolated} {sys.path[0]}'),",
+    )
+    done = __import__("subprocess").run(
+        [str(script), path], capture_output=True, text=True, env=shell_env(env), timeout=30
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert f"FLAGS 000 {script.parent}" in done.stdout
