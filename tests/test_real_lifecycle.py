@@ -28,6 +28,23 @@ requires_lifecycle = pytest.mark.skipif(
 pytestmark = [requires_rclpy, requires_lifecycle, pytest.mark.timeout(150)]
 
 
+# What each test expects of the listener: the talker's messages, sent only while it is active.
+HEARS_DATA = ("--expect-output", r"lifecycle_listener:data_callback: Lifecycle HelloWorld #\d+")
+
+
+def passes_test(env: dict[str, str], cwd: Path, *argv: str) -> str:
+    """`mlaunch test ARGV` on the real programs (none replaced by a stand-in) passes: its output."""
+    done = subprocess.run(
+        mlaunch("test", *argv, "--expect-lifecycle", "/lc_talker", *HEARS_DATA,
+                "--timeout", "90", "--hold", "1"),
+        capture_output=True, text=True, env=env, timeout=140, cwd=cwd,
+    )  # fmt: skip
+    out = done.stdout + done.stderr
+    assert done.returncode == 0, out[-4000:]
+    assert "not installed" not in out, out[-4000:]
+    return out
+
+
 def test_the_real_lifecycle_talker_autostarts_and_the_listener_hears_it(
     ros_env: dict[str, str], tmp_path: Path
 ) -> None:
@@ -42,17 +59,7 @@ def test_the_real_lifecycle_talker_autostarts_and_the_listener_hears_it(
     assert shown.returncode == 0, shown.stderr
     assert str(TALKER) in shown.stdout, shown.stdout
     assert str(TALKER.with_name("lifecycle_listener")) in shown.stdout, shown.stdout
-    done = subprocess.run(
-        mlaunch(
-            "test", str(launch), "--expect-lifecycle", "/lc_talker",
-            "--expect-output", r"lifecycle_listener:data_callback: Lifecycle HelloWorld #\d+",
-            "--timeout", "90", "--hold", "1",
-        ),
-        capture_output=True, text=True, env=env, timeout=140, cwd=tmp_path,
-    )  # fmt: skip
-    out = done.stdout + done.stderr
-    assert done.returncode == 0, out[-4000:]
-    assert "not installed" not in out, out[-4000:]
+    out = passes_test(env, tmp_path, str(launch))
     assert "[lc_talker]: on_configure() is called." in out, out[-4000:]
     assert "[lc_talker]: on_activate() is called." in out, out[-4000:]
     assert "lifecycle node /lc_talker is active" in out, out[-4000:]
@@ -64,20 +71,10 @@ def test_the_upstream_lifecycle_demo_launch_file(ros_env: dict[str, str], tmp_pa
     drives the talker through its transitions (one each 10 s), which the listener is notified
     of, and the talker publishes to it while active."""
     assert DEMO.is_file(), f"the build installs the demo's launch file as {DEMO}"
-    env = env_for(ros_env, tmp_path, real=True)
-    done = subprocess.run(
-        mlaunch(
-            "test", "lifecycle", "lifecycle_demo_launch.py", "--expect-lifecycle", "/lc_talker",
-            "--expect-output",
-            r"lifecycle_listener:notify callback: Transition from state \w+ to \w+",
-            "--expect-output", r"lifecycle_listener:data_callback: Lifecycle HelloWorld #\d+",
-            # The client's calls, answered by the talker: configure (1), then activate (3).
-            "--expect-output", "lifecycle_service_client:Transition 1 successfully triggered",
-            "--expect-output", "lifecycle_service_client:Transition 3 successfully triggered",
-            "--timeout", "90", "--hold", "1",
-        ),
-        capture_output=True, text=True, env=env, timeout=140, cwd=tmp_path,
+    passes_test(
+        env_for(ros_env, tmp_path, real=True), tmp_path, "lifecycle", "lifecycle_demo_launch.py",
+        "--expect-output", r"lifecycle_listener:notify callback: Transition from state \w+ to \w+",
+        # The client's calls, answered by the talker: configure (1), then activate (3).
+        "--expect-output", "lifecycle_service_client:Transition 1 successfully triggered",
+        "--expect-output", "lifecycle_service_client:Transition 3 successfully triggered",
     )  # fmt: skip
-    out = done.stdout + done.stderr
-    assert done.returncode == 0, out[-4000:]
-    assert "not installed" not in out, out[-4000:]
