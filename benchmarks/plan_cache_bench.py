@@ -20,6 +20,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from autoware_bench import Figure  # one row of the table, as the autoware group's
 from probes import BenchError
 
 COLD = re.compile(
@@ -36,17 +37,6 @@ class Case:
     name: str
     argv: list[str]
     env: dict[str, str]
-
-
-@dataclass
-class Figure:
-    name: str
-    unit: str
-    samples: list[float]
-    floor_name: str = ""
-    floor_samples: list[float] = field(default_factory=list)
-    target: float | None = None
-    note: str = ""
 
 
 @dataclass
