@@ -22,6 +22,7 @@ import os
 import pickle
 import sys
 import time
+from types import FunctionType
 
 from mlaunch.plan import inputs as plan_inputs
 from mlaunch.ros.files import write_all
@@ -465,9 +466,7 @@ def _pickle(value: object, folders: tuple[str, ...]) -> bytes:
     import io
 
     buffer = io.BytesIO()
-    pickler = _ModulesPickler(buffer, protocol=pickle.HIGHEST_PROTOCOL)
-    pickler.folders = tuple(f for f in folders if f)
-    pickler.dump(value)
+    _ModulesPickler(buffer, tuple(f for f in folders if f)).dump(value)
     return buffer.getvalue()
 
 
@@ -539,26 +538,30 @@ def _write_made_files(made: dict[str, bytes], temp_dir: str) -> None:
 
 class _ModulesPickler(pickle.Pickler):
     """A pickler that refuses what a new run could not import, and writes every string that
-    names the run's own temp or log folder as a reference, rebased when read back."""
+    names the run's places (temp and log folders, run id) as a reference, rebased when read
+    back. Called for every object of the plan: the common cases return first."""
 
-    folders: tuple[str, ...] = ()
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
+    def __init__(self, file: Any, folders: tuple[str, ...]) -> None:
+        super().__init__(file, protocol=pickle.HIGHEST_PROTOCOL)
+        self.folders = folders
+        self.shortest = min((len(f) for f in folders), default=1 << 30)
         self.pids: dict[str, tuple[str, bytes]] = {}
 
     def persistent_id(self, obj: Any) -> Any:
         kind = type(obj)
         if kind is str:
-            if self.folders and any(f in obj for f in self.folders):
-                # bytes: the pid's own items go through persistent_id again; one tuple per
-                # text, so the pickle's memo writes each once
-                pid = self.pids.get(obj)
-                if pid is None:
-                    pid = self.pids[obj] = ("folder", obj.encode("utf-8", "surrogatepass"))
-                return pid
+            if len(obj) < self.shortest:
+                return None
+            for place in self.folders:
+                if place in obj:
+                    # bytes: the pid's own items go through persistent_id again; one tuple
+                    # per text, so the pickle's memo writes each once
+                    pid = self.pids.get(obj)
+                    if pid is None:
+                        pid = self.pids[obj] = ("folder", obj.encode("utf-8", "surrogatepass"))
+                    return pid
             return None
-        if isinstance(obj, type) or callable(obj):
+        if kind is FunctionType or isinstance(obj, type):
             module = getattr(obj, "__module__", None)
             if module == "python_launch_file" or module == "__main__":
                 name = getattr(obj, "__qualname__", repr(obj))
