@@ -41,12 +41,33 @@ def run(text: str, context: LaunchContext | None = None) -> str:
         (r"\$(var x)", ["$(var x)"]),
         (r"a\\b", ["a\\b"]),
         (r"\(\)\'\"", ["()'\""]),
-        (r"C:\dir\d+", [r"C:\dir\d+"]),  # a backslash before anything else is kept
-        ("trailing \\", ["trailing \\"]),
+        # launch drops a backslash before any character (launch 3.4.3 gives each of these)
+        (r"C:\dir\d+", ["C:dird+"]),
+        (r"\\\d", [r"\d"]),
+        (r"a\ b", ["a b"]),
+        ("trailing \\", ["trailing \\"]),  # nothing after it: kept
+        ("a\\\nb", ["a\\\nb"]),  # before a line break: kept
     ],
 )
 def test_text_and_escapes(text: str, parts: list[str]) -> None:
     assert parse_template(text) == parts
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [
+        # what launch 3.4.3's parser and perform_substitutions give for each
+        (r"$(env MLAUNCH_TEST_UNSET a\db)", "adb"),
+        (r"$(env MLAUNCH_TEST_UNSET 'a\d b')", "ad b"),
+        (r"$(env MLAUNCH_TEST_UNSET 'x\ y')", "x y"),
+        (r"$(env MLAUNCH_TEST_UNSET \\d)", r"\d"),
+        (r"$(env MLAUNCH_TEST_UNSET 'a$(env MLAUNCH_TEST_UNSET b\c)')", "abc"),
+        ("$(env MLAUNCH_TEST_UNSET 'a\\\nb')", "a\\\nb"),
+        (r'$(env MLAUNCH_TEST_UNSET "p\q r")', "pq r"),
+    ],
+)
+def test_a_backslash_in_an_argument_escapes_any_character(text: str, value: str) -> None:
+    assert run(text) == value
 
 
 def test_text_around_substitutions_is_merged_and_kept_in_order() -> None:

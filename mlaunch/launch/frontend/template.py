@@ -9,11 +9,12 @@ grammar is ROS 2's (``launch/frontend/grammar.lark``):
 - an argument quoted with ``'...'`` or ``"..."`` may hold spaces and parentheses; inside it, the
   arguments of a nested ``$(...)`` cannot be quoted again (ROS 2's rule), the other quote
   character is plain text there;
-- a backslash escapes ``$ ( ) ' "`` and itself; a ``$`` not followed by ``(`` is plain text, and
-  so are quotes and parentheses outside ``$(...)``.
+- a backslash escapes the character after it, as launch's ``replace_escaped_characters`` does
+  (``$ ( ) ' "``, itself, and any other: ``\\d`` is ``d``), except a line break, and in an
+  unquoted argument a blank, which end the text it is in (the backslash is kept); a ``$`` not
+  followed by ``(`` is plain text, and so are quotes and parentheses outside ``$(...)``.
 
-Deliberate differences from ROS 2: a backslash before any other character is kept (ROS 2 drops
-it, so ``\\d`` became ``d``), and a lone ``$`` is text (ROS 2's grammar rejects it).
+Deliberate difference from ROS 2: a lone ``$`` is text (ROS 2's grammar rejects it).
 
 Errors are ``TemplateError(message, index)``; the frontend turns the index into file:line:col.
 
@@ -39,7 +40,6 @@ if TYPE_CHECKING:
 Part = str | Substitution
 Parts = list[Part]
 
-_ESCAPABLE = frozenset("$()'\"\\")
 _IDENTIFIER = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
 # Runs of characters that are plain text in each context (the scanner jumps over them).
 _TOP_SPECIAL = re.compile(r"[\\$]")
@@ -247,7 +247,8 @@ class _Scanner:
             if j > i:
                 buf.append(s[i:j])
             if s[j] == "\\":
-                if j + 1 < n and s[j + 1] in _ESCAPABLE:
+                # launch drops a backslash before any character but a line break
+                if j + 1 < n and s[j + 1] != "\n":
                     buf.append(s[j + 1])
                     i = j + 2
                 else:
@@ -359,7 +360,7 @@ class _Scanner:
             c = s[i]
             if c == " " or c == ")":
                 break
-            after = self.escape_or_nested(i, buf, value, quote)
+            after = self.escape_or_nested(i, buf, value, quote, blank_ends=True)
             if after is not None:
                 i = after
             elif c == "(":
@@ -385,7 +386,7 @@ class _Scanner:
         return i
 
     def escape_or_nested(
-        self, i: int, buf: list[str], value: Parts, quote: str | None
+        self, i: int, buf: list[str], value: Parts, quote: str | None, *, blank_ends: bool
     ) -> int | None:
         """A backslash escape or a nested ``$(`` at ``i``: consume it, return the next index.
 
@@ -394,7 +395,10 @@ class _Scanner:
         s, n = self.s, self.n
         c = s[i]
         if c == "\\":
-            if i + 1 < n and s[i + 1] in _ESCAPABLE:
+            # a line break, or a blank in an unquoted argument, ends the text the backslash is
+            # in: it is kept there, as launch's grammar reads it
+            nxt = s[i + 1] if i + 1 < n else "\n"
+            if nxt != "\n" and not (blank_ends and nxt == " "):
                 buf.append(s[i + 1])
                 return i + 2
             buf.append("\\")
@@ -427,7 +431,7 @@ class _Scanner:
                 if not value:
                     value.append("")
                 return i + 1
-            after = self.escape_or_nested(i, buf, value, q)
+            after = self.escape_or_nested(i, buf, value, q, blank_ends=False)
             if after is not None:
                 i = after
             else:
