@@ -44,16 +44,6 @@ def test_every_format_is_covered() -> None:
     assert {"", ".py", ".yaml", ".xml"} <= suffixes  # ROS 1 (.launch) and the three ROS 2 ones
 
 
-@pytest.mark.parametrize("path", LAUNCH_FILES, ids=launch_id)
-def test_every_launch_file_validates(path: Path, env: dict[str, str]) -> None:
-    document = plan_of(str(path), *REQUIRED_ARGUMENTS.get(path.name, []), env=env)
-    validate(document)
-    assert document["schema"] == "mlaunch-plan/1"
-    assert document["steps"], "an empty plan checks nothing"
-    # Nothing of the run's temporary folder leaks: its files are named in plan order.
-    assert "/tmp/mlaunch-" not in json.dumps(document)
-
-
 def test_the_composed_launch_lists_its_components(env: dict[str, str]) -> None:
     document = plan_of(str(LAUNCHES / "jtbot_composed.launch.py"), env=env)
     (load,) = [s for s in document["steps"] if s["kind"] == "load_components"]
@@ -68,9 +58,17 @@ def test_the_composed_launch_lists_its_components(env: dict[str, str]) -> None:
 
 
 @pytest.mark.parametrize("path", LAUNCH_FILES, ids=launch_id)
-def test_argv_is_what_text_print_shows(path: Path, env: dict[str, str]) -> None:
+def test_every_launch_file_validates_and_its_argv_is_what_text_print_shows(
+    path: Path, env: dict[str, str]
+) -> None:
+    """One JSON plan per file for both (each was printed twice: 20 runs of mlaunch more)."""
     arguments = REQUIRED_ARGUMENTS.get(path.name, [])
     document = plan_of(str(path), *arguments, env=env)
+    validate(document)
+    assert document["schema"] == "mlaunch-plan/1"
+    assert document["steps"], "an empty plan checks nothing"
+    # Nothing of the run's temporary folder leaks: its files are named in plan order.
+    assert "/tmp/mlaunch-" not in json.dumps(document)
     text = run_mlaunch(str(path), "--print", *arguments, env=env)
     assert text.returncode == 0, text.stderr
     lines = text.stdout.splitlines()
