@@ -149,11 +149,14 @@ def main(argv: list[str] | None = None) -> int:
     env = dict(os.environ, SUITE_TIMELINE_DIR=str(folder))
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(HERE), env.get("PYTHONPATH")) if p)
     env.pop("PYTHONDONTWRITEBYTECODE", None)  # as scripts/check
+    for name in [n for n in env if n.startswith("PYTEST_XDIST_")]:
+        del env[name]  # run from an xdist worker (a test): not one of its workers
     command = [sys.executable, "-m", "pytest", "-p", "suite_timeline", "-q"]
     if args.workers > 0:
         command += ["-n", str(args.workers), "--dist", "worksteal"]
     command += args.pytest_args
     before, started = load(), time.monotonic()
+    reaped = resource.getrusage(resource.RUSAGE_CHILDREN)
     status = subprocess.run(command, cwd=REPO, env=env, check=False).returncode
     wall = time.monotonic() - started
     usage = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -161,7 +164,7 @@ def main(argv: list[str] | None = None) -> int:
         "command": command,
         "status": status,
         "wall_s": wall,
-        "cpu_s": usage.ru_utime + usage.ru_stime,
+        "cpu_s": usage.ru_utime + usage.ru_stime - reaped.ru_utime - reaped.ru_stime,
         "load_before": before,
         "load_after": load(),
         "summary": summarize(read_timeline(folder)),
