@@ -155,6 +155,9 @@ def test_every_step_loads_through_one_node(prefix: Path, loader: Any) -> None:
             return any(wanted <= services for services in clients.values())
 
         assert wait_until(one_node_has_both, 15), clients
+        name = next(n for n, services in clients.items() if wanted <= services)
+        served = probe.get_service_names_and_types_by_node(name, "/")
+        assert not [s for s, _ in served if "type_description" in s], served
     finally:
         probe.destroy_node()
     driver.stop.set()

@@ -285,6 +285,7 @@ class ComponentLoader:
 
                 from rclpy.executors import SingleThreadedExecutor
                 from rclpy.node import Node
+                from rclpy.parameter import Parameter
 
                 node = Node(
                     f"_mlaunch_loader_{os.getpid()}",
@@ -292,6 +293,8 @@ class ComponentLoader:
                     use_global_arguments=False,
                     start_parameter_services=False,
                     enable_rosout=False,
+                    # As the graph bridge's: no <fqn>/get_type_description among the services.
+                    parameter_overrides=[Parameter("start_type_description_service", value=False)],
                 )
                 executor = SingleThreadedExecutor(context=self.context)
                 executor.add_node(node)
