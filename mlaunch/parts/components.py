@@ -270,6 +270,14 @@ class ComponentLoader:
             self._settling.forget(id(client))  # the id may be reused by a later client
         return results
 
+    def prepare(self) -> None:
+        """Make the shared node now, on the calling thread, with the launcher's lean
+        participant (mlaunch.parts.lean): only the thread that resolves and spawns may call it."""
+        from mlaunch.parts.lean import lean_participant
+
+        with lean_participant():
+            self._node()
+
     def _node(self) -> Any:
         """The one node every load and unload of the run goes through, and its executor.
 
@@ -517,12 +525,18 @@ class ComponentDriver(Part):
             ) from e
         self.supervisor = supervisor
         self.loop = LoopCall(supervisor.selector)
+        from mlaunch.parts.lean import limit_arenas
+
+        limit_arenas()  # before rclpy's threads: they share two arenas (mlaunch.parts.lean)
         environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
         context = Context()
         context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
         self.loader = ComponentLoader(
             context, self._log, self._finished, self._loaded, self._failed, self._refused
         )
+        # The participant and the loader node, here on the run's thread (the lean
+        # participant's setting is in os.environ while it is made; no one spawns meanwhile).
+        self.loader.prepare()
         # Who waits for a load thread to end (a ``load`` asked through runtime control).
         self.waiting: list[Callable[[threading.Thread], None]] = []
         supervisor.records.subscribe(self.on_record)
