@@ -29,7 +29,9 @@ def env(tmp_path: Path) -> dict[str, str]:
 
 def fails(path: Path, env: dict[str, str], *args: str) -> str:
     """Run ``mlaunch path --print``; it must exit 2 with one line on stderr, returned."""
-    done = run_mlaunch(str(path), "--print", *args, env=env, timeout=60)
+    # A deadline, not a speed check: the deepest files cost seconds of CPU, and at load 24 two
+    # runs passed 60 s.
+    done = run_mlaunch(str(path), "--print", *args, env=env, timeout=240)
     assert done.returncode == 2, done.stdout + done.stderr
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1, done.stderr
@@ -107,6 +109,7 @@ def test_a_file_including_itself_with_an_argument_that_ends_it_still_runs(
     ]
 
 
+@pytest.mark.timeout(300)  # fails()'s deadline
 def test_a_cycle_that_changes_an_argument_each_time_stops_at_the_depth_limit(
     tmp_path: Path, env: dict[str, str]
 ) -> None:
@@ -181,6 +184,7 @@ def test_groups_nest_deeper_than_python_allows_by_default(
     assert done.returncode == 0, done.stderr
 
 
+@pytest.mark.timeout(300)  # fails()'s deadline
 @pytest.mark.parametrize("fmt", sorted(NESTED))
 def test_nesting_past_the_limit_is_a_located_error(
     tmp_path: Path, env: dict[str, str], fmt: str
