@@ -54,10 +54,17 @@ class PacedReader(threading.Thread):
             deadline_sleep(now + self.every)
 
 
+def bytes_ahead(arrivals: list[tuple[float, bytes]], i: int, written: float) -> int:
+    """The bytes of the lines that reached the reader after line ``i`` was written (the
+    writer's monotonic time ``written``) and before it: the backlog it waited behind."""
+    return sum(len(line) + 1 for when, line in arrivals[:i] if when >= written)
+
+
 @pytest.mark.serial  # a quiet line's lag, in seconds
 def test_a_flooding_child_does_not_stall_a_quiet_ones_lines() -> None:
     # ~320 KB/s: the flood (~1.5 MB) takes seconds to pass; a whole 1 MiB backlog ahead of a
-    # quiet line would hold it ~3 s. Per-process flow control keeps it near 32 KiB, ~0.1 s.
+    # quiet line would hold it ~3 s. Per-process flow control keeps the flood's share of it
+    # near 32 KiB, ~0.1 s (the pipes hold the rest).
     r, w = os.pipe()
     screen = Screen(w)
     reader = PacedReader(r, 16 * 1024, 0.05)
@@ -71,12 +78,13 @@ def test_a_flooding_child_does_not_stall_a_quiet_ones_lines() -> None:
         os.close(w)
         reader.join(30)
         os.close(r)
-    delays = []
+    delays, ahead = [], []
     flood_lines = 0
-    for arrived, line in reader.arrivals:
+    for i, (arrived, line) in enumerate(reader.arrivals):
         if line.startswith(b"[quiet] q "):
             _, _, _, stamp = line.split()
             delays.append(arrived - float(stamp))
+            ahead.append(bytes_ahead(reader.arrivals, i, float(stamp)))
         elif line.startswith(b"[flood] f "):
             flood_lines += 1
     assert flood_lines == 100_000, "the flood lost lines"
@@ -84,9 +92,11 @@ def test_a_flooding_child_does_not_stall_a_quiet_ones_lines() -> None:
     worst = max(delays)
     print(
         f"quiet child's lines behind a flood: worst {worst:.3f} s, median "
-        f"{sorted(delays)[20]:.3f} s"
+        f"{sorted(delays)[20]:.3f} s; at most {max(ahead)} bytes reached the screen ahead of one"
     )
-    assert worst < 1.0, f"a quiet line waited {worst:.2f} s behind the flood"
+    # Flow control bounds the bytes ahead of a quiet line (how long they take also depends on
+    # how busy the machine is): ~80 KB measured, the pipes and the flood's share; ~1 MiB without.
+    assert max(ahead) < 256 * 1024, f"{max(ahead)} bytes reached the screen ahead of a quiet line"
 
 
 # --- log retention ----------------------------------------------------------------------------------

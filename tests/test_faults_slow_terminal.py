@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 from test_faults import Mlaunch, proc, write_launch
-from test_faults_output import PacedReader
+from test_faults_output import PacedReader, bytes_ahead
 
 SECONDS = 8
 FLOOD = f"""
@@ -49,16 +49,21 @@ def test_a_quiet_line_is_never_a_second_behind_a_flood_on_a_30_kb_s_terminal(
         m.close()
         reader.join(30)
         os.close(r)
-    delays, notices = [], 0
-    for arrived, line in reader.arrivals:
+    delays, ahead, notices = [], [], 0
+    for i, (arrived, line) in enumerate(reader.arrivals):
         if b"[quiet" in line and b"] q " in line:
             *_, stamp = line.split()
             delays.append(arrived - float(stamp))
+            ahead.append(bytes_ahead(reader.arrivals, i, float(stamp)))
         notices += b"the terminal fell behind" in line
     assert len(delays) == SECONDS, "the quiet child lost lines on the screen"
     worst = max(delays)
-    print(f"quiet lines behind a flood at 30 KB/s: worst {worst:.3f} s, all {delays}")
-    assert worst < 1.0, f"a quiet line waited {worst:.2f} s behind the flood (was 3.6-4.8 s)"
+    print(
+        f"quiet lines behind a flood at 30 KB/s: worst {worst:.3f} s, all {delays}; {ahead} bytes ahead"
+    )
+    # Under a second of the terminal's 30 KB/s ahead of a quiet line (was 3.6-4.8 s of it); in
+    # bytes, since the time also depends on how busy the machine is.
+    assert max(ahead) < 30_000, f"{max(ahead)} bytes reached the screen ahead of a quiet line"
     assert notices >= 1, "lines were dropped from the screen without a word"
     (folder,) = [p for p in (tmp_path / "log").iterdir() if not p.is_symlink()]
     flooded = (folder / "flood-1.log").read_text().splitlines()
