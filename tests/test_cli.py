@@ -318,8 +318,13 @@ HEAVY_AT_START = (
 )
 
 
-def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
-    """The HEAVY_AT_START modules mlaunch has loaded once it has started the launch's first child.
+def loaded_at_first_child(
+    path: str,
+    env: dict[str, str],
+    options: tuple[str, ...] = (),
+    modules: tuple[str, ...] = HEAVY_AT_START,
+) -> list[str]:
+    """The ``modules`` mlaunch has loaded once it has started the launch's first child.
 
     The child's own start is the moment checked: the supervisor's start() is wrapped, and the
     modules are looked for in mlaunch's sys.modules as soon as it returns.
@@ -336,11 +341,11 @@ def loaded_at_first_child(path: str, env: dict[str, str]) -> list[str]:
         "original = sup.Supervisor.start\n"
         "def start(self, *a, **k):\n"
         "    result = original(self, *a, **k)\n"
-        f"    seen.extend(m for m in {HEAVY_AT_START!r} if m in sys.modules)\n"
+        f"    seen.extend(m for m in {modules!r} if m in sys.modules)\n"
         "    return result\n"
         "sup.Supervisor.start = start\n"
         "from mlaunch.cli import main\n"
-        "rc = main([sys.argv[1], '-q'])\n"
+        f"rc = main([sys.argv[1], '-q', *{options!r}])\n"
         "print('AT-FIRST-CHILD', sorted(set(seen)))\n"
         "sys.exit(rc)\n"
     )
@@ -369,6 +374,15 @@ def test_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:
     )
     assert done.returncode == 0, done.stderr
     assert "SHOW-ARGS []" in done.stdout
+
+
+def test_no_cache_loads_none_of_the_plan_cache(tmp_path: Path, env: dict[str, str]) -> None:
+    """--no-cache and MLAUNCH_NO_CACHE=1 decide before the cache's code (and pickle) loads."""
+    path = launch_file(tmp_path, "ExecuteProcess(cmd=[PY, '-c', 'print(1)'], output='screen'),")
+    cache = ("mlaunch.app.plan_cache", "mlaunch.plan.inputs", "pickle")
+    assert loaded_at_first_child(path, env, ("--no-cache",), cache) == []
+    assert loaded_at_first_child(path, {**env, "MLAUNCH_NO_CACHE": "1"}, (), cache) == []
+    assert loaded_at_first_child(path, env, (), cache) != []  # the check sees them otherwise
 
 
 def test_node_start_path_stays_light(tmp_path: Path, env: dict[str, str]) -> None:

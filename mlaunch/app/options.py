@@ -14,7 +14,7 @@ from mlaunch.plan.argparser import ArgumentParser
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
 # The viewer stand-in's port variable (mlaunch.standins.viewer_config.PORT_ENV; not imported
 # from there: that module loads dataclasses and typing, which a launch's start-up does without).
@@ -524,3 +524,12 @@ def _log_keep(value: str | None) -> int | None:
     raise UsageError(
         f"--log-keep is {value!r}; valid: a number of rotated files (0 or more), or all"
     )
+
+
+NO_CACHE_ENV = "MLAUNCH_NO_CACHE"
+
+
+def cache_wanted(opts: Options, environ: Mapping[str, str]) -> bool:
+    """Whether this run may use the plan cache: not --no-cache, not MLAUNCH_NO_CACHE=1 (any
+    value but empty and 0). Decided here, before the cache's code (and pickle) is imported."""
+    return opts.cache and environ.get(NO_CACHE_ENV, "") in ("", "0")

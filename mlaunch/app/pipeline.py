@@ -223,6 +223,10 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
 
 def plan_cache(opts: Options) -> PlanCache | None:
     """The run's entry in the plan cache, or None (--no-cache, MLAUNCH_NO_CACHE)."""
+    from mlaunch.app.options import cache_wanted
+
+    if not cache_wanted(opts, os.environ):
+        return None  # the cache's code is not even imported
     from mlaunch.app.plan_cache import PlanCache
     from mlaunch.engine.lifeline import say
 

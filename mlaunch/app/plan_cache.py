@@ -24,6 +24,7 @@ import sys
 import time
 from types import FunctionType
 
+from mlaunch.app.options import cache_wanted
 from mlaunch.plan import inputs as plan_inputs
 from mlaunch.ros.files import write_all
 
@@ -37,7 +38,6 @@ if TYPE_CHECKING:
     from mlaunch.resolve.resolver import LabelCounter, ResolveOptions
 
 FORMAT = b"mlaunch plan cache 2\n"
-DISABLE_ENV = "MLAUNCH_NO_CACHE"
 MAX_ENTRY_BYTES = 32 << 20
 MAX_TOTAL_BYTES = 256 << 20
 _DIGEST_CHARS = 40  # plan_inputs.digest: 20 bytes in hex
@@ -69,11 +69,8 @@ class Entry:
 
 
 def enabled(opts: Options, environ: Mapping[str, str]) -> bool:
-    """Whether this run may use the cache: not --no-cache, not MLAUNCH_NO_CACHE=1 (any value
-    but empty and 0), not a native ROS 1 run (decided while loading)."""
-    if not opts.cache:
-        return False
-    return environ.get(DISABLE_ENV, "") in ("", "0")
+    """Whether this run may use the cache (a native ROS 1 run is refused while loading)."""
+    return cache_wanted(opts, environ)
 
 
 def cache_folder(environ: Mapping[str, str]) -> str:
