@@ -358,6 +358,18 @@ PARTS = {
         "n.create_client(s.LoadNode, '/bench/_container/load_node')\n"
         "n.destroy_node(); rclpy.shutdown()"
     ),
+    # As mlaunch's LoadNode driver makes it (mlaunch.parts.lean): the floor of its rclpy side.
+    "the same, lean (UDPv4 only, two malloc arenas: the launcher's own participant)": (
+        "from mlaunch.parts.lean import lean_participant, limit_arenas\n"
+        "limit_arenas()\n"
+        "import rclpy, rclpy.node, composition_interfaces.srv as s\n"
+        "rclpy.init()\n"
+        "with lean_participant():\n"
+        "    n = rclpy.node.Node('_mlaunch_bench_part', start_parameter_services=False,"
+        " enable_rosout=False)\n"
+        "n.create_client(s.LoadNode, '/bench/_container/load_node')\n"
+        "n.destroy_node(); rclpy.shutdown()"
+    ),
 }
 
 
