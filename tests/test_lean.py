@@ -3,6 +3,8 @@ only unless the user configures Fast DDS, only while it is made; malloc arenas a
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 
 from mlaunch.parts import lean
@@ -54,3 +56,19 @@ def test_arenas_are_limited_through_mallopt() -> None:
 
     assert lean.limit_arenas(mallopt)
     assert calls == [(-8, 2)]  # M_ARENA_MAX in glibc's malloc.h
+
+
+def test_off_the_main_thread_nothing_is_set() -> None:
+    """A LaunchService on a thread of its own (launch_testing): the test's thread may spawn
+    with os.environ meanwhile, so the participant keeps the default transports."""
+    environ: dict[str, str] = {}
+    seen: list[dict[str, str]] = []
+
+    def make() -> None:
+        with lean.lean_participant(environ):
+            seen.append(dict(environ))
+
+    thread = threading.Thread(target=make)
+    thread.start()
+    thread.join(10)
+    assert seen == [{}]

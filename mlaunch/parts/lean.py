@@ -13,7 +13,8 @@ the launcher's peak RSS, best of alternating runs:
 
 Both apply to this process only: ``mallopt`` is undone by the exec of a child, and the transport
 setting is in this process's environment only while its participant is made, on the thread that
-resolves and spawns (children get the plan's environment, never os.environ's at that moment).
+resolves and spawns (children get the plan's environment, never os.environ's at that moment),
+and only when that is the main thread (mlaunch's own run).
 A user's own Fast DDS configuration (a profile file, FASTDDS_BUILTIN_TRANSPORTS, another RMW) is
 left as it is.
 """
@@ -53,10 +54,14 @@ def lean_participant(environ: MutableMapping[str, str] | None = None) -> Iterato
     """While inside, a participant this process makes uses UDPv4 only (see the module).
 
     ``environ``: the process's environment (os.environ); a test passes a dict. Call it only on
-    the thread that resolves and spawns: it sets os.environ for that while.
+    the thread that resolves and spawns: it sets os.environ for that while. Off the main thread
+    (a LaunchService run by launch_testing beside the tests' own thread, which may spawn with
+    os.environ) it does nothing.
     """
+    import threading
+
     env = os.environ if environ is None else environ
-    if not lean_transports(env):
+    if threading.current_thread() is not threading.main_thread() or not lean_transports(env):
         yield
         return
     env[TRANSPORTS] = "UDPv4"
