@@ -477,3 +477,50 @@ def test_code_imported_before_the_window_is_an_input(
         del sys.modules["helper_for_the_cache_test"]
     assert str(tmp_path / "helper_for_the_cache_test.py") in recording.inputs.files
     assert not any(path.startswith(os.path.dirname(os.__file__)) for path in recording.inputs.files)
+
+
+SLOW_TOP = """\
+import time
+from launch import LaunchDescription
+from launch.actions import ExecuteProcess
+
+def generate_launch_description():
+    time.sleep(1.0)  # still loading when the run's move into its cgroup is done
+    return LaunchDescription([ExecuteProcess(cmd=['true'])])
+"""
+
+
+def test_the_runs_own_cgroup_move_is_not_the_launchs_write(
+    tmp_path: Path, env: dict[str, str]
+) -> None:
+    """The move into the run's cgroup runs in a thread while the file loads; its write of
+    cgroup.procs is mlaunch's, not the launch file's: a cold run still stores its plan (a fresh
+    clone's CI lost a store to it). The move is held 0.3 s so it lands inside the loading."""
+    from mlaunch.engine.cgroup import RunCgroup
+
+    made, why = RunCgroup.create(dict(os.environ))
+    if made is None:
+        pytest.skip(f"no cgroup of its own for a run here: {why}")
+    made.remove()
+    top = tmp_path / "slow.launch.py"
+    top.write_text(SLOW_TOP)
+    code = (
+        "import sys, time\n"
+        "import mlaunch.engine.cgroup as cgroup\n"
+        "enter = cgroup.RunCgroup.enter\n"
+        "def held(self):\n"
+        "    time.sleep(0.3)\n"
+        "    return enter(self)\n"
+        "cgroup.RunCgroup.enter = held\n"
+        "from mlaunch.cli import main\n"
+        "sys.exit(main(sys.argv[1:]))\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code, str(top), "--print", "--debug"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert STORED in cache_lines(done), cache_lines(done)

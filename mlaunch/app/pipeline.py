@@ -241,6 +241,10 @@ def resolve_recorded(
     from mlaunch.plan import inputs
 
     path = ""
+    # The move into the run's cgroup (a thread of its own while the file loads) writes
+    # cgroup.procs: finished first, or the recording would take that for the launch's own write
+    # and refuse to store the plan (on a cold run only; a cached one does not record).
+    life.settle()
     with cache.record(life.temp_dir) as recording:
         path, search = find_target(opts)
         if native_ros1(opts, path):
