@@ -152,7 +152,10 @@ def test_a_slow_reader_slows_the_children_down_and_loses_nothing(tmp_path: Path)
     n = 200_000
     stamp = tmp_path / "stamp"
     specs = [make_spec("slowed", flood_code(n, "s", stamp))]
-    _, screen, reader = run_with_reader(specs, {"chunk": 32 * 1024, "every": 0.01}, {})
+    # A slow but steady reader: the stall rule (1 s without progress, tested below) is put far
+    # off, since this reader is a thread the loaded machine may not run for a second (a fresh
+    # clone's CI, 4 workers on 2 cores: it fell behind once).
+    _, screen, reader = run_with_reader(specs, {"chunk": 32 * 1024, "every": 0.01}, {"stall": 30.0})
     data = bytes(reader.data)
     assert b"fell behind" not in data and screen.dropped_lines == 0
     assert child_lines(data, "slowed", "s") == list(range(n))
