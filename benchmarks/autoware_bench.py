@@ -400,6 +400,9 @@ def measure(
     if isinstance(reference, str):
         return reference
     ours = tree.environ(dict(env))
+    # The harness turns the plan cache off for the other groups (run.py's measured
+    # environment); here it is on as a user has it, and --no-cache (or cold) turns it off.
+    ours.pop("MLAUNCH_NO_CACHE", None)
     theirs = tree.environ(reference)
     ros2 = shutil.which("ros2", path=theirs["PATH"])
     if ros2 is None:
@@ -506,6 +509,7 @@ def part_figures(
     # Without the ROS wheels' re-exec (the harness's own environment has run it): each part
     # alone, in one interpreter.
     env = {**env, **{k: os.environ[k] for k in HOOK_VARIABLES if k in os.environ}}
+    env.pop("MLAUNCH_NO_CACHE", None)  # the resolving part says --no-cache itself
     codes = dict(PARTS)
     codes["resolve the tree (mlaunch --print --no-cache, xacro in-process)"] = (
         f"from mlaunch.cli import main\nmain({['--print', '--no-cache', *launch]!r})"
