@@ -321,15 +321,16 @@ def test_a_stdout_nobody_reads_never_blocks_the_children(tmp_path: Path) -> None
 
 
 PROBE = """
-import subprocess, sys
+import sys
+from mlaunch.engine import spawning
 heavy = ("rich", "psutil", "ctypes")
 first = []
-original = subprocess.Popen.__init__
-def spy(self, *args, **kwargs):
+original = spawning.start
+def spy(*args, **kwargs):
     if not first:
         first.append([m for m in heavy if m in sys.modules])
-    original(self, *args, **kwargs)
-subprocess.Popen.__init__ = spy
+    return original(*args, **kwargs)
+spawning.start = spy
 from mlaunch.cli import main
 code = main([sys.argv[1]])
 print("AT-FIRST-SPAWN", first[0], "AT-END", [m for m in heavy[:2] if m in sys.modules])

@@ -423,3 +423,22 @@ def test_an_unknown_fork_exec_is_not_used(monkeypatch: pytest.MonkeyPatch) -> No
     ):
         monkeypatch.setattr(_posixsubprocess, "fork_exec", Fake(wrong))
         assert spawning._fork_exec() is None, wrong
+
+
+def test_equal_environments_are_encoded_once_and_a_change_is_seen() -> None:
+    base = {"PATH": "/nowhere", "A": "1"}
+    first = spawning.environment(dict(base))
+    assert spawning.environment(dict(base)) is first  # equal content, another dict
+    changed = spawning.environment({**base, "A": "2"})
+    assert changed is not first
+    argv = [PY, "-S", "-c", "import os; print(os.environ['A'])"]
+    assert run(argv, first) == (0, b"1\n")
+    assert run(argv, changed) == (0, b"2\n")
+
+
+def test_bytes_and_paths_in_the_environment_are_taken_as_popen_takes_them() -> None:
+    env = {b"RAW": b"\xff", "P": Path("/x/y")}
+    argv = [PY, "-S", "-c", "import os; print(os.environb[b'RAW'], os.environ['P'])"]
+    assert run(argv, env) == popen_run(argv, env) == (0, b"b'\\xff' /x/y\n")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="illegal environment variable name"):
+        launch(["true"], {b"A=B": b"1"})  # type: ignore[dict-item]

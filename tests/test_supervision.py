@@ -8,6 +8,7 @@ process of the run is left, found by the run's marker in /proc.
 
 from __future__ import annotations
 
+import json
 import os
 import resource
 import signal
@@ -27,6 +28,7 @@ from mlaunch.engine.logfiles import LogFile
 from mlaunch.engine.output import Printer
 from mlaunch.engine.process import (
     MAX_PARTIAL,
+    Process,
     core_dump_hint,
     expand_core_pattern,
     utf8_safe_cut,
@@ -36,7 +38,7 @@ from mlaunch.engine.respawn import STABLE_UPTIME, respawn_delay
 from mlaunch.engine.screen import Screen
 from mlaunch.engine.supervisor import Supervisor
 from mlaunch.parts.control import Control
-from mlaunch.plan.records import Exited, Output, Record, Started
+from mlaunch.plan.records import Exited, FailedToStart, Output, Record, Started
 from mlaunch.plan.steps import Plan, ProcessSpec, RespawnPolicy, Spawn
 
 if TYPE_CHECKING:
@@ -84,6 +86,7 @@ class Harness:
         out: Callable[[bytes], object] | None = None,
         clock: Callable[[], float] = time.monotonic,
         stray_grace: float = 2.0,
+        spawner: type[Process] = Process,
     ) -> None:
         if isinstance(plan, list):
             plan = Plan(steps=[Spawn(spec=s) for s in plan])
@@ -95,7 +98,12 @@ class Harness:
             rotate_keep=rotate_keep,
         )
         self.sup = Supervisor(
-            plan, self.printer, install_signals=False, clock=clock, stray_grace=stray_grace
+            plan,
+            self.printer,
+            install_signals=False,
+            clock=clock,
+            stray_grace=stray_grace,
+            spawner=spawner,
         )
         self.lines: list[tuple[str, bytes]] = []
         self._triggers: list[tuple[bytes, Callable[[str, bytes], None]]] = []
@@ -810,3 +818,96 @@ def test_held_process_is_signalled_only_when_released() -> None:
     assert order.index("exited free-2") < order.index("release") < order.index("exited held-1"), (
         order
     )
+
+
+# --- how a child is started: engine.spawning, or Popen where it is not available ------------
+
+
+class PopenProcess(Process):
+    """A Process started by subprocess.Popen, as on a Python whose fork_exec is unknown."""
+
+    direct = False
+
+
+def output(h: Harness, label: str) -> list[str]:
+    """What the child of ``label`` wrote, line by line."""
+    return [line.decode() for who, line in h.lines if who == label]
+
+
+KINDS = pytest.mark.parametrize("kind", [Process, PopenProcess], ids=["direct", "popen"])
+
+
+@KINDS
+def test_a_program_that_cannot_start_is_said_and_the_run_goes_on(
+    kind: type[Process], tmp_path: Path
+) -> None:
+    plain = tmp_path / "plain"
+    plain.write_text("not a program\n")
+    specs = [
+        make_spec("missing", "", argv=("no-such-program-xyz",)),
+        make_spec("plain", "", argv=(str(plain),)),
+        make_spec("fine", "print('fine')"),
+    ]
+    h = Harness(specs, spawner=kind)
+    failed: dict[str, str] = {}
+    h.sup.records.subscribe(
+        lambda r: failed.update({r.process.label: r.reason}) if isinstance(r, FailedToStart) else 0
+    )
+    assert h.run() == 0
+    assert failed == {"missing": "No such file or directory", "plain": "Permission denied"}
+    assert h.sup.states["missing"].state == FAILED
+    assert "[fine] fine" in h.text
+    assert "failed to start" in h.text or "No such file or directory" in h.text
+
+
+@KINDS
+def test_a_child_gets_argv_env_cwd_the_run_marker_and_a_stdin_that_stays_open(
+    kind: type[Process], tmp_path: Path
+) -> None:
+    code = """
+        import json, os, select, sys
+        # stdin is a pipe nobody writes to: not readable (no EOF) while the run holds it.
+        readable = select.select([sys.stdin], [], [], 0.5)[0]
+        print(json.dumps({"argv": sys.argv[1:], "cwd": os.getcwd(), "stdin": bool(readable),
+                          "env": {k: v for k, v in os.environ.items() if k.startswith("MLAUNCH")},
+                          "mine": os.environ.get("MINE")}))
+    """
+    spec = make_spec("kid", code, cwd=str(tmp_path))
+    spec.argv = (*spec.argv, "a b", "")
+    spec.env = {**spec.env, "MINE": "x y"}
+    h = Harness([spec], spawner=kind)
+    assert h.run() == 0
+    (line,) = output(h, "kid")
+    seen = json.loads(line)
+    assert seen["argv"] == ["a b", ""] and seen["cwd"] == str(tmp_path)
+    assert seen["stdin"] is False, "stdin read EOF or data: it must be an open, empty pipe"
+    assert seen["mine"] == "x y"
+    assert any(h.sup.run_id in v for v in seen["env"].values()), seen["env"]
+
+
+@KINDS
+def test_shell_joins_the_command_and_emulate_tty_gives_terminals(kind: type[Process]) -> None:
+    shell = make_spec("sh", "", argv=("echo", "$MINE", "two  spaces"))
+    shell.shell = True
+    shell.env = {**shell.env, "MINE": "expanded"}
+    tty = make_spec("tty", "import os; print(os.isatty(0), os.isatty(1), os.isatty(2))")
+    tty.emulate_tty = True
+    h = Harness([shell, tty], spawner=kind)
+    assert h.run() == 0
+    assert output(h, "sh") == ["expanded two spaces"]
+    assert output(h, "tty") == ["False True True"]
+
+
+@KINDS
+def test_only_fds_0_to_2_reach_a_child(kind: type[Process]) -> None:
+    leaky_r, leaky_w = os.pipe()
+    os.set_inheritable(leaky_r, True)
+    try:
+        code = "import os; print(sorted(os.listdir('/proc/self/fd')))"
+        h = Harness([make_spec("fds", code)], spawner=kind)
+        assert h.run() == 0
+        # The child's own listing holds the fd of the folder it lists (3) and nothing else.
+        assert output(h, "fds") == ["['0', '1', '2', '3']"]
+    finally:
+        os.close(leaky_r)
+        os.close(leaky_w)

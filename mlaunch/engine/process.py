@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
 import time
 from collections.abc import Callable, Mapping
 
+from mlaunch.engine import spawning
+
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    import subprocess
+
     from mlaunch.plan.steps import ProcessSpec
 
 READ_SIZE = 256 * 1024
@@ -197,6 +200,10 @@ class Process:
         "user_stop",
     )
 
+    # Start children with engine.spawning (False: subprocess.Popen, as on a Python whose
+    # fork_exec spawning does not know; the engine's tests run both).
+    direct = spawning.AVAILABLE
+
     def __init__(self, spec: ProcessSpec, index: int, restarts: int = 0) -> None:
         self.spec = spec
         self.index = index
@@ -251,57 +258,79 @@ class Process:
         the program cannot be started.
         """
         spec = self.spec
-        args: list[str] | str = list(spec.argv)
-        if spec.shell:
-            # ROS 2 joins the command with spaces and hands it to /bin/sh, unquoted.
-            args = " ".join(spec.argv)
         env = {**spec.env, **extra_env} if extra_env else spec.env
-        ttys = _ptys() if spec.emulate_tty else None
+        # ROS 2 joins the command with spaces and hands it to /bin/sh, unquoted (Popen's
+        # shell=True makes this same argv).
+        argv = ("/bin/sh", "-c", " ".join(spec.argv)) if spec.shell else spec.argv
         from mlaunch.engine import fdlimit
 
-        # A pipe nobody writes to, open while the child lives, as launch gives: a child that
-        # reads its stdin waits (DEVNULL would hand it EOF at once). Made here rather than by
-        # stdin=PIPE, which wraps the write end in a file object (three more system calls and
-        # an object per child, for an end that is only ever closed).
+        # The user's own open-file limit, when the run raised its own (only then).
+        setup = fdlimit.LIMIT.child_setup() if fdlimit.LIMIT is not None else None
+        # stdout and stderr: (read, write) pipes, or (master, slave) terminals for emulate_tty.
+        outputs = _ptys() if spec.emulate_tty else None
+        made: list[int] = [fd for pair in outputs or () for fd in pair]
         try:
-            stdin_read, stdin_write = os.pipe()  # close-on-exec; the child gets a copy as fd 0
+            if outputs is None:
+                outputs = (os.pipe(), os.pipe())  # close-on-exec, as every fd below
+                made += (*outputs[0], *outputs[1])
+            # A pipe nobody writes to, open while the child lives, as launch gives: a child
+            # that reads its stdin waits (DEVNULL would hand it EOF at once). Its write end is
+            # held (``stdin_fd``) and only ever closed, so it is a bare fd, not a file object.
+            stdin_read, stdin_write = os.pipe()
+            made += (stdin_read, stdin_write)
+            out, err = outputs[0][1], outputs[1][1]
+            if self.direct:
+                self.pid = spawning.start(
+                    argv,
+                    spawning.environment(env),
+                    stdin=stdin_read,
+                    stdout=out,
+                    stderr=err,
+                    cwd=spec.cwd,
+                    child_setup=setup,
+                )
+            else:
+                self._popen(argv, env, stdin_read, out, err, setup)
         except BaseException:
-            for fd in [fd for pair in ttys or () for fd in pair]:
+            for fd in made:
                 os.close(fd)
             raise
-        try:
-            self.popen = subprocess.Popen(
-                args,
-                stdin=stdin_read,
-                stdout=subprocess.PIPE if ttys is None else ttys[0][1],
-                stderr=subprocess.PIPE if ttys is None else ttys[1][1],
-                env=env,
-                cwd=spec.cwd,
-                shell=spec.shell,
-                start_new_session=True,
-                close_fds=True,
-                # The user's own open-file limit, when the run raised its own (only then).
-                preexec_fn=fdlimit.LIMIT.child_setup() if fdlimit.LIMIT is not None else None,
-            )
-        except BaseException:
-            for fd in [stdin_write, *(fd for pair in ttys or () for fd in pair)]:
-                os.close(fd)
-            raise
-        finally:
-            os.close(stdin_read)
+        os.close(stdin_read)
         self.stdin_fd = stdin_write
-        self.pid = self.popen.pid
         self.started_at = clock()
-        if ttys is None:
-            self.watch_pipes()
-            return
-        for name, (master, slave) in zip(("stdout", "stderr"), ttys, strict=True):
-            os.close(slave)  # the child has it; the master reads EOF (EIO) once the child is gone
-            os.set_blocking(master, False)
-            self.streams[master] = Stream(name, master)
+        for name, (read, write) in zip(("stdout", "stderr"), outputs, strict=True):
+            os.close(write)  # the child has it: the read end sees EOF (a pty EIO) once it is gone
+            os.set_blocking(read, False)
+            self.streams[read] = Stream(name, read)
+
+    def _popen(
+        self,
+        argv: tuple[str, ...],
+        env: Mapping[str, str],
+        stdin: int,
+        stdout: int,
+        stderr: int,
+        setup: Callable[[], None] | None,
+    ) -> None:
+        """Start the child with subprocess.Popen (a Python whose fork_exec engine.spawning
+        does not know): the same child, at three times the cost."""
+        import subprocess
+
+        self.popen = subprocess.Popen(
+            argv,
+            stdin=stdin,
+            stdout=stdout,
+            stderr=stderr,
+            env=env,
+            cwd=self.spec.cwd,
+            start_new_session=True,
+            close_fds=True,
+            preexec_fn=setup,
+        )
+        self.pid = self.popen.pid
 
     def watch_pipes(self) -> None:
-        """Take the child's stdout and stderr as non-blocking streams (subclasses' spawns too)."""
+        """Take a Popen's stdout and stderr as non-blocking streams (a subclass's spawn)."""
         assert self.popen is not None
         for name, pipe in (("stdout", self.popen.stdout), ("stderr", self.popen.stderr)):
             assert pipe is not None
@@ -341,7 +370,7 @@ class Process:
         if stream is not None and stream.file is not None:
             stream.file.close()  # type: ignore[attr-defined]
         elif stream is not None:
-            os.close(fd)  # a pty master
+            os.close(fd)  # a bare pipe or pty master
 
     def reaped(
         self,
@@ -357,12 +386,12 @@ class Process:
         if rusage is not None:
             self.peak_rss = int(rusage.ru_maxrss) * 1024  # type: ignore[attr-defined]  # KiB
             self.cpu_time = rusage.ru_utime + rusage.ru_stime  # type: ignore[attr-defined]
+        if self.stdin_fd >= 0:  # what is left of its group reads EOF from now on
+            os.close(self.stdin_fd)
+            self.stdin_fd = -1
         if self.popen is not None:
             # We reaped it ourselves; tell Popen so it never waits for this pid again.
             self.popen.returncode = code
-            if self.stdin_fd >= 0:  # what is left of its group reads EOF from now on
-                os.close(self.stdin_fd)
-                self.stdin_fd = -1
             if self.popen.stdin is not None:
                 try:  # what is left of its group reads EOF from now on
                     self.popen.stdin.close()
