@@ -1,7 +1,8 @@
 """Which commit made start-up slower: several revisions of mlaunch side by side, in one run.
 
     .venv/bin/python benchmarks/bisect_revs.py [--runs N] [--n 100] [--format py|yaml|xml]
-                                               [--ros2] [--calls] [--cache] [--json FILE] REV ...
+                                               [--ros2] [--floor] [--calls] [--cache]
+                                               [--json FILE] REV ...
     .venv/bin/python benchmarks/bisect_revs.py --between OLD NEW --steps K [...]
 
 Each revision is checked out into a temporary worktree (``git worktree add --detach``, removed
@@ -23,8 +24,10 @@ of load from elsewhere hits them all) and the table gives best and median over t
 Python) until the first and the N-th child were started, and the modules loaded by then: the
 same on an idle or a loaded machine, so one run says what a change costs. The plan cache is
 off (``MLAUNCH_NO_CACHE=1``) unless ``--cache``: revisions before it always resolve the file.
-``--ros2`` adds the reference ros2 launch (found as ``run.py`` finds it) as one more column of
-the same rounds, and the ratios of each revision to it. ``--between OLD NEW --steps K`` measures
+``--floor`` adds the bare Popen loop (``floor_spawn.py``, started as the revisions are) as a
+column, and each revision's ratios to it: the figure of "within 1.1x of the floor" that a
+loaded machine does not blur. ``--ros2`` adds the reference ros2 launch (found as ``run.py``
+finds it) as one more column of the same rounds, and the ratios of each revision to it. ``--between OLD NEW --steps K`` measures
 K+1 revisions evenly spread over OLD..NEW's first-parent history (both ends included): bisect by
 narrowing it run after run.
 """
@@ -71,18 +74,38 @@ if os.environ.get("MLAUNCH_BISECT_CALLS"):
     def count(frame, event, arg):
         if event == "call" or event == "c_call":
             calls[0] += 1
-    init = subprocess.Popen.__init__
-    def counted(self, *args, **kwargs):
-        marks.append(calls[0])
-        init(self, *args, **kwargs)
-        if len(marks) == want:
-            sys.setprofile(None)
-            with open(out, "w") as f:
-                f.write(f"{{marks[0]}} {{calls[0]}} {{len(sys.modules)}}\\n")
-    subprocess.Popen.__init__ = counted
+    def counting(start):
+        def counted(*args, **kwargs):
+            marks.append(calls[0])
+            pid = start(*args, **kwargs)
+            if len(marks) == want:
+                sys.setprofile(None)
+                with open(out, "w") as f:
+                    f.write(f"{{marks[0]}} {{calls[0]}} {{len(sys.modules)}}\\n")
+            return pid
+        return counted
+    try:  # revisions that start children with engine.spawning (Popen only as a fallback)
+        from mlaunch.engine import spawning
+    except ImportError:
+        spawning = None
+    if spawning is not None and spawning.AVAILABLE:
+        spawning.start = counting(spawning.start)
+    else:
+        subprocess.Popen.__init__ = counting(subprocess.Popen.__init__)
     sys.setprofile(count)
 from mlaunch.cli import program
 program()
+"""
+
+# The floor (benchmarks/floor_spawn.py: a bare Popen loop) run as the revisions are run.
+FLOOR = """\
+import sys
+sys.modules.setdefault("ros_wheels_bootstrapper", type(sys)("ros_wheels_bootstrapper"))
+import site
+site.main()
+sys.path.insert(0, {here!r})
+import floor_spawn
+sys.exit(floor_spawn.main(sys.argv[1:]))
 """
 
 
@@ -125,63 +148,6 @@ def spread(old: str, new: str, steps: int) -> list[str]:
     return list(dict.fromkeys(picks))
 
 
-# --- the launcher's CPU ----------------------------------------------------------------------
-
-
-def _ticks(stat_path: str) -> int:
-    with open(stat_path) as f:
-        fields = f.read().rsplit(")", 1)[1].split()
-    return int(fields[11]) + int(fields[12])
-
-
-def process_cpu(pid: int) -> float:
-    """CPU seconds of one process: its live threads in ns, those that ended in ticks."""
-    live_ns = live_ticks = 0
-    for tid in os.listdir(f"/proc/{pid}/task"):
-        try:
-            with open(f"/proc/{pid}/task/{tid}/schedstat") as f:
-                live_ns += int(f.read().split()[0])
-            live_ticks += _ticks(f"/proc/{pid}/task/{tid}/stat")
-        except (FileNotFoundError, ProcessLookupError):
-            continue  # ended between listdir and open: its time is in the ticks below
-    dead = max(0, _ticks(f"/proc/{pid}/stat") - live_ticks)
-    return live_ns / 1e9 + dead / pr.CLK_TCK
-
-
-def descendants(pid: int) -> list[int]:
-    """Every live descendant of pid (children lists of every thread, recursively)."""
-    found: list[int] = []
-    todo = [pid]
-    while todo:
-        parent = todo.pop()
-        try:
-            tids = os.listdir(f"/proc/{parent}/task")
-        except FileNotFoundError:
-            continue
-        for tid in tids:
-            try:
-                with open(f"/proc/{parent}/task/{tid}/children") as f:
-                    kids = [int(k) for k in f.read().split()]
-            except FileNotFoundError:
-                continue
-            found.extend(kids)
-            todo.extend(kids)
-    return found
-
-
-def launcher_cpu(pid: int) -> float:
-    """CPU seconds of the launcher and its descendants running the same executable."""
-    total = process_cpu(pid)
-    exe = os.readlink(f"/proc/{pid}/exe")
-    for kid in descendants(pid):
-        try:
-            if os.readlink(f"/proc/{kid}/exe") == exe:
-                total += process_cpu(kid)
-        except (FileNotFoundError, PermissionError):
-            continue
-    return total
-
-
 # --- one run ---------------------------------------------------------------------------------
 
 
@@ -192,7 +158,7 @@ def one_run(subject: Subject, n: int, fifo: Path, out_file: Path) -> dict[str, f
     try:
         try:
             first, last = probe.wait_ready(n, proc, time.perf_counter() + 30 + n / 10)
-            cpu = launcher_cpu(proc.pid)
+            cpu = pr.launcher_cpu(proc.pid)
             if subject.graceful:
                 pr.stop_and_time(proc, probe, signal.SIGINT, 30.0)
         except BenchError as e:
@@ -239,6 +205,9 @@ def table(subjects: Sequence[Subject], ref: Subject | None, meta: dict[str, obje
     counted = any(s.calls for s in subjects)
     if counted:
         head += f" {'calls first/all':>16} {'modules':>7}"
+    floor = next((s for s in subjects if s.label == "floor"), None)
+    if floor is not None:
+        head += f" {'CPU/floor':>9} {'all/floor':>9}"
     if ref is not None:
         head += f" {'CPU/ros2':>9} {'all/ros2':>9}"
     lines.append(head + "  subject")
@@ -251,6 +220,11 @@ def table(subjects: Sequence[Subject], ref: Subject | None, meta: dict[str, obje
         if counted:
             first, every, modules = s.calls or (0, 0, 0)
             row += f" {first:7d}/{every:8d} {modules:7d}" if s.calls else " " * 25
+        if floor is not None:
+            row += (
+                f" {s.median('cpu') / floor.median('cpu'):9.3f}"
+                f" {s.median('all') / floor.median('all'):9.3f}"
+            )
         if ref is not None:
             row += (
                 f" {s.median('cpu') / ref.median('cpu'):9.3f}"
@@ -269,6 +243,12 @@ def parse_args(argv: Sequence[str]) -> argparse.Namespace:
     p.add_argument("--n", type=int, default=100, help="children in the launch (100)")
     p.add_argument("--format", choices=gen.FORMATS, default="py")
     p.add_argument("--ros2", action="store_true", help="add the reference ros2 launch")
+    p.add_argument(
+        "--floor",
+        action="store_true",
+        help="add the bare Popen loop (floor_spawn.py, run as the revisions are) and the ratios"
+        " to it",
+    )
     p.add_argument(
         "--cache",
         action="store_true",
@@ -312,6 +292,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         argv = [sys.executable, "-S", "-P", "-c", LAUNCHER.format(n=args.n), str(launch)]
         subjects = [revision_subject(rev, trees, mlaunch_env, argv) for rev in dict.fromkeys(revs)]
+        if args.floor:
+            floor_argv = [sys.executable, "-S", "-P", "-c", FLOOR.format(here=str(HERE))]
+            floor_argv += [str(args.n), *child]
+            about = "bare Popen loop (benchmarks/floor_spawn.py)"
+            subjects.append(Subject("floor", floor_argv, mlaunch_env, about))
         ref = None
         if args.ros2:
             with bench.ros_domain(None) as domain:
@@ -348,6 +333,8 @@ def measure(
     if args.calls:
         counts = out_file.with_name("calls.txt")
         for subject in revisions:
+            if subject.label == "floor":
+                continue  # counts mlaunch's calls only
             counting = Subject(subject.label, subject.argv, subject.env, subject.about)
             counting.env = {**subject.env, "MLAUNCH_BISECT_CALLS": str(counts)}
             one_run(counting, args.n, fifo, out_file)

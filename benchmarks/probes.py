@@ -216,6 +216,60 @@ def fine_cpu_seconds(pid: int) -> float:
     return total / 1e9
 
 
+def _ticks(stat_path: str) -> int:
+    with open(stat_path) as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])
+
+
+def process_cpu(pid: int) -> float:
+    """CPU seconds of one process: its live threads in ns, those that ended in ticks."""
+    live_ns = live_ticks = 0
+    for tid in os.listdir(f"/proc/{pid}/task"):
+        try:
+            with open(f"/proc/{pid}/task/{tid}/schedstat") as f:
+                live_ns += int(f.read().split()[0])
+            live_ticks += _ticks(f"/proc/{pid}/task/{tid}/stat")
+        except (FileNotFoundError, ProcessLookupError):
+            continue  # ended between listdir and open: its time is in the ticks below
+    dead = max(0, _ticks(f"/proc/{pid}/stat") - live_ticks)
+    return live_ns / 1e9 + dead / CLK_TCK
+
+
+def descendants(pid: int) -> list[int]:
+    """Every live descendant of pid (children lists of every thread, recursively)."""
+    found: list[int] = []
+    todo = [pid]
+    while todo:
+        parent = todo.pop()
+        try:
+            tids = os.listdir(f"/proc/{parent}/task")
+        except FileNotFoundError:
+            continue
+        for tid in tids:
+            try:
+                with open(f"/proc/{parent}/task/{tid}/children") as f:
+                    kids = [int(k) for k in f.read().split()]
+            except FileNotFoundError:
+                continue
+            found.extend(kids)
+            todo.extend(kids)
+    return found
+
+
+def launcher_cpu(pid: int) -> float:
+    """CPU seconds of the launcher and its descendants running the same executable."""
+    total = process_cpu(pid)
+    exe = os.readlink(f"/proc/{pid}/exe")
+    for kid in descendants(pid):
+        try:
+            if os.readlink(f"/proc/{kid}/exe") == exe:
+                total += process_cpu(kid)
+        except (FileNotFoundError, PermissionError):
+            continue
+    return total
+
+
 def vm_hwm_mb(pid: int) -> float:
     """Peak resident set size so far (VmHWM), in MB (10^6 bytes)."""
     with open(f"/proc/{pid}/status") as f:

@@ -601,6 +601,11 @@ class Bench:
                 # its child said it runs, read as the line arrives: what a loaded machine's
                 # wall clock hides. The threads alive now only (a thread that ended is ~0).
                 result["first_cpu"] = pr.fine_cpu_seconds(proc.pid)
+            else:
+                # The launcher's CPU (and its helpers' that run the same executable: mlaunch's
+                # guard) until its N-th child said it runs: the figure to compare on a busy
+                # machine, whose wall clock also measures the wait for a core.
+                result["all_cpu"] = pr.launcher_cpu(proc.pid)
             if noted is not None:
                 self.wait_output(noted, n, proc, time.perf_counter() + 30 + n / 10)
             if idle > 0:
@@ -791,6 +796,21 @@ class Bench:
                 ),
                 "all",
             )
+            if "all_cpu" in samples[0] and (not floors or "all_cpu" in floors[0]):
+                add(
+                    Row(
+                        "startup",
+                        f"CPU until all {n} children run, {fmt}",
+                        venv.name,
+                        "s",
+                        pick(samples, "all_cpu"),
+                        loop,
+                        pick(floors, "all_cpu"),
+                        None,
+                        params,
+                    ),
+                    "all_cpu",
+                )
         if fmt != "py":
             return
         if n in self.config.shutdown_ns:

@@ -353,6 +353,7 @@ def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
 
     before = worktrees()
     argv = [sys.executable, str(BENCH / "bisect_revs.py"), "--runs", "2", "--n", "3", "--calls"]
+    argv.append("--floor")
     done = subprocess.run(
         [*argv, "--json", str(out), "HEAD"], capture_output=True, text=True, timeout=120
     )
@@ -364,14 +365,16 @@ def test_bisect_measures_a_revision_from_its_own_tree(tmp_path: Path) -> None:
     head = subprocess.run(
         ["git", "-C", str(REPO), "rev-parse", "HEAD"], capture_output=True, text=True, check=True
     ).stdout.strip()[:7]
-    [subject] = data["subjects"]
+    [subject, floor] = data["subjects"]
     assert subject["label"] == head and len(subject["samples"]) == 2
-    for sample in subject["samples"]:
+    assert floor["label"] == "floor" and len(floor["samples"]) == 2 and floor["calls"] is None
+    for sample in subject["samples"] + floor["samples"]:
         assert sample["cpu"] > 0 and 0 < sample["first"] <= sample["all"]
     # Python calls to the first and to the third child started, and the modules loaded by then.
     first, every, modules = subject["calls"]
     assert 0 < first < every and modules > 50
-    assert f"\n{head} " in done.stdout
+    assert f"\n{head} " in done.stdout and "\nfloor " in done.stdout
+    assert "CPU/floor" in done.stdout  # each revision's ratio to the bare Popen loop
 
 
 def test_bisect_spreads_revisions_over_the_history() -> None:
