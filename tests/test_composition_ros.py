@@ -43,23 +43,46 @@ RECORDER = str(Path(__file__).parent / "nodes" / "recording_container.py")
 
 
 @pytest.fixture
-def loader(ros_env: dict[str, str]) -> Iterator[tuple[Any, list[tuple[str, str]]]]:
-    """A ComponentLoader on its own rclpy context in the test's domain, and its log lines."""
+def ros_context(ros_env: dict[str, str]) -> Iterator[Any]:
+    """An rclpy context in the test's domain (the tests' probes of the graph)."""
     import rclpy
-
-    from mlaunch.parts.components import ComponentLoader
 
     context = rclpy.Context()
     rclpy.init(context=context)
+    try:
+        yield context
+    finally:
+        context.try_shutdown()
+
+
+@pytest.fixture(params=["rtps", "rclpy"])
+def loader(
+    request: pytest.FixtureRequest, ros_env: dict[str, str], ros_context: Any
+) -> Iterator[tuple[Any, list[tuple[str, str]]]]:
+    """A ComponentLoader in the test's domain, over each link (mlaunch.parts.loadnode_links:
+    RTPS of its own, or rclpy on the test's context), and its log lines."""
+    from mlaunch.parts.components import ComponentLoader
+    from mlaunch.parts.loadnode_links import RclpyLink, RtpsLink
+    from mlaunch.parts.rtps import discovery_range
+
+    if request.param == "rtps":
+        scope = discovery_range(ros_env)
+        assert scope is not None
+        link: Any = RtpsLink(int(ros_env["ROS_DOMAIN_ID"]), scope)
+    else:
+        link = RclpyLink(ros_context)
     lines: list[tuple[str, str]] = []
-    driver = ComponentLoader(context, lambda level, message: lines.append((level, message)))
+    driver = ComponentLoader(link, lambda level, message: lines.append((level, message)))
     try:
         yield driver, lines
     finally:
         driver.stop.set()
         driver.join(5.0)
         driver.close()
-        context.try_shutdown()
+
+
+class _Skip(Exception):
+    """The rest of a test does not apply to this link."""
 
 
 def as_lists(request: LoadRequest) -> dict[str, Any]:
@@ -128,10 +151,11 @@ def test_the_recording_container_receives_launch_ros_requests(
     assert len(loads(plan)) == 2
 
 
-def test_every_step_loads_through_one_node(prefix: Path, loader: Any) -> None:
+def test_every_step_loads_through_one_node(prefix: Path, loader: Any, ros_context: Any) -> None:
     """Steps waiting for their containers at once are clients of one loader node (a node per
     step cost ~0.35 MB and 1.5 ms each: 27 of them on Autoware's planning_simulator), and a
-    stop still abandons each load with its own line."""
+    stop still abandons each load with its own line. (Over RTPS: one participant, whose
+    clients are not a ROS node's.)"""
     from rclpy.node import Node
 
     driver, lines = loader
@@ -143,9 +167,15 @@ def test_every_step_loads_through_one_node(prefix: Path, loader: Any) -> None:
     for target in targets:
         driver.start(LoadComponents(step.origin, target, step.requests[:1], step.written))
     wanted = {f"{target}/_container/load_node" for target in targets}
-    probe = Node("loader_probe", context=driver.context)
+    probe = Node("loader_probe", context=ros_context)
     clients: dict[str, set[str]] = {}
     try:
+        if driver.link.name == "rtps":
+            participant = driver.link._made()
+            assert wait_until(
+                lambda: {c.service for c in list(participant.clients.values())} == wanted, 15
+            ), participant.clients
+            raise _Skip
 
         def one_node_has_both() -> bool:
             for name, namespace in probe.get_node_names_and_namespaces():
@@ -158,6 +188,8 @@ def test_every_step_loads_through_one_node(prefix: Path, loader: Any) -> None:
         name = next(n for n, services in clients.items() if wanted <= services)
         served = probe.get_service_names_and_types_by_node(name, "/")
         assert not [s for s, _ in served if "type_description" in s], served
+    except _Skip:
+        pass
     finally:
         probe.destroy_node()
     driver.stop.set()
@@ -167,7 +199,7 @@ def test_every_step_loads_through_one_node(prefix: Path, loader: Any) -> None:
 
 
 def test_the_standin_container_hosts_robot_state_publisher_and_refuses_unknown_plugins(
-    spawn: Callable[..., Proc], loader: Any
+    spawn: Callable[..., Proc], loader: Any, ros_context: Any
 ) -> None:
     driver, lines = loader
     spawn(standin("container", "--ros-args", "-r", "__node:=box"), "container")
@@ -190,12 +222,12 @@ def test_the_standin_container_hosts_robot_state_publisher_and_refuses_unknown_p
     assert any(
         level == "ERROR" and "'talker' of type 'composition::Talker'" in m for level, m in lines
     )
-    names = list_nodes(driver.context, "/box")
+    names = list_nodes(ros_context, "/box")
     assert names == ["/robot_state_publisher"]
 
 
 def test_the_standin_container_reads_extra_arguments_as_jazzys_container(
-    spawn: Callable[..., Proc], loader: Any
+    spawn: Callable[..., Proc], loader: Any, ros_context: Any
 ) -> None:
     """use_intra_process_comms and forward_global_arguments must be booleans (rclcpp's
     message otherwise), other names are ignored, and forward_global_arguments=true gives the
@@ -250,7 +282,7 @@ def test_the_standin_container_reads_extra_arguments_as_jazzys_container(
     assert (fwd.success, fwd.full_node_name) == (True, "/fwd")
     from rclpy.node import Node
 
-    probe = Node("graph_probe", context=driver.context)
+    probe = Node("graph_probe", context=ros_context)
     try:
         topics: dict[str, set[str]] = {"fwd": set(), "plain": set()}
 
@@ -320,3 +352,73 @@ def test_composed_jtbot_passes_mlaunch_test(ros_env: dict[str, str], tmp_path: P
     assert done.returncode == 0, done.stdout[-4000:] + done.stderr[-2000:]
     assert "node /robot_state_publisher is in the ROS graph" in out
     assert "Loaded node '/robot_state_publisher' in container '/jtbot_container'" in out
+
+
+@pytest.mark.parametrize("loader_env", ["", "rclpy"])
+def test_a_run_of_composable_nodes_loads_them_without_rclpy(
+    ros_env: dict[str, str], tmp_path: Path, loader_env: str
+) -> None:
+    """The launcher's only ROS need here is LoadNode: over RTPS it imports no rclpy (the run's
+    largest cost in memory); MLAUNCH_LOADER=rclpy goes through rclpy as before."""
+    import signal
+    import subprocess
+
+    from procutil import REPO, clean_env, mlaunch
+
+    env = clean_env(**{k: ros_env[k] for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")})
+    env["ROS_LOG_DIR"] = str(tmp_path / "log")
+    if loader_env:
+        env["MLAUNCH_LOADER"] = loader_env
+    out = tmp_path / "out"
+    with open(out, "wb") as sink:
+        run = subprocess.Popen(
+            mlaunch(str(REPO / "launches" / "jtbot_composed.launch.py"), "rviz:=false"),
+            stdout=sink,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            env=env,
+        )
+    try:
+        loaded = "Loaded node '/robot_state_publisher' in container '/jtbot_container'"
+        assert wait_until(lambda: loaded in out.read_text(), 60), out.read_text()[-3000:]
+        maps = Path(f"/proc/{run.pid}/maps").read_text()
+        assert ("rclpy" in maps) == (loader_env == "rclpy"), loader_env
+    finally:
+        run.send_signal(signal.SIGINT)
+        assert run.wait(30) == 130, out.read_text()[-3000:]
+
+
+def test_a_loaded_component_unloads_and_loads_again(
+    spawn: Callable[..., Proc], loader: Any, ros_context: Any
+) -> None:
+    """``mlaunch ctl unload``/``load``'s path: UnloadNode with the container's unique id, then
+    the same request again; an unload the container refuses carries its message."""
+    import threading
+
+    driver, lines = loader
+    spawn(standin("container", "--ros-args", "-r", "__node:=ubox"), "container")
+    rsp = LoadRequest(
+        "robot_state_publisher",
+        "robot_state_publisher::RobotStatePublisher",
+        "rsp",
+        parameters=(TypedParameter("robot_description", STRING, URDF),),
+    )
+    driver.start(LoadComponents("t", "/ubox", (rsp,)))
+    assert driver.join(30.0)
+    (component,) = driver.components
+    assert (component.state, component.name, component.unique_id) == ("loaded", "/rsp", 1)
+    done = threading.Event()
+    driver.unload(component, lambda _: done.set())
+    assert done.wait(30.0)
+    assert (component.state, component.error) == ("unloaded", "")
+    assert ("INFO", "Unloaded node '/rsp' from container '/ubox'") in lines
+    assert list_nodes(ros_context, "/ubox") == []
+    assert driver.reload(component).join(30.0) is None
+    assert (component.state, component.unique_id) == ("loaded", 2)
+    component.unique_id = 99  # a node the container does not have: it refuses, and says why
+    done.clear()
+    driver.unload(component, lambda _: done.set())
+    assert done.wait(30.0)
+    assert component.state == "loaded"
+    assert "99" in component.error, component.error
+    assert list_nodes(ros_context, "/ubox") == ["/rsp"]

@@ -14,18 +14,21 @@ container's loads wait for it to serve again. When the launch shuts down every w
 abandoned, one line per load never made, and the threads end before the run does. A load that
 raises ends the launch with status 1, as launch's run loop does with the exception.
 
-rclpy and composition_interfaces are imported only when a driver is made.
+The requests go over RTPS from this process itself where that is exactly what rclpy would do
+(Fast DDS at its defaults on every side: ``mlaunch.parts.rtps``), else through rclpy
+(``mlaunch.parts.loadnode_links``; ``MLAUNCH_LOADER=rclpy`` chooses it). rclpy and
+composition_interfaces are imported only for the second.
 """
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 from mlaunch.engine.part import Part
 from mlaunch.launch_ros.actions.node import same_name_warning
 from mlaunch.launch_ros.composition import LoadComponents
-from mlaunch.launch_ros.load_request import LoadRequest, to_message
+from mlaunch.launch_ros.load_request import LoadRequest
 from mlaunch.parts.discovery import Settling
 from mlaunch.plan.errors import EXIT_FAILURE, MlaunchError
 from mlaunch.plan.records import (
@@ -134,14 +137,15 @@ class ComponentLoader:
 
     def __init__(
         self,
-        context: Any,
+        link: Any,
         log: Log,
         finished: Callable[[threading.Thread], None] | None = None,
         loaded: Callable[[LoadComponents, str, LoadRequest], None] | None = None,
         failed: Callable[[LoadComponents], None] | None = None,
         refused: Callable[[LoadComponents, LoadResult], None] | None = None,
     ) -> None:
-        self.context = context  # an initialised rclpy Context
+        # how the requests reach the containers (mlaunch.parts.loadnode_links)
+        self.link = link
         self.log = log
         self.finished = finished
         # (step, the node's full name, the request) after each successful load
@@ -160,11 +164,6 @@ class ComponentLoader:
         # Every composable node the run asked for, in order; each step's, by its count.
         self.components: list[Component] = []
         self._entries: dict[int, list[Component]] = {}
-        # The node every client belongs to and its executor (made at the first load); held
-        # by whichever thread spins it, or makes or destroys a client.
-        self._shared: tuple[Any, Any] | None = None
-        self._spin_lock = threading.Lock()
-        self._closed = False
 
     def listed(self) -> list[dict[str, object]]:
         """Every composable node of the run and its state (any thread)."""
@@ -240,18 +239,15 @@ class ComponentLoader:
         """Send the step's requests in order, each once the container answered the one before.
 
         Once stopped, each request not sent (or not answered) is abandoned with its own line.
-        ``count`` numbers the step (its pending requests). Every step's client belongs to one
-        node (``_node``).
+        ``count`` numbers the step (its pending requests).
         """
-        from composition_interfaces.srv import LoadNode
-
         with self._lock:
             remaining = self._pending[count][1]
             entries = list(self._entries.get(count, []))
         results: list[LoadResult] = []
         client = None
         try:
-            client = self._client(LoadNode, step.service)
+            client = self.link.client(step.service, "LoadNode")
             for index, request in enumerate(step.requests):
                 result = None
                 if self._wait_for_service(client, step, request):
@@ -266,89 +262,18 @@ class ComponentLoader:
                         self.results.append(result)
         finally:
             if client is not None:
-                self._destroy_client(client)
+                self.link.destroy(client)
             self._settling.forget(id(client))  # the id may be reused by a later client
         return results
 
     def prepare(self) -> None:
-        """Make the shared node now, on the calling thread, with the launcher's lean
-        participant (mlaunch.parts.lean): only the thread that resolves and spawns may call it."""
-        from mlaunch.parts.lean import lean_participant
-
-        with lean_participant():
-            self._node()
-
-    def _node(self) -> Any:
-        """The one node every load and unload of the run goes through, and its executor.
-
-        Made at the first load: a node per step cost a few hundred kB and ~1.5 ms each (27 on
-        Autoware's planning_simulator). Hidden (a leading '_') and unique to this launcher, so
-        it never shows among the launched nodes.
-        """
-        with self._spin_lock:
-            if self._closed:
-                raise RuntimeError("the launch has ended")
-            if self._shared is None:
-                import os
-
-                from rclpy.executors import SingleThreadedExecutor
-                from rclpy.node import Node
-                from rclpy.parameter import Parameter
-
-                node = Node(
-                    f"_mlaunch_loader_{os.getpid()}",
-                    context=self.context,
-                    use_global_arguments=False,
-                    start_parameter_services=False,
-                    enable_rosout=False,
-                    # As the graph bridge's: no <fqn>/get_type_description among the services.
-                    parameter_overrides=[Parameter("start_type_description_service", value=False)],
-                )
-                executor = SingleThreadedExecutor(context=self.context)
-                executor.add_node(node)
-                self._shared = (node, executor)
-            return self._shared
-
-    def _client(self, kind: Any, service: str) -> Any:
-        """A client of the shared node (made while no thread spins its executor)."""
-        node, _ = self._node()
-        with self._spin_lock:
-            return node.create_client(kind, service)
-
-    def _destroy_client(self, client: Any) -> None:
-        with self._spin_lock:
-            if self._shared is not None:  # else closed: the node went with its clients
-                self._shared[0].destroy_client(client)
-
-    def _answer(self, future: Any, until: Callable[[], bool]) -> bool:
-        """Wait for ``future`` until it is done (True) or ``until()`` (False).
-
-        Whichever waiting thread finds the executor free spins it, for every client's answer;
-        the others wait for their own future's callback.
-        """
-        answered = threading.Event()
-        future.add_done_callback(lambda _: answered.set())
-        _, executor = self._node()
-        while not future.done():
-            if until():
-                return False
-            if self._spin_lock.acquire(blocking=False):
-                try:
-                    executor.spin_once(timeout_sec=POLL)
-                finally:
-                    self._spin_lock.release()
-            else:
-                answered.wait(POLL)
-        return True
+        """Make the link's participant now, on the calling thread (the run's: see
+        mlaunch.parts.lean)."""
+        self.link.prepare()
 
     def close(self) -> None:
-        """Destroy the shared node (the loads have ended)."""
-        with self._spin_lock:
-            shared, self._shared, self._closed = self._shared, None, True
-        if shared is not None:
-            node, executor = shared
-            executor.shutdown()
-            node.destroy_node()
+        """End the link (the loads have ended)."""
+        self.link.close()
 
     def unload(self, component: Component, done: Callable[[Component], None]) -> None:
         """Ask its container to unload ``component`` (a thread of its own); ``done(component)``
@@ -381,24 +306,24 @@ class ComponentLoader:
         """The container's UnloadNode answer: "" when it unloaded the node, else why not."""
         import time
 
-        from composition_interfaces.srv import UnloadNode
-
         service = f"{component.step.target}/_container/unload_node"
-        client = self._client(UnloadNode, service)
+        client = self.link.client(service, "UnloadNode")
         try:
             deadline = time.monotonic() + UNLOAD_TIMEOUT
-            while not client.service_is_ready():
+            while not self.link.ready(client):
                 if self._stopping() or time.monotonic() > deadline:
                     return f"the container does not serve {service}"
                 self.stop.wait(POLL)
-            future = client.call_async(UnloadNode.Request(unique_id=component.unique_id))
-            if not self._answer(future, lambda: self._stopping() or time.monotonic() > deadline):
-                future.cancel()
+            response = self.link.call(
+                client,
+                component.unique_id,
+                lambda: self._stopping() or time.monotonic() > deadline,
+            )
+            if response is None:
                 return f"no answer from {service} in {UNLOAD_TIMEOUT:.0f} s"
-            response = future.result()
             return "" if response.success else (response.error_message or "refused")
         finally:
-            self._destroy_client(client)
+            self.link.destroy(client)
 
     def reload(self, component: Component) -> threading.Thread:
         """Load ``component`` into its container again (an unloaded or failed one)."""
@@ -421,12 +346,12 @@ class ComponentLoader:
                     component.state = "gone"
 
     def _stopping(self) -> bool:
-        return self.stop.is_set() or not self.context.ok()
+        return self.stop.is_set() or not self.link.ok()
 
     def _wait_for_service(self, client: Any, step: LoadComponents, request: LoadRequest) -> bool:
         """Wait until the container serves load_node; False (said) once the launch stops."""
         while not self._stopping():
-            if client.service_is_ready():
+            if self.link.ready(client):
                 if self._settled(client):
                     return True
                 continue
@@ -443,7 +368,10 @@ class ComponentLoader:
         """True once ``client`` has seen its service long enough (mlaunch.parts.discovery).
 
         Waits out what is left (a stop ends the wait at once); later requests go at once.
+        A link that knows the container matched the client does not settle.
         """
+        if not self.link.settles:
+            return True
         left = self._settling.left(id(client))
         if left > 0:
             self.stop.wait(left)
@@ -451,16 +379,14 @@ class ComponentLoader:
         return True
 
     def _call(self, client: Any, request: LoadRequest, step: LoadComponents) -> LoadResult | None:
-        future = client.call_async(to_message(request))
-        if not self._answer(future, self._stopping):
+        response = self.link.call(client, request, self._stopping)
+        if response is None:
             self.log(
                 "WARNING",
                 f"Abandoning wait for the '{step.service}' service response, due to"
                 f" shutdown: {describe_load(request)} may not have been loaded",
             )
-            future.cancel()
             return None
-        response = future.result()
         name = response.full_node_name or request.node_name
         if response.success:
             if self.loaded is not None and name:
@@ -485,6 +411,28 @@ class ComponentLoader:
         if not response.success and self.refused is not None:
             self.refused(step, result)
         return result
+
+
+def make_link(environ: Mapping[str, str], processes: list[dict[str, str]], domain: int) -> Any:
+    """The RTPS link where it does exactly what rclpy would (mlaunch.parts.rtps.unusable),
+    else rclpy's; ``environ`` is the launcher's, ``processes`` the launched processes'."""
+    from mlaunch.parts.rtps import discovery_range, unusable
+
+    if not unusable(environ, processes):
+        from mlaunch.parts.loadnode_links import RtpsLink
+
+        return RtpsLink(domain, discovery_range(environ) or "SUBNET")
+    try:
+        import composition_interfaces.srv  # noqa: F401  (the loads need it, say so now)
+
+        from mlaunch.parts.loadnode_links import rclpy_link
+
+        return rclpy_link(domain)
+    except ImportError as e:
+        raise MlaunchError(
+            f"composable nodes are loaded with rclpy and composition_interfaces ({e}):"
+            " run ./scripts/setup, or source a ROS 2 installation"
+        ) from e
 
 
 def _note(component: Component, result: LoadResult) -> None:
@@ -515,26 +463,16 @@ class ComponentDriver(Part):
         from mlaunch.parts.graph_types import domain_id_from
         from mlaunch.parts.handoff import LoopCall
 
-        try:
-            import composition_interfaces.srv  # noqa: F401  (the loads need it, say so now)
-            from rclpy.context import Context
-        except ImportError as e:
-            raise MlaunchError(
-                f"composable nodes are loaded with rclpy and composition_interfaces ({e}):"
-                " run ./scripts/setup, or source a ROS 2 installation"
-            ) from e
         self.supervisor = supervisor
         self.loop = LoopCall(supervisor.selector)
-        from mlaunch.parts.lean import limit_arenas
-
-        limit_arenas()  # before rclpy's threads: they share two arenas (mlaunch.parts.lean)
-        environ = next((dict(s.env) for s in supervisor.plan.processes()), dict(os.environ))
-        context = Context()
-        context.init([], initialize_logging=False, domain_id=domain_id_from(environ))
+        processes = [dict(s.env) for s in supervisor.plan.processes()]
+        environ = processes[0] if processes else dict(os.environ)
+        domain = domain_id_from(environ)
+        link = make_link(os.environ, processes, domain)
         self.loader = ComponentLoader(
-            context, self._log, self._finished, self._loaded, self._failed, self._refused
+            link, self._log, self._finished, self._loaded, self._failed, self._refused
         )
-        # The participant and the loader node, here on the run's thread (the lean
+        # The participant (and rclpy's loader node), here on the run's thread (the lean
         # participant's setting is in os.environ while it is made; no one spawns meanwhile).
         self.loader.prepare()
         # Who waits for a load thread to end (a ``load`` asked through runtime control).
@@ -673,5 +611,4 @@ class ComponentDriver(Part):
         self.loop.run_pending()  # the loop is over: the abandoned loads' lines are said here
         self.supervisor.records.unsubscribe(self.on_record)
         self.loader.close()
-        self.loader.context.try_shutdown()
         self.loop.close()
