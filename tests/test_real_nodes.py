@@ -125,6 +125,84 @@ def test_composable_nodes_load_into_the_real_container(
     assert "not installed" not in run.text, run.text[-3000:]
 
 
+TYPED = """
+from launch import LaunchDescription
+from launch_ros.actions import LoadComposableNodes, Node
+from launch_ros.descriptions import ComposableNode
+
+
+def generate_launch_description():
+    talker = 'composition::Talker'
+    return LaunchDescription([
+        Node(package='rclcpp_components', executable='component_container', name='cbox'),
+        LoadComposableNodes(target_container='/cbox', composable_node_descriptions=[
+            ComposableNode(package='composition', plugin=talker, name='typed',
+                           parameters=[{'use_sim_time': True, 'n': 3, 'xs': [1.5, 2.0]}],
+                           extra_arguments=[{'use_intra_process_comms': True}]),
+            ComposableNode(package='composition', plugin=talker, name='badly_typed',
+                           extra_arguments=[{'use_intra_process_comms': 'yes'}]),
+            ComposableNode(package='composition', plugin='composition::Nope', name='nope'),
+        ]),
+    ])
+"""
+
+
+@pytest.mark.parametrize("loader", ["", "rclpy"])
+def test_the_real_container_gets_typed_values_and_says_why_it_refuses(
+    loader: str, ros_env: dict[str, str], tmp_path: Path
+) -> None:
+    """rclcpp's own component manager reads the request: a bool parameter arrives as a bool
+    (the node's use_sim_time), a string where it reads a bool is refused with rclcpp's message,
+    an unknown plugin with its loader's; the same over RTPS (the default) and rclpy."""
+    env = env_for(ros_env, tmp_path, real=True)
+    if loader:
+        env["MLAUNCH_LOADER"] = loader
+    path = tmp_path / "typed.launch.py"
+    path.write_text(TYPED)
+    run = Running(mlaunch(str(path)), env=env, cwd=str(tmp_path))
+    try:
+        run.wait_for(r"Loaded node '/typed' in container '/cbox'", timeout=60)
+        run.wait_for(
+            r"Failed to load node 'badly_typed' of type 'composition::Talker' in container"
+            r" '/cbox': Extra component argument 'use_intra_process_comms' must be a boolean",
+            timeout=30,
+        )
+        run.wait_for(
+            r"Failed to load node 'nope' of type 'composition::Nope' in container '/cbox':"
+            r" Failed to find class with the requested plugin name",
+            timeout=30,
+        )
+        assert parameter_of("/typed", "use_sim_time", ros_env) == (1, True)  # BOOL
+        run.signal(signal.SIGINT)
+        assert run.finish(timeout=20) == 130, run.text[-3000:]
+    finally:
+        run.kill()
+
+
+def parameter_of(node: str, name: str, ros_env: dict[str, str]) -> tuple[int, Any]:
+    """(type, value) of a node's parameter, through its get_parameters service."""
+    import rclpy
+    from rcl_interfaces.srv import GetParameters
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    try:
+        probe = Node("param_probe", context=context)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(probe)
+        client = probe.create_client(GetParameters, f"{node}/get_parameters")
+        assert client.wait_for_service(timeout_sec=20.0)
+        future = client.call_async(GetParameters.Request(names=[name]))
+        executor.spin_until_future_complete(future, timeout_sec=20.0)
+        (value,) = future.result().values
+        executor.shutdown()
+        return value.type, value.bool_value
+    finally:
+        context.try_shutdown()
+
+
 def test_mlaunch_test_on_the_real_container(ros_env: dict[str, str], tmp_path: Path) -> None:
     """`mlaunch test`: the components are in the graph and /chatter flows; the composed jtbot
     (robot_state_publisher's component in the real container) is ready too."""
