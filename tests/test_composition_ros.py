@@ -422,3 +422,35 @@ def test_a_loaded_component_unloads_and_loads_again(
     assert component.state == "loaded"
     assert "99" in component.error, component.error
     assert list_nodes(ros_context, "/ubox") == ["/rsp"]
+
+
+def test_over_rtps_in_the_subnet_range(
+    ros_env: dict[str, str], spawn: Callable[..., Proc], tmp_path: Path
+) -> None:
+    """ROS 2's default range (SUBNET): discovery by multicast, the domain's own group port;
+    the container then answers as on localhost."""
+    from mlaunch.parts.components import ComponentLoader
+    from mlaunch.parts.loadnode_links import RtpsLink
+
+    ros_env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "SUBNET"  # the container's environment
+    container = spawn(
+        [sys.executable, RECORDER, "--fail", "p::Bad", "--ros-args", "-r", "__node:=sbox"], "rec"
+    )
+    lines: list[tuple[str, str]] = []
+    driver = ComponentLoader(
+        RtpsLink(int(ros_env["ROS_DOMAIN_ID"]), "SUBNET"), lambda *line: lines.append(line)
+    )
+    try:
+        good = LoadRequest("p", "p::Good", "good", parameters=(TypedParameter("n", INTEGER, 3),))
+        driver.start(LoadComponents("t", "/sbox", (good, LoadRequest("p", "p::Bad", "bad"))))
+        assert driver.join(30.0), stalled(container, lines)
+        assert [(r.success, r.full_node_name) for r in driver.results] == [
+            (True, "/good"),
+            (False, ""),
+        ]
+        assert driver.results[1].error_message == "refused by the recording container"
+        assert json.loads(container.stdout().splitlines()[0]) == as_lists(good)
+    finally:
+        driver.stop.set()
+        driver.join(5.0)
+        driver.close()

@@ -9,10 +9,11 @@ needs, over UDPv4, as ROS 2 Jazzy's rmw_fastrtps (Fast DDS 2.14) expects it:
   participant the moment it is found; announcements are received and kept while their lease
   lasts. Where they go is what rmw_fastrtps sets up for the discovery range: SUBNET (the
   default, and SYSTEM_DEFAULT) multicast 239.255.0.1 at port 7400 + 250 * domain, received on a
-  shared socket of that port too; LOCALHOST the unicast discovery ports of participant ids 0 to
-  31 on 127.0.0.1 (7410 + 250 * domain + 2 * id: Fast DDS's initial peers with rmw_fastrtps's
-  maxInitialPeersRange), no multicast. This participant takes the first free of those ports, so
-  theirs reach it too.
+  shared socket of that port too (and, in case this host routes no multicast, the unicast
+  discovery ports of ids 0 to 3 on 127.0.0.1: Fast DDS's default initial peers); LOCALHOST the
+  unicast discovery ports of participant ids 0 to 31 on 127.0.0.1 (7410 + 250 * domain + 2 * id:
+  Fast DDS's initial peers with rmw_fastrtps's maxInitialPeersRange), no multicast. This
+  participant takes the first free of those ports, so theirs reach it too.
 - **Endpoint discovery (SEDP)**: the reliable builtin publications and subscriptions writers
   (every announcement kept, sent to each participant found) and readers (ACKNACK on HEARTBEAT).
   Announcements that do not name a container's service are acknowledged and not parsed.
@@ -59,6 +60,7 @@ VENDOR = b"\x01\xff"
 PB, DG, PG, D0, D1 = 7400, 250, 2, 0, 10  # the RTPS port mapping's defaults
 MULTICAST = "239.255.0.1"
 LOCALHOST_PEERS = 32  # rmw_fastrtps's maxInitialPeersRange for LOCALHOST
+SUBNET_LOCAL_PEERS = 4  # Fast DDS's default maxInitialPeersRange
 MAX_PARTICIPANT_ID = 120
 LEASE = 20.0  # this participant's lease duration, as Fast DDS's default
 ANNOUNCE = 3.0  # the period of its announcements (Fast DDS's)
@@ -463,15 +465,17 @@ class Participant:
                 pass  # a peer gone, a full buffer: reliability sends again
 
     def _peers(self) -> list[tuple[str, int]]:
-        """Where this participant's periodic announcement goes."""
-        if self.scope == "SUBNET":
-            return [(MULTICAST, PB + DG * self.domain + D0)]
+        """Where this participant's periodic announcement goes: LOCALHOST, the discovery ports
+        of participant ids 0 to 31 on this host; SUBNET, the multicast group, and (should this
+        host not route multicast) the ports of Fast DDS's default initial peers, ids 0 to 3."""
         base = PB + DG * self.domain + D1
-        return [
-            ("127.0.0.1", base + PG * pid)
-            for pid in range(LOCALHOST_PEERS)
-            if base + PG * pid != self.port
+        count = LOCALHOST_PEERS if self.scope == "LOCALHOST" else SUBNET_LOCAL_PEERS
+        local = [
+            ("127.0.0.1", base + PG * pid) for pid in range(count) if base + PG * pid != self.port
         ]
+        if self.scope == "SUBNET":
+            return [(MULTICAST, PB + DG * self.domain + D0), *local]
+        return local
 
     # --- messages ---
 
