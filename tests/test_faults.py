@@ -323,7 +323,7 @@ def test_a_stdout_nobody_reads_never_blocks_the_children(tmp_path: Path) -> None
 PROBE = """
 import sys
 from mlaunch.engine import spawning
-heavy = ("rich", "psutil", "ctypes")
+heavy = ("rich", "psutil", "ctypes", "subprocess")
 first = []
 original = spawning.start
 def spy(*args, **kwargs):
