@@ -1406,6 +1406,40 @@ class Bench:
                 self.results.rows.append(
                     Row("profile", f"{what}: {bucket}", venv.name, "s", samples, note="CPU")
                 )
+        self.spawn_cost(venv)
+
+    def spawn_cost(self, venv: Venv) -> None:
+        """The launcher's CPU to start one child (benchmarks/spawn_cost.py): engine.spawning,
+        and os.posix_spawn for reference, beside Popen (the floor's way), with 0 and 300 other
+        fds open."""
+        argv = [str(venv.python), str(HERE / "spawn_cost.py"), "--json"]
+        argv += ["--rounds", str(self.config.runs)]
+        done = subprocess.run(
+            argv, env=self.floor_env(venv), capture_output=True, text=True, timeout=300
+        )
+        if done.returncode != 0:
+            self.results.skip("profile", venv.name, "a child's start", one_line(done.stderr))
+            return
+        found = json.loads(done.stdout)
+        popen = found.pop("popen")
+        for way, by_fds in found.items():
+            for fds, samples in by_fds.items():
+                name = f"a child's start, {way}, {fds} other fds open"
+                note = "CPU" if way == "spawning" else "CPU; closes no inheritable fd (< 3.13)"
+                self.results.rows.append(
+                    Row(
+                        "profile",
+                        name,
+                        venv.name,
+                        "s",
+                        samples,
+                        "Popen(close_fds=True)",
+                        popen[fds],
+                        None,
+                        {"fds": int(fds)},
+                        note=note,
+                    )
+                )
 
     # --- import time ---------------------------------------------------------------------------
 

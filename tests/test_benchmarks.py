@@ -321,6 +321,8 @@ def test_quick_run(tmp_path: Path, ros_env: dict[str, str]) -> None:
     assert "first child running, py, N=1" in names
     assert "SIGINT until all gone, N=10" in names
     assert "--show-args one-process launch, py" in names
+    # The launcher's CPU to start one child, beside Popen's (benchmarks/spawn_cost.py).
+    assert "a child's start, spawning, 300 other fds open" in names
     assert any(row["unit"] == "lines/s" and row["floor"]["name"] == "cat" for row in rows)
     for skip in skipped:
         assert skip["reason"] and "\n" not in skip["reason"]
