@@ -911,3 +911,35 @@ def test_only_fds_0_to_2_reach_a_child(kind: type[Process]) -> None:
     finally:
         os.close(leaky_r)
         os.close(leaky_w)
+
+
+@KINDS
+def test_a_start_that_runs_out_of_fds_raises_the_limit_and_tries_once_more(
+    kind: type[Process], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """EMFILE at a start (a handler's process in a run whose plan fit): the run's soft limit is
+    raised and the start tried again; the child gets the user's own limit back."""
+    from mlaunch.engine import fdlimit
+
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    users = min(soft, 1024)  # the user's own limit in this test: room above it to raise
+    attempts: list[int] = []
+
+    class Starved(kind):  # type: ignore[valid-type,misc]
+        def spawn(self, *args: object, **kwargs: object) -> None:
+            if not attempts:  # the first start finds one descriptor free: no pipe fits
+                resource.setrlimit(resource.RLIMIT_NOFILE, (len(os.listdir("/proc/self/fd")), hard))
+            attempts.append(resource.getrlimit(resource.RLIMIT_NOFILE)[0])
+            super().spawn(*args, **kwargs)  # type: ignore[arg-type]
+
+    code = "import resource; print(resource.getrlimit(resource.RLIMIT_NOFILE)[0])"
+    try:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (users, hard))
+        monkeypatch.setattr(fdlimit, "LIMIT", fdlimit.Limit())  # the run's, from the user's
+        h = Harness([make_spec("kid", code)], spawner=Starved)
+        assert h.run() == 0
+    finally:
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+    assert len(attempts) == 2 and attempts[1] > attempts[0], attempts
+    assert output(h, "kid") == [str(users)]  # the user's own, not the raised one
+    assert "Too many open files" not in h.text
