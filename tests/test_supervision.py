@@ -943,3 +943,28 @@ def test_a_start_that_runs_out_of_fds_raises_the_limit_and_tries_once_more(
     assert len(attempts) == 2 and attempts[1] > attempts[0], attempts
     assert output(h, "kid") == [str(users)]  # the user's own, not the raised one
     assert "Too many open files" not in h.text
+
+
+@KINDS
+def test_a_value_no_exec_can_take_fails_that_start_only_and_names_the_value(
+    kind: type[Process],
+) -> None:
+    """A NUL byte in an argument or the environment, or "=" in a variable's name (both crashed
+    the run with "internal error: ValueError"), is that process's failure to start."""
+    nul_arg = make_spec("nul-arg", "", argv=("echo", "a\0b"))
+    nul_env = make_spec("nul-env", "print('x')")
+    nul_env.env = {**nul_env.env, "BAD": "x\0y"}
+    eq_name = make_spec("eq-name", "print('x')")
+    eq_name.env = {**eq_name.env, "A=B": "1"}
+    h = Harness([nul_arg, nul_env, eq_name, make_spec("fine", "print('fine')")], spawner=kind)
+    failed: dict[str, str] = {}
+    h.sup.records.subscribe(
+        lambda r: failed.update({r.process.label: r.reason}) if isinstance(r, FailedToStart) else 0
+    )
+    assert h.run() == 0
+    assert failed == {
+        "nul-arg": "argument 1 'a\\x00b' holds a NUL byte, which no program argument can",
+        "nul-env": "environment variable BAD is 'x\\x00y': a NUL byte, which no value can hold",
+        "eq-name": "environment variable name 'A=B' holds '=' or a NUL byte, which no name can",
+    }
+    assert "[fine] fine" in h.text and "internal error" not in h.text

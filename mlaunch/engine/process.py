@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 from mlaunch.engine import spawning
 
@@ -161,6 +162,23 @@ def _ptys() -> tuple[tuple[int, int], tuple[int, int]]:
     return pairs[0], pairs[1]
 
 
+def unstartable(argv: Sequence[str], env: Mapping[str, str], cwd: str | None) -> str | None:
+    """Why no exec can take these values (a NUL byte ends a C string; "=" ends a variable's
+    name), naming the first bad one; None when none is."""
+    for i, arg in enumerate(argv):
+        if "\0" in arg:
+            what = "the program's name" if i == 0 else f"argument {i}"
+            return f"{what} {arg!r} holds a NUL byte, which no program argument can"
+    for name, value in env.items():
+        if "=" in name or "\0" in name:
+            return f"environment variable name {name!r} holds '=' or a NUL byte, which no name can"
+        if "\0" in value:
+            return f"environment variable {name} is {value!r}: a NUL byte, which no value can hold"
+    if cwd is not None and "\0" in cwd:
+        return f"the working directory {cwd!r} holds a NUL byte, which no path can"
+    return None
+
+
 class Stream:
     """One pipe from a child: its fd and the partial line not yet complete."""
 
@@ -279,18 +297,21 @@ class Process:
             stdin_read, stdin_write = os.pipe()
             made += (stdin_read, stdin_write)
             out, err = outputs[0][1], outputs[1][1]
-            if self.direct:
-                self.pid = spawning.start(
-                    argv,
-                    spawning.environment(env),
-                    stdin=stdin_read,
-                    stdout=out,
-                    stderr=err,
-                    cwd=spec.cwd,
-                    child_setup=setup,
-                )
-            else:
-                self._popen(argv, env, stdin_read, out, err, setup)
+            try:
+                if self.direct:
+                    self.pid = spawning.start(
+                        argv,
+                        spawning.environment(env),
+                        stdin=stdin_read,
+                        stdout=out,
+                        stderr=err,
+                        cwd=spec.cwd,
+                        child_setup=setup,
+                    )
+                else:
+                    self._popen(argv, env, stdin_read, out, err, setup)
+            except ValueError as e:  # a value no exec can take: this child fails to start
+                raise OSError(errno.EINVAL, unstartable(argv, env, spec.cwd) or str(e)) from e
         except BaseException:
             for fd in made:
                 os.close(fd)
