@@ -40,6 +40,7 @@ import probes as pr
 from probes import BenchError
 
 POLL_S = 0.05
+RCLPY = ", loads through rclpy (MLAUNCH_LOADER=rclpy)"  # the variant of the launcher before
 UP_TIMEOUT_S = 300.0  # ros2 launch takes ~15 s to resolve the tree on a quiet 2-core machine
 STOP_TIMEOUT_S = 60.0
 
@@ -370,6 +371,17 @@ PARTS = {
         "n.create_client(s.LoadNode, '/bench/_container/load_node')\n"
         "n.destroy_node(); rclpy.shutdown()"
     ),
+    # What the launcher's loads cost now (mlaunch.parts.rtps): no rclpy at all.
+    "RTPS: a participant with a LoadNode client (mlaunch's default, no rclpy)": (
+        "import os, time\n"
+        "from mlaunch.parts.loadnode_links import RtpsLink\n"
+        "from mlaunch.parts.rtps import discovery_range\n"
+        "link = RtpsLink(int(os.environ.get('ROS_DOMAIN_ID') or 0),"
+        " discovery_range(os.environ) or 'SUBNET')\n"
+        "link.prepare(); link.client('/bench/_container/load_node', 'LoadNode')\n"
+        "time.sleep(0.5)\n"  # its first announcements and what answers them
+        "link.close()"
+    ),
 }
 
 
@@ -408,10 +420,12 @@ def measure(
     if ros2 is None:
         return "the reference environment has no ros2 command"
     launch = [str(tree.launch_file), *tree.arguments]
-    # mlaunch twice a run: as a user starts it (the plan cache on: from run 1 on, the plan
-    # the warm-up stored) and resolving the files again (--no-cache).
+    # mlaunch three times a run: as a user starts it (the plan cache on: from run 1 on, the
+    # plan the warm-up stored), resolving the files again (--no-cache), and with the loads
+    # through rclpy as before the RTPS client (MLAUNCH_LOADER=rclpy, the plan cache on).
     cold = {**ours, "MLAUNCH_NO_CACHE": "1"}
-    ml: dict[str, list[Sample]] = {"": [], ", --no-cache": []}
+    through_rclpy = {**ours, "MLAUNCH_LOADER": "rclpy"}
+    ml: dict[str, list[Sample]] = {"": [], ", --no-cache": [], RCLPY: []}
     ref: list[Sample] = []
     for i in range(runs + 1):
         say(f"autoware: run {i} of {runs} (0 is the warm-up): ros2 launch ...")
@@ -419,10 +433,12 @@ def measure(
         say(f"autoware: run {i}: mlaunch, mlaunch --no-cache ...")
         warm = start_tree([str(mlaunch), *launch], ours, tree, tmp, tmp / "mlaunch.out")
         fresh = start_tree([str(mlaunch), *launch], cold, tree, tmp, tmp / "mlaunch.out")
+        old = start_tree([str(mlaunch), *launch], through_rclpy, tree, tmp, tmp / "mlaunch.out")
         if i:
             ref.append(one_ref)
             ml[""].append(warm)
             ml[", --no-cache"].append(fresh)
+            ml[RCLPY].append(old)
     figures = [
         Figure(
             "planning_simulator: 55 processes and 53 components up",
@@ -432,14 +448,17 @@ def measure(
         )
     ]
     for variant, samples in ml.items():
-        figures += tree_figures(variant, samples, ref)
+        figures += tree_figures(variant, samples, ref, targets=variant != RCLPY)
     figures += print_figures(runs, mlaunch, python, launch, ours)
     figures += part_figures(runs, python, mlaunch, launch, ours)
     return figures
 
 
-def tree_figures(variant: str, ml: Sequence[Sample], ref: Sequence[Sample]) -> list[Figure]:
-    """The launcher's CPU and memory (with their ratios to ros2 launch's) and Ctrl-C."""
+def tree_figures(
+    variant: str, ml: Sequence[Sample], ref: Sequence[Sample], targets: bool = True
+) -> list[Figure]:
+    """The launcher's CPU and memory (with their ratios to ros2 launch's) and Ctrl-C; the
+    issue's targets on the ratios unless ``targets`` is False (a comparison, not a goal)."""
 
     def both(name: str, attr: str, unit: str, note: str = "") -> Figure:
         return Figure(
@@ -453,7 +472,12 @@ def tree_figures(variant: str, ml: Sequence[Sample], ref: Sequence[Sample]) -> l
     def ratio(name: str, attr: str, target: float) -> Figure:
         pairs = zip(ml, ref, strict=True)
         values = [getattr(m, attr) / getattr(r, attr) for m, r in pairs]
-        return Figure(name + variant + ", mlaunch / ros2 launch", "x", values, target=target)
+        return Figure(
+            name + variant + ", mlaunch / ros2 launch",
+            "x",
+            values,
+            target=target if targets else None,
+        )
 
     return [
         both("launcher CPU until all up", "cpu", "s"),
