@@ -371,3 +371,73 @@ def test_close_ends_the_thread_and_the_sockets(ros_env: dict[str, str]) -> None:
     assert made.unicast.fileno() == -1
     assert made.multicast is not None and made.multicast.fileno() == -1
     made.close()  # twice is no error
+
+
+# --- a container that never answers, one that leaves ----------------------------------------
+
+
+def _mute_container(domain: int, target: str) -> rtps.Participant:
+    """A participant that serves ``target``'s load_node as far as discovery goes (its request
+    reader and reply writer, announced and acknowledging) and never answers a request."""
+    container = rtps.Participant(domain, "LOCALHOST", "mute")
+    service = f"{target}/_container/load_node"
+    kind = rtps.Client(service, "LoadNode", 1, container.prefix)
+    with container.lock:
+        container.endpoint(
+            b"\x00\x00\x07\x04", rtps.request_topic(service), kind.request_type, False
+        )
+        container.endpoint(b"\x00\x00\x08\x03", rtps.reply_topic(service), kind.reply_type, True)
+    return container
+
+
+def test_a_container_that_never_answers_is_abandoned_at_shutdown(
+    ros_env: dict[str, str],
+) -> None:
+    from procutil import wait_until
+
+    from mlaunch.launch_ros.composition import LoadComponents
+    from mlaunch.parts.components import ComponentLoader
+    from mlaunch.parts.loadnode_links import RtpsLink
+
+    domain = int(ros_env["ROS_DOMAIN_ID"])
+    mute = _mute_container(domain, "/mute")
+    lines: list[tuple[str, str]] = []
+    link = RtpsLink(domain, "LOCALHOST")
+    driver = ComponentLoader(link, lambda *line: lines.append(line))
+    try:
+        driver.start(LoadComponents("t", "/mute", (LoadRequest("p", "p::A", "a"),)))
+        participant = link._made()
+        client = participant.clients["LoadNode /mute/_container/load_node"]
+        # the request went out: the client waits for the answer
+        assert wait_until(lambda: client.sn == 1 and bool(client.waiting), 20), lines
+        assert not driver.join(0.5)
+        driver.stop.set()
+        assert driver.join(5.0)
+    finally:
+        driver.close()
+        mute.close()
+    assert lines == [
+        (
+            "WARNING",
+            "Abandoning wait for the '/mute/_container/load_node' service response, due to"
+            " shutdown: node 'a' of type 'p::A' may not have been loaded",
+        )
+    ]
+    assert not [t for t in threading.enumerate() if t.name == "rtps" and t.is_alive()]
+
+
+def test_a_container_that_leaves_is_no_longer_ready(ros_env: dict[str, str]) -> None:
+    from procutil import wait_until
+
+    domain = int(ros_env["ROS_DOMAIN_ID"])
+    mute = _mute_container(domain, "/gone")
+    participant = rtps.Participant(domain, "LOCALHOST")
+    try:
+        client = participant.client("/gone/_container/load_node", "LoadNode")
+        assert wait_until(lambda: participant.ready(client), 20)
+        mute.close()  # says it leaves
+        assert wait_until(lambda: not participant.ready(client), 10)
+        assert mute.prefix not in participant.remotes
+    finally:
+        participant.close()
+        mute.close()
