@@ -1386,18 +1386,22 @@ class Bench:
 
     def profile(self, venv: Venv) -> None:
         """mlaunch's CPU until its first child, bucket by bucket (benchmarks/startup_profile.py),
-        for a one-process and a one-Node launch whose child is ``true``."""
+        for a one-process and a one-Node launch whose child is ``true``, and until the 100th of a
+        100-process launch; then the launcher's CPU to start one child (``spawn_cost``)."""
         true = shutil.which("true") or "/bin/true"
         one = gen.write([gen.many_children("true1", 1, [true])], "py", self.launches / "true1")
         node, prefix = gen.write_node_launch(self.launches / "node_true", Path(true), self.fifo)
+        many = gen.write([gen.many_children("true100", 100, [true])], "py", self.launches / "t100")
         cases = (
-            ("one-process launch", one, self.env),
-            ("one-Node launch", node, {**self.env, "AMENT_PREFIX_PATH": str(prefix)}),
+            ("one-process launch", one, self.env, 1),
+            ("one-Node launch", node, {**self.env, "AMENT_PREFIX_PATH": str(prefix)}, 1),
+            # Until the 100th start: resolving 100 processes, then starting them.
+            ("100-process launch", many, self.env, 100),
         )
-        for what, path, env in cases:
+        for what, path, env, children in cases:
             try:
                 found = startup_profile.profile(
-                    [str(venv.mlaunch), str(path)], env, self.config.runs
+                    [str(venv.mlaunch), str(path)], env, self.config.runs, children=children
                 )
             except (RuntimeError, subprocess.TimeoutExpired) as e:
                 self.results.skip("profile", venv.name, what, str(e))

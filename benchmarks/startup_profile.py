@@ -1,6 +1,7 @@
 """Where mlaunch's CPU goes on its way to the first child, bucket by bucket.
 
-    .venv/bin/python benchmarks/startup_profile.py [--runs N] [--tree DIR] -- MLAUNCH [ARGS...]
+    .venv/bin/python benchmarks/startup_profile.py [--runs N] [--tree DIR] [--children N]
+                                                   -- MLAUNCH [ARGS...]
 
 Runs the command as given (the mlaunch command of the venv, with its shell script and without
 the ROS wheels' re-exec, or pip's console script, or ``python -m mlaunch``) N times with a
@@ -9,7 +10,8 @@ revisions in one run). ``site`` imports it after the ``.pth`` files, so it runs 
 that goes on to run mlaunch (the hook's re-exec, where there is one, happened before). It takes
 the process's CPU time (``CLOCK_PROCESS_CPUTIME_ID``: everything since the fork, the shell
 script and the re-exec included) at each step and writes them to a file when the supervisor's
-first ``start`` returns; mlaunch then runs on (the launch's child should end by itself: ``true``).
+first ``start`` returns (``--children N``: the N-th, the spawns after the first one bucket); mlaunch
+then runs on (the launch's children should end by themselves: ``true``).
 
 Prints the buckets (CPU, min and median over the runs) and, with ``--json``, writes them. The
 bucket names are the steps of ``mlaunch.app.pipeline.launch``; a step the revision does not have
@@ -33,6 +35,7 @@ from pathlib import Path
 SITECUSTOMIZE = r"""
 import os, sys, time
 _out = os.environ.pop("MLAUNCH_STARTUP_PROFILE", "")
+_children = int(os.environ.pop("MLAUNCH_STARTUP_PROFILE_CHILDREN", "1"))
 if _out:  # popped: the Python programs mlaunch starts are not profiled
     _marks = [("interpreter and site (from exec)", time.process_time())]
 
@@ -71,10 +74,19 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
             import mlaunch.engine.supervisor as sup
             start = sup.Supervisor.start
 
+            count = [0]
+
             def started(self, *a, **k):
-                _mark("supervisor: imports, set-up, parts")
+                count[0] += 1
+                if count[0] == 1:
+                    _mark("supervisor: imports, set-up, parts")
                 result = start(self, *a, **k)
-                _mark("spawn of the first child")
+                if count[0] == 1:
+                    _mark("spawn of the first child")
+                if count[0] < _children:
+                    return result
+                if _children > 1:
+                    _mark(f"spawns of children 2 to {_children}")
                 sup.Supervisor.start = start
                 text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
                 with open(_out + ".tmp", "w") as f:
@@ -91,7 +103,7 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
 """
 
 
-def buckets(marks: list[tuple[str, float]]) -> dict[str, float]:
+def buckets(marks: list[tuple[str, float]], children: int = 1) -> dict[str, float]:
     """CPU seconds per step: the first mark itself, then the differences; the time between a
     step's end and the next step's start is its own bucket ("before X": the code in between)."""
     out: dict[str, float] = {}
@@ -99,14 +111,20 @@ def buckets(marks: list[tuple[str, float]]) -> dict[str, float]:
     for name, cpu in marks:
         out[name] = out.get(name, 0.0) + cpu - previous
         previous = cpu
-    out["total until the first child runs"] = previous
+    total = "total until the first child runs" if children == 1 else f"total to {children} started"
+    out[total] = previous
     return out
 
 
 def profile(
-    argv: Sequence[str], env: dict[str, str], runs: int, tree: str | None = None
+    argv: Sequence[str],
+    env: dict[str, str],
+    runs: int,
+    tree: str | None = None,
+    children: int = 1,
 ) -> dict[str, list[float]]:
-    """Run ``argv`` ``runs`` times (plus a warm-up); each bucket's CPU seconds per run."""
+    """Run ``argv`` ``runs`` times (plus a warm-up); each bucket's CPU seconds per run, until
+    the first child was started, or the ``children``-th."""
     found: dict[str, list[float]] = {}
     with tempfile.TemporaryDirectory(prefix="mlaunch-profile-") as tmp:
         site = Path(tmp) / "site"
@@ -117,6 +135,7 @@ def profile(
             out = Path(tmp) / f"marks-{i}.txt"
             run_env = {**env, "PYTHONPATH": os.pathsep.join(paths)}
             run_env["MLAUNCH_STARTUP_PROFILE"] = str(out)
+            run_env["MLAUNCH_STARTUP_PROFILE_CHILDREN"] = str(children)
             done = subprocess.run(
                 list(argv), env=run_env, capture_output=True, text=True, timeout=120
             )
@@ -131,7 +150,7 @@ def profile(
             for line in out.read_text().splitlines():
                 name, _, cpu = line.rpartition("\t")
                 marks.append((name, float(cpu)))
-            for name, value in buckets(marks).items():
+            for name, value in buckets(marks, children).items():
                 found.setdefault(name, []).append(value)
     return found
 
@@ -150,6 +169,12 @@ def main(args: Sequence[str] | None = None) -> int:
     parser.add_argument("--runs", type=int, default=9)
     parser.add_argument("--tree", help="a checkout of mlaunch to run instead (put on PYTHONPATH)")
     parser.add_argument("--json", help="write the buckets' samples here")
+    parser.add_argument(
+        "--children",
+        type=int,
+        default=1,
+        help="profile until the N-th child was started (the launch's first N), not the first",
+    )
     parser.add_argument("command", nargs=argparse.REMAINDER)
     opts = parser.parse_args(args)
     command = [c for c in opts.command if c != "--"] if opts.command[:1] == ["--"] else opts.command
@@ -161,7 +186,7 @@ def main(args: Sequence[str] | None = None) -> int:
         for k, v in os.environ.items()
         if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONUNBUFFERED")
     }
-    found = profile(command, env, opts.runs, opts.tree)
+    found = profile(command, env, opts.runs, opts.tree, opts.children)
     sys.stdout.write(table(found))
     if opts.json:
         Path(opts.json).write_text(json.dumps(found, indent=2) + "\n")

@@ -513,3 +513,16 @@ def test_startup_profile_follows_mlaunch_to_its_first_child(tmp_path: Path) -> N
     assert all(len(v) == 1 and v[0] >= 0 for v in found.values())
     total = found.pop("total until the first child runs")[0]
     assert sum(v[0] for v in found.values()) == pytest.approx(total)
+
+
+def test_startup_profile_follows_mlaunch_to_its_nth_child(tmp_path: Path) -> None:
+    """--children N: the starts after the first are one bucket, the total ends at the N-th."""
+    import startup_profile
+
+    path = gen.write([gen.many_children("t", 5, ["true"])], "py", tmp_path / "launch")
+    env = {**os.environ, "ROS_LOG_DIR": str(tmp_path / "logs"), "MLAUNCH_NO_CACHE": "1"}
+    argv = [sys.executable, "-m", "mlaunch", str(path)]
+    found = startup_profile.profile(argv, env, 1, children=5)
+    assert "spawn of the first child" in found and "spawns of children 2 to 5" in found
+    total = found.pop("total to 5 started")[0]
+    assert sum(v[0] for v in found.values()) == pytest.approx(total)
