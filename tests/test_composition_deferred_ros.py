@@ -285,7 +285,8 @@ def test_the_driver_abandons_its_loads_at_shutdown_and_leaves_no_thread(
     finally:
         driver.close()
     h.printer.flush()
-    assert not [t for t in threading.enumerate() if t.name.startswith("load ")]
+    left = [t for t in threading.enumerate() if t.name.startswith("load ") or t.name == "rtps"]
+    assert not left
     assert (
         "Abandoning wait for the '/nobody/_container/load_node' service, due to shutdown:"
         " node 'a' of type 'p::A' was never loaded"
@@ -473,3 +474,32 @@ def test_mlaunch_test_expects_the_nodes_a_timer_loads(
     failed = [rest for status, rest in rows if status == "FAIL"]
     assert any("node /rsp is in the ROS graph" in r for r in ok), out
     assert [r for r in failed if "node /talker is in the ROS graph" in r], out
+
+
+def test_the_driver_loads_through_rclpy_when_rtps_cannot_start(
+    ros_env: dict[str, str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """No RTPS port of the domain free (or no UDP at all): the run says so once and its loads
+    go through rclpy, as they did before the RTPS client."""
+    from test_supervision import Harness
+
+    from mlaunch.launch_ros.composition import LoadComponents
+    from mlaunch.launch_ros.load_request import LoadRequest
+    from mlaunch.parts import rtps
+    from mlaunch.parts.components import ComponentDriver
+    from mlaunch.plan.steps import Plan
+
+    def no_port(self: rtps.Participant) -> None:
+        raise OSError("no free RTPS port from 7410 for domain 0: address in use")
+
+    monkeypatch.setattr(rtps.Participant, "_bind_unicast", no_port)
+    request = LoadRequest("p", "p::A", "a")
+    h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
+    driver = ComponentDriver(h.sup)
+    try:
+        assert driver.loader.link.name == "rclpy"
+    finally:
+        driver.close()
+    h.printer.flush()
+    assert "the RTPS loader could not start (no free RTPS port" in h.text
+    assert "loading through rclpy" in h.text

@@ -441,3 +441,22 @@ def test_a_container_that_leaves_is_no_longer_ready(ros_env: dict[str, str]) -> 
     finally:
         participant.close()
         mute.close()
+
+
+def test_many_announcements_go_in_datagrams_that_fit(participant: rtps.Participant) -> None:
+    """A launch with hundreds of containers: its endpoint announcements to a participant are
+    split over datagrams UDP carries (one datagram of them all was refused: EMSGSIZE)."""
+    for n in range(300):
+        participant.client(f"/container_{n}/_container/load_node", "LoadNode")
+    sent: list[bytes] = []
+    participant._send = lambda data, addresses: sent.append(data)  # type: ignore[method-assign]
+    remote = rtps.Remote(b"\x01\x0f" + bytes(10))
+    remote.builtin = rtps.BUILTIN_ENDPOINTS
+    remote.metatraffic = [("127.0.0.1", 9)]
+    with participant.lock:
+        participant._offer(remote)
+    assert len(sent) > 1 and all(len(d) <= rtps.MAX_DATAGRAM for d in sent)
+    topics = {f"rq/container_{n}/_container/load_nodeRequest" for n in range(300)}
+    topics |= {f"rr/container_{n}/_container/load_nodeReply" for n in range(300)}
+    joined = b"".join(sent)
+    assert all(topic.encode() in joined for topic in topics)

@@ -474,7 +474,17 @@ class ComponentDriver(Part):
         )
         # The participant (and rclpy's loader node), here on the run's thread (the lean
         # participant's setting is in os.environ while it is made; no one spawns meanwhile).
-        self.loader.prepare()
+        try:
+            self.loader.prepare()
+        except OSError as e:  # RTPS: no port of the domain free, no UDP at all
+            if link.name != "rtps":
+                raise
+            self._say("WARNING", f"the RTPS loader could not start ({e}): loading through rclpy")
+            from mlaunch.parts.rtps import LOADER
+
+            link.close()
+            self.loader.link = make_link({LOADER: "rclpy"}, processes, domain)
+            self.loader.prepare()
         # Who waits for a load thread to end (a ``load`` asked through runtime control).
         self.waiting: list[Callable[[threading.Thread], None]] = []
         supervisor.records.subscribe(self.on_record)

@@ -181,6 +181,7 @@ class Remote:
         "default",
         "lease",
         "metatraffic",
+        "offers",
         "prefix",
         "seen",
     )
@@ -192,6 +193,7 @@ class Remote:
         self.lease = LEASE
         self.seen = time.monotonic()
         self.builtin = 0
+        self.offers = 0  # heartbeats in a row its SEDP readers did not acknowledge
         # what its SEDP readers acknowledged of ours: entity -> first sequence number not acked
         self.acked: dict[bytes, int] = {PUB_WRITER: 1, SUB_WRITER: 1}
 
@@ -745,7 +747,7 @@ class Participant:
 
     def _offer(self, remote: Remote) -> None:
         """Our SEDP announcements it has not acknowledged, and a heartbeat of each writer."""
-        parts = [self._header(remote.prefix)]
+        parts: list[bytes] = []
         for writer, reader, bit in (
             (PUB_WRITER, PUB_READER, PUBLICATIONS_DETECTOR),
             (SUB_WRITER, SUB_READER, SUBSCRIPTIONS_DETECTOR),
@@ -757,8 +759,8 @@ class Participant:
                 if sn >= remote.acked[writer]:
                     parts.append(data)
             parts.append(self._heartbeat(reader, writer, 1, len(history)))
-        if len(parts) > 1:
-            self._send(b"".join(parts), remote.metatraffic)
+        if parts:
+            self._deliver(remote.prefix, parts, b"", remote.metatraffic)
 
     def _endpoint(
         self, source: bytes, publication: bool, payload: bytes, inline: dict[int, list[bytes]]
@@ -898,7 +900,7 @@ class Participant:
             if resend:
                 target = PUB_READER if writer == PUB_WRITER else SUB_READER
                 beat = self._heartbeat(target, writer, 1, len(history))
-                self._send(self._header(source) + b"".join(resend) + beat, remote.metatraffic)
+                self._deliver(source, resend, beat, remote.metatraffic)
             return
         client = self.by_entity.get(writer)
         if client is None:
@@ -973,7 +975,12 @@ class Participant:
         """Heartbeats of what is not acknowledged yet (the lock held)."""
         for remote in self.remotes.values():
             if any(remote.acked[w] <= len(self.announced[w]) for w in (PUB_WRITER, SUB_WRITER)):
-                self._offer(remote)
+                # one that does not acknowledge (unreachable from here): every 4 s after 5 s
+                remote.offers += 1
+                if remote.offers <= 10 or remote.offers % 8 == 0:
+                    self._offer(remote)
+            else:
+                remote.offers = 0
         for client in self.clients.values():
             for guid, entry in client.readers.items():
                 if entry.acked <= client.sn:
