@@ -442,3 +442,27 @@ def test_bytes_and_paths_in_the_environment_are_taken_as_popen_takes_them() -> N
     assert run(argv, env) == popen_run(argv, env) == (0, b"b'\\xff' /x/y\n")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="illegal environment variable name"):
         launch(["true"], {b"A=B": b"1"})  # type: ignore[dict-item]
+
+
+def test_the_audit_event_is_popen_s() -> None:
+    """Audit hooks see a start as they see Popen's: ``subprocess.Popen`` with the program,
+    the arguments, the working directory and the environment mapping."""
+    code = (
+        "import sys\n"
+        f"sys.path.insert(0, {str(Path(spawning.__file__).parents[2])!r})\n"
+        "from mlaunch.engine import spawning\n"
+        "seen = []\n"
+        "sys.addaudithook(lambda e, a: seen.append(a) if e == 'subprocess.Popen' else None)\n"
+        "env = {'PATH': '/bin:/usr/bin', 'A': '1'}\n"
+        "import os\n"
+        "pid = spawning.start(['true', 'x'], spawning.environment(env), stdin=0, stdout=1,"
+        " stderr=2, cwd='/')\n"
+        "os.waitpid(pid, 0)\n"
+        "print(seen)\n"
+    )
+    out = subprocess.run(
+        [PY, "-S", "-c", code], capture_output=True, text=True, check=True, timeout=60
+    )
+    assert (
+        out.stdout.strip() == "[('true', ['true', 'x'], '/', {'PATH': '/bin:/usr/bin', 'A': '1'})]"
+    )

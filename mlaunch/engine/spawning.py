@@ -75,7 +75,7 @@ class Environment:
     Raises ValueError for a name with "=" in it, as Popen does.
     """
 
-    __slots__ = ("entries", "path")
+    __slots__ = ("entries", "mapping", "path")
 
     def __init__(self, env: Mapping[str, str]) -> None:
         enc, errors = _FS_ENCODING, _FS_ERRORS
@@ -91,6 +91,7 @@ class Environment:
                     raise ValueError("illegal environment variable name")
                 entries.append(raw + b"=" + os.fsencode(value))
         self.entries = entries
+        self.mapping = env  # what the audit event names, as Popen's
         # The PATH the program is looked up on (os.get_exec_path's rule: the default if unset).
         path = env.get("PATH")
         self.path: str = os.defpath if path is None else path
@@ -166,7 +167,7 @@ def start(
     args = list(argv)
     program = os.fspath(args[0])
     executables = _candidates(program, environment.path)
-    sys.audit("subprocess.Popen", program, args, cwd, env)
+    sys.audit("subprocess.Popen", program, args, cwd, environment.mapping)
     # Popen's protocol: the child writes "Name:hex errno:detail" to this pipe when it cannot
     # exec; the end it writes to is close-on-exec, so a started child leaves it empty.
     errpipe_read, errpipe_write = os.pipe()
