@@ -13,6 +13,7 @@ import os
 import resource
 import signal
 import stat
+import subprocess
 import sys
 import textwrap
 import time
@@ -913,36 +914,57 @@ def test_only_fds_0_to_2_reach_a_child(kind: type[Process]) -> None:
         os.close(leaky_w)
 
 
-@KINDS
-def test_a_start_that_runs_out_of_fds_raises_the_limit_and_tries_once_more(
-    kind: type[Process], monkeypatch: pytest.MonkeyPatch
-) -> None:
+STARVED = """
+import json, os, resource, sys
+from mlaunch.engine import fdlimit
+from mlaunch.engine.output import Printer
+from mlaunch.engine.process import Process
+from mlaunch.engine.supervisor import Supervisor
+from mlaunch.plan.records import Output
+from mlaunch.plan.steps import Plan, ProcessSpec, Spawn
+
+soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+users = min(soft, 1024)  # the user's own limit here: room above it to raise
+resource.setrlimit(resource.RLIMIT_NOFILE, (users, hard))
+fdlimit.LIMIT = fdlimit.Limit()
+attempts = []
+
+class Starved(Process):
+    direct = sys.argv[1] == "direct"
+
+    def spawn(self, *args, **kwargs):
+        if not attempts:  # the first start finds no descriptor free: no pipe fits
+            resource.setrlimit(resource.RLIMIT_NOFILE, (len(os.listdir("/proc/self/fd")), hard))
+        attempts.append(resource.getrlimit(resource.RLIMIT_NOFILE)[0])
+        super().spawn(*args, **kwargs)
+
+code = "import resource; print(resource.getrlimit(resource.RLIMIT_NOFILE)[0])"
+spec = ProcessSpec("kid", (sys.executable, "-c", code), dict(os.environ), {}, output="screen")
+screen, lines = bytearray(), []
+sup = Supervisor(
+    Plan(steps=[Spawn(spec=spec)]), Printer(out=screen.extend), install_signals=False,
+    spawner=Starved,
+)
+sup.records.subscribe(lambda r: lines.append(r.data.decode()) if isinstance(r, Output) else 0)
+status = sup.run()
+print(json.dumps({"status": status, "attempts": attempts, "users": users, "lines": lines,
+                  "screen": screen.decode()}))
+"""
+
+
+@pytest.mark.parametrize("kind", ["direct", "popen"])
+def test_a_start_that_runs_out_of_fds_raises_the_limit_and_tries_once_more(kind: str) -> None:
     """EMFILE at a start (a handler's process in a run whose plan fit): the run's soft limit is
-    raised and the start tried again; the child gets the user's own limit back."""
-    from mlaunch.engine import fdlimit
-
-    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
-    users = min(soft, 1024)  # the user's own limit in this test: room above it to raise
-    attempts: list[int] = []
-
-    class Starved(kind):  # type: ignore[valid-type,misc]
-        def spawn(self, *args: object, **kwargs: object) -> None:
-            if not attempts:  # the first start finds one descriptor free: no pipe fits
-                resource.setrlimit(resource.RLIMIT_NOFILE, (len(os.listdir("/proc/self/fd")), hard))
-            attempts.append(resource.getrlimit(resource.RLIMIT_NOFILE)[0])
-            super().spawn(*args, **kwargs)  # type: ignore[arg-type]
-
-    code = "import resource; print(resource.getrlimit(resource.RLIMIT_NOFILE)[0])"
-    try:
-        resource.setrlimit(resource.RLIMIT_NOFILE, (users, hard))
-        monkeypatch.setattr(fdlimit, "LIMIT", fdlimit.Limit())  # the run's, from the user's
-        h = Harness([make_spec("kid", code)], spawner=Starved)
-        assert h.run() == 0
-    finally:
-        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+    raised and the start tried again; the child gets the user's own limit back. In a process of
+    its own: the limit is the whole process's (an xdist worker's threads must not starve)."""
+    done = subprocess.run([PY, "-c", STARVED, kind], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    seen = json.loads(done.stdout.splitlines()[-1])
+    assert seen["status"] == 0, seen["screen"]
+    attempts = seen["attempts"]
     assert len(attempts) == 2 and attempts[1] > attempts[0], attempts
-    assert output(h, "kid") == [str(users)]  # the user's own, not the raised one
-    assert "Too many open files" not in h.text
+    assert seen["lines"] == [f"{seen['users']}\n"]  # the user's own, not the raised one
+    assert "Too many open files" not in seen["screen"]
 
 
 @KINDS
