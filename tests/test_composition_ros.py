@@ -28,6 +28,7 @@ from mlaunch.launch_ros.load_request import (
     BOOL,
     INTEGER,
     STRING,
+    STRING_ARRAY,
     LoadRequest,
     TypedParameter,
 )
@@ -454,3 +455,27 @@ def test_over_rtps_in_the_subnet_range(
         driver.stop.set()
         driver.join(5.0)
         driver.close()
+
+
+def test_a_request_larger_than_a_datagram_arrives_whole(
+    spawn: Callable[..., Proc], loader: Any
+) -> None:
+    """Autoware's planners send requests of ~94 kB (their parameters): over RTPS in fragments
+    (DATA_FRAG), which Fast DDS puts together; the container records the request whole."""
+    driver, lines = loader
+    container = spawn([sys.executable, RECORDER, "--ros-args", "-r", "__node:=big"], "rec")
+    values = tuple(f"value {n} " * 20 for n in range(600))  # ~110 kB of strings
+    request = LoadRequest(
+        "p",
+        "p::Big",
+        "big_node",
+        parameters=(
+            TypedParameter("many", STRING_ARRAY, values),
+            TypedParameter("after", INTEGER, 7),
+        ),
+    )
+    driver.start(LoadComponents("t", "/big", (request,)))
+    assert driver.join(30.0), stalled(container, lines)
+    assert [r.success for r in driver.results] == [True]
+    assert wait_until(recorded(container, 1), 10)
+    assert json.loads(container.stdout().splitlines()[0]) == as_lists(request)

@@ -137,7 +137,8 @@ def generate_launch_description():
         Node(package='rclcpp_components', executable='component_container', name='cbox'),
         LoadComposableNodes(target_container='/cbox', composable_node_descriptions=[
             ComposableNode(package='composition', plugin=talker, name='typed',
-                           parameters=[{'use_sim_time': True, 'n': 3, 'xs': [1.5, 2.0]}],
+                           parameters=[{'use_sim_time': True, 'n': 3, 'xs': [1.5, 2.0],
+                                        'big': ['x' * 100] * 1000}],
                            extra_arguments=[{'use_intra_process_comms': True}]),
             ComposableNode(package='composition', plugin=talker, name='badly_typed',
                            extra_arguments=[{'use_intra_process_comms': 'yes'}]),
@@ -151,8 +152,8 @@ def generate_launch_description():
 def test_the_real_container_gets_typed_values_and_says_why_it_refuses(
     loader: str, ros_env: dict[str, str], tmp_path: Path
 ) -> None:
-    """rclcpp's own component manager reads the request: a bool parameter arrives as a bool
-    (the node's use_sim_time), a string where it reads a bool is refused with rclcpp's message,
+    """rclcpp's own component manager reads the request (~100 kB: in fragments over RTPS): a
+    bool parameter arrives as a bool (the node's use_sim_time), a string where it reads a bool is refused with rclcpp's message,
     an unknown plugin with its loader's; the same over RTPS (the default) and rclpy."""
     env = env_for(ros_env, tmp_path, real=True)
     if loader:

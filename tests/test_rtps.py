@@ -460,3 +460,18 @@ def test_many_announcements_go_in_datagrams_that_fit(participant: rtps.Participa
     topics |= {f"rr/container_{n}/_container/load_nodeReply" for n in range(300)}
     joined = b"".join(sent)
     assert all(topic.encode() in joined for topic in topics)
+
+
+def test_an_announcement_in_fragments_is_not_asked_for_again(
+    participant: rtps.Participant,
+) -> None:
+    """A node's endpoint announcement past one datagram (DATA_FRAG) is no container's: noted as
+    received, so this reader's ACKNACK does not ask the writer for it forever."""
+    valid = _valid_messages(participant)
+    participant.receive(valid[0])  # the participant
+    prefix = valid[0][8:20]
+    head = valid[0][:20]
+    frags = rtps._fragments(rtps.PUB_READER, rtps.PUB_WRITER, 1, bytes(40000), b"")
+    assert participant.receive(head + frags[0])
+    state = participant.states[prefix + rtps.PUB_WRITER]
+    assert state.base == 2 and not state.missing(1)

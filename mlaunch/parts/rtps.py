@@ -651,6 +651,8 @@ class Participant:
                 self._on_gap(source, body, little)
             elif kind == NACK_FRAG:
                 self._on_nack_frag(source, body, little)
+            elif kind == DATA_FRAG:
+                self._on_data_frag(source, body, little)
 
     def _data(self, source: bytes, flags: int, body: bytes, little: bool) -> None:
         i = "<" if little else ">"
@@ -698,6 +700,14 @@ class Participant:
         if waiter is not None and waiter.reply is None:
             waiter.reply = bytes(payload)
             waiter.event.set()
+
+    def _on_data_frag(self, source: bytes, body: bytes, little: bool) -> None:
+        """A sample in fragments: no container's endpoint or answer is that large, so it is
+        noted as received (an endpoint announcement not asked for again), never assembled."""
+        writer = body[8:12]
+        if writer in (PUB_WRITER, SUB_WRITER) and source in self.remotes:
+            high, low = struct.unpack_from("<iI" if little else ">iI", body, 12)
+            self.states.setdefault(source + writer, ReaderState()).received(_sn(high, low))
 
     def _reply_client(self, guid: bytes, reader: bytes) -> Client | None:
         client = self.by_entity.get(reader)
@@ -1100,7 +1110,7 @@ def _fragments(reader: bytes, writer: bytes, sn: int, payload: bytes, inline: by
         )
         pad = -len(body) % 4
         body += bytes(pad)
-        out.append(struct.pack("<BBH", DATA_FRAG, 1 | 2, len(body)) + body)
+        out.append(struct.pack("<BBH", DATA_FRAG, 1 | (2 if inline else 0), len(body)) + body)
     return out
 
 
