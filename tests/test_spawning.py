@@ -466,3 +466,13 @@ def test_the_audit_event_is_popen_s() -> None:
     assert (
         out.stdout.strip() == "[('true', ['true', 'x'], '/', {'PATH': '/bin:/usr/bin', 'A': '1'})]"
     )
+
+
+def test_bytes_and_path_arguments_are_taken_as_popen_takes_them(tmp_path: Path) -> None:
+    prog = script(tmp_path / "prog", '#!/bin/sh\necho "$@"\n')
+    env = {"PATH": str(tmp_path)}
+    for argv in ([b"prog", b"a"], [prog, "b"], [os.fsencode(prog), "c"]):
+        assert run(argv, env) == popen_run(argv, env)  # type: ignore[arg-type]
+    for missing in ([b"no-such-xyz"], [tmp_path / "nope"]):
+        ours = failure(lambda m=missing: launch(m, env))  # type: ignore[misc]
+        assert ours == failure(lambda m=missing: popen_run(m, env))  # type: ignore[misc]

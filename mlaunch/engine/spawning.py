@@ -121,7 +121,7 @@ _MAX_LOOKUPS = 512
 
 
 def _candidates(program: str, path: str) -> tuple[bytes, ...]:
-    """The files exec is tried on, in order: ``program`` itself when it names a directory,
+    """The files exec is tried on, in order: ``program`` itself when it is a path (has a "/"),
     else ``program`` in each folder of ``path`` (an empty entry is the working directory)."""
     key = (program, path)
     found = _LOOKUPS.get(key)
@@ -165,9 +165,9 @@ def start(
         raise ValueError("argv is empty: there is no program to start")
     environment = env if isinstance(env, Environment) else Environment(env)
     args = list(argv)
-    program = os.fspath(args[0])
-    executables = _candidates(program, environment.path)
-    sys.audit("subprocess.Popen", program, args, cwd, environment.mapping)
+    given = args[0]  # as Popen names it in its errors and its audit event (str, bytes, a path)
+    executables = _candidates(os.fsdecode(given), environment.path)
+    sys.audit("subprocess.Popen", given, args, cwd, environment.mapping)
     # Popen's protocol: the child writes "Name:hex errno:detail" to this pipe when it cannot
     # exec; the end it writes to is close-on-exec, so a started child leaves it empty.
     errpipe_read, errpipe_write = os.pipe()
@@ -196,11 +196,11 @@ def start(
     finally:
         os.close(errpipe_read)
     if report:
-        _raise_failure(pid, bytes(report), program, cwd)
+        _raise_failure(pid, bytes(report), given, cwd)
     return pid
 
 
-def _raise_failure(pid: int, report: bytes, program: str, cwd: str | None) -> None:
+def _raise_failure(pid: int, report: bytes, program: object, cwd: str | None) -> None:
     """Reap the child that could not exec and raise what Popen raises for ``report``."""
     try:
         os.waitpid(pid, 0)
