@@ -526,10 +526,9 @@ def _log_keep(value: str | None) -> int | None:
     )
 
 
-NO_CACHE_ENV = "MLAUNCH_NO_CACHE"
-
-
 def cache_wanted(opts: Options, environ: Mapping[str, str]) -> bool:
     """Whether this run may use the plan cache: not --no-cache, not MLAUNCH_NO_CACHE=1 (any
     value but empty and 0). Decided here, before the cache's code (and pickle) is imported."""
-    return opts.cache and environ.get(NO_CACHE_ENV, "") in ("", "0")
+    from mlaunch.app.quick import cache_allowed
+
+    return opts.cache and cache_allowed(environ)

@@ -23,6 +23,7 @@ from mlaunch.plan.steps import SHARE, Plan
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from mlaunch.app.plan_cache import PlanCache
+    from mlaunch.app.quick import QuickStart
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.launch.launch_description import LaunchDescription
     from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
@@ -186,13 +187,17 @@ def resolve_for_run(
 # --- the whole pipeline --------------------------------------------------------------------------
 
 
-def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
-    """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it."""
+def launch(opts: Options, attach: Sequence[PartMaker], quick: QuickStart | None = None) -> int:
+    """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it.
+
+    ``quick``: the quick start of this command line (mlaunch.app.quick): its lifeline and the
+    children it started, which the run adopts; else its entry is written once the plan is known.
+    """
     from mlaunch.engine.lifeline import Lifeline
 
     # From here on a launch file's code and substitutions may start processes: signals, the
     # guard and the run's marker cover them (a slow Command is when SIGTERM tends to arrive).
-    with Lifeline() as life:
+    with quick.life if quick is not None and quick.life is not None else Lifeline() as life:
         if opts.show_args:
             return show_arguments(opts, life)
         cache = plan_cache(opts)
@@ -208,8 +213,11 @@ def launch(opts: Options, attach: Sequence[PartMaker]) -> int:
 
                     set_launch_argv(opts.target, opts.second, opts.launch_argv)
                     plan, options, labels = cached.plan, cached.options, cached.labels
-                    return run_plan(opts, plan, options, labels, log_dir, life, attach, cached.path)
-            return resolve_recorded(opts, cache, life, attach)
+                    note_quick(quick, plan, life, log_dir, cache)
+                    return run_plan(
+                        opts, plan, options, labels, log_dir, life, attach, cached.path, quick
+                    )
+            return resolve_recorded(opts, cache, life, attach, quick)
         path, search = find_target(opts)
         description = load_file(opts, path, search, temp_dir=life.temp_dir)
         streams_back(path)
@@ -233,8 +241,22 @@ def plan_cache(opts: Options) -> PlanCache | None:
     return PlanCache.for_run(opts, os.environ, say)
 
 
+def note_quick(
+    quick: QuickStart | None, plan: Plan, life: Lifeline, log_dir: str, cache: PlanCache
+) -> None:
+    """Write the quick entry of a plan the cache holds, unless this run was quick-started."""
+    if quick is None or quick.found or cache.inputs_data is None:
+        return
+    if not quick.note(plan, life.run_id, (life.temp_dir, log_dir), cache.inputs_data):
+        cache.debug(f"no quick start: {quick.why_not}")
+
+
 def resolve_recorded(
-    opts: Options, cache: PlanCache, life: Lifeline, attach: Sequence[PartMaker]
+    opts: Options,
+    cache: PlanCache,
+    life: Lifeline,
+    attach: Sequence[PartMaker],
+    quick: QuickStart | None = None,
 ) -> int:
     """Load and resolve as ``launch`` does, noting every input, and store the plan when the
     recording saw everything it depends on (``--debug`` and ``--print`` say when not)."""
@@ -268,7 +290,9 @@ def resolve_recorded(
         from mlaunch.engine.lifeline import say
 
         say(f"mlaunch: plan cache: not stored: {cache.why_not}")
-    return run_plan(opts, plan, options, labels, log_dir, life, attach, path)
+    if stored:
+        note_quick(quick, plan, life, log_dir, cache)
+    return run_plan(opts, plan, options, labels, log_dir, life, attach, path, quick)
 
 
 def run_log_dir(opts: Options) -> str:
@@ -289,14 +313,15 @@ def run_plan(
     life: Lifeline,
     attach: Sequence[PartMaker],
     path: str,
+    quick: QuickStart | None = None,
 ) -> int:
-    """Print the plan (--print), or run it."""
+    """Print the plan (--print), or run it (adopting what ``quick`` started)."""
     if opts.print_plan:
         from mlaunch.engine.lifeline import write_stdout
 
         write_stdout(describe(opts, plan, path))
         return 0
-    return supervise(opts, plan, options, labels, log_dir, life, attach, path=path)
+    return supervise(opts, plan, options, labels, log_dir, life, attach, path=path, quick=quick)
 
 
 def show_arguments(opts: Options, life: Lifeline) -> int:
@@ -351,9 +376,10 @@ def supervise(
     attach: Sequence[PartMaker],
     *,
     path: str = "",
+    quick: QuickStart | None = None,
 ) -> int:
     """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts; ``path`` is
-    the launch file (the parts' ``Run.launch_file``)."""
+    the launch file (the parts' ``Run.launch_file``); ``quick``'s children are adopted."""
     from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
     from mlaunch.engine.output import Printer, stdout_is_color_terminal
     from mlaunch.engine.process import Process
@@ -388,6 +414,7 @@ def supervise(
         guard=guard,
         run_id=run_id,
         spawner=Process if spawner is None else spawner,
+        prestarted=quick if quick is not None and quick.children else None,
     )
     supervisor.records.emit(Said("INFO", "launch", f"All log files can be found below {log_dir}"))
     run = Run(opts, plan, supervisor, printer, launch_file=path)

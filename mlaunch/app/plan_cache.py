@@ -25,6 +25,8 @@ import time
 from types import FunctionType
 
 from mlaunch.app.options import cache_wanted
+from mlaunch.app.quick import REORDERED, cache_folder, read_private
+from mlaunch.app.quick import SUFFIX as QUICK
 from mlaunch.plan import inputs as plan_inputs
 from mlaunch.ros.files import write_all
 
@@ -73,14 +75,6 @@ def enabled(opts: Options, environ: Mapping[str, str]) -> bool:
     return cache_wanted(opts, environ)
 
 
-def cache_folder(environ: Mapping[str, str]) -> str:
-    """Where the entries are: the user's cache folder's mlaunch/plans."""
-    base = environ.get("XDG_CACHE_HOME") or ""
-    if not os.path.isabs(base):  # the XDG rule: a relative value is ignored
-        base = os.path.join(os.path.expanduser("~"), ".cache")
-    return os.path.join(base, "mlaunch", "plans")
-
-
 # Options that do not change the plan (how it is shown, how the run looks, logs, metrics): every
 # other option is in the key, an option added later too.
 NOT_IN_KEY = frozenset(
@@ -118,11 +112,6 @@ def run_key(opts: Options, environ: Mapping[str, str]) -> str:
         [(name, value) for name, value in vars(opts).items() if name not in NOT_IN_KEY],
     )
     return plan_inputs.digest(repr(parts).encode("utf-8", "surrogateescape"))
-
-
-# Variables keyed by their entries, not their order, and rebased to this run's value: the ROS
-# wheels' start-up hook writes LD_LIBRARY_PATH's entries in a new order in every interpreter.
-REORDERED = ("LD_LIBRARY_PATH",)
 
 
 def _environment_key(environ: Mapping[str, str]) -> list[tuple[str, str]]:
@@ -185,6 +174,8 @@ class PlanCache:
         self._say = say
         self._debug = debug
         self.why_not = ""  # why the last resolution was not stored ("" when it was)
+        # What the plan found or stored was resolved from (Inputs.as_data), for the quick start.
+        self.inputs_data: Any = None
         # --debug says how long finding the plan took, in wall-clock and CPU time
         self._started = (time.perf_counter(), time.process_time())
 
@@ -233,6 +224,7 @@ class PlanCache:
         if changed is not None:
             self.debug(f"resolving again: {changed}")
             return None
+        self.inputs_data = header["inputs"]
         return Entry(payload, places, len(recorded))
 
     def take(self, entry: Entry, places: tuple[str, ...]) -> Cached | None:
@@ -259,7 +251,6 @@ class PlanCache:
         return Cached(path, plan, options, labels)
 
     def _read(self) -> bytes | None:
-        flags = os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
         problem = self._private_folder(make=False)
         if problem:
             if os.path.isdir(self.folder):
@@ -267,33 +258,14 @@ class PlanCache:
             else:
                 self.debug("no entry yet")
             return None
-        try:
-            fd = os.open(self.file, flags)
-        except FileNotFoundError:
-            self.debug("no entry yet")
-            return None
-        except OSError as e:
-            self._ignore(f"cannot be opened ({e.strerror or e})")
-            return None
-        try:
-            import stat
-
-            st = os.fstat(fd)
-            if not stat.S_ISREG(st.st_mode) or st.st_uid != os.getuid():
-                self._ignore("not a file of yours", remove=False)
-                return None
-            if st.st_mode & 0o077:
-                self._ignore(f"mode {stat.S_IMODE(st.st_mode):o} lets others in", remove=False)
-                return None
-            if st.st_size > MAX_ENTRY_BYTES:
-                self._ignore("too large")
-                return None
-            chunks = []
-            while chunk := os.read(fd, 1 << 20):
-                chunks.append(chunk)
-            return b"".join(chunks)
-        finally:
-            os.close(fd)
+        data, problem = read_private(self.file, MAX_ENTRY_BYTES)
+        if data is None:
+            if not problem:
+                self.debug("no entry yet")
+            else:  # what is not the user's own is left; what is broken goes
+                broken = problem == "too large" or problem.startswith("cannot be opened")
+                self._ignore(problem, remove=broken)
+        return data
 
     def _ignore(self, why: str, remove: bool = True) -> None:
         self._say(f"mlaunch: plan cache: ignored {self.file}: {why}; resolving the launch again")
@@ -346,6 +318,8 @@ class PlanCache:
                     "places": list(places),
                 }
                 self.why_not = self._write(_join(header, payload))
+                if not self.why_not:
+                    self.inputs_data = header["inputs"]
         if self.why_not:
             self.debug(f"not stored: {self.why_not}")
             return False
@@ -403,7 +377,7 @@ class PlanCache:
         try:
             with os.scandir(self.folder) as found:
                 for entry in found:
-                    if entry.name.endswith((".plan", ".tmp")) and entry.is_file():
+                    if entry.name.endswith((".plan", QUICK, ".tmp")) and entry.is_file():
                         st = entry.stat()
                         entries.append((st.st_mtime_ns, st.st_size, entry.path))
         except OSError:

@@ -15,29 +15,33 @@ from __future__ import annotations
 import os
 import sys
 
-from mlaunch.app.options import Options, parse_options
-from mlaunch.commands import subcommands
-
+# Nothing else at first: the quick start (mlaunch.app.quick) starts a repeated launch's first
+# processes before the rest of mlaunch is imported.
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from mlaunch.app.options import Options
     from mlaunch.app.parts import Run
+    from mlaunch.app.quick import QuickStart
     from mlaunch.engine.part import Part
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """``mlaunch ...`` and its subcommands: the one place errors are caught and printed."""
+def main(argv: Sequence[str] | None = None, quick: QuickStart | None = None) -> int:
+    """``mlaunch ...`` and its subcommands: the one place errors are caught and printed.
+
+    ``quick``: the quick start of ``program`` (its children adopted by the run)."""
     args = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in args or "-d" in args
     from mlaunch import compat
+    from mlaunch.commands import subcommands
 
     compat.install()  # launch files import the ROS 2 names (launch, launch_ros ...)
     try:
         sub = subcommands().get(args[0]) if args and not os.path.isfile(args[0]) else None
         if sub is not None:  # each parses its own options and runs through mlaunch.app
             return sub.main(args[1:])
-        return run_cli(args)
+        return run_cli(args, quick)
     except BrokenPipeError:
         from mlaunch.engine.lifeline import stdout_gone
 
@@ -55,9 +59,10 @@ def report_error(error: BaseException, debug: bool) -> int:
     return report(error, debug=debug)
 
 
-def run_cli(argv: Sequence[str]) -> int:
+def run_cli(argv: Sequence[str], quick: QuickStart | None = None) -> int:
     """``mlaunch FILE ...``: the pipeline with what every run attaches (or ``--check``)."""
     from mlaunch.app import pipeline
+    from mlaunch.app.options import parse_options
     from mlaunch.app.parts import PartMaker, standard_parts
 
     opts = parse_options(argv)
@@ -66,7 +71,7 @@ def run_cli(argv: Sequence[str]) -> int:
     parts = standard_parts(opts)
     # Before the control socket opens: it answers wait-ready through it.
     parts.insert(0, PartMaker("the readiness checks", _readiness))
-    return pipeline.launch(opts, parts)
+    return pipeline.launch(opts, parts, quick)
 
 
 def _readiness(run: Run) -> Part:
@@ -102,10 +107,19 @@ def program() -> None:
         from mlaunch.cli.completion import complete
 
         complete()
+    quick = None
     try:
-        code = main()
+        from mlaunch.app.quick import prestart
+
+        quick = prestart(sys.argv[1:], os.environ)
+        code = main(quick=quick)
     except SystemExit as e:  # argparse's usage errors and --help
         code = e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
+    except (Exception, KeyboardInterrupt) as e:  # the quick start's (a signal while it starts)
+        code = report_error(e, "--debug" in sys.argv or "-d" in sys.argv)
+    finally:
+        if quick is not None:
+            quick.close()  # what the run did not adopt (it ended before): none, normally
     code = flush_std_streams(code)
     os._exit(code)
 

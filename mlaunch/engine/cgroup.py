@@ -105,6 +105,28 @@ class RunCgroup:
 
         _thread.start_new_thread(move, ())
 
+    def move_soon(self, pids: list[int]) -> None:
+        """Move ``pids`` into the run's cgroup once this process's own move is done, in a
+        thread of its own (``settle`` waits for both): children the quick start
+        (mlaunch.app.quick) started while that move was under way began outside it."""
+        before = self._moving
+        moving = _thread.allocate_lock()
+        moving.acquire()
+        self._moving = moving
+        procs = os.path.join(self.path, "cgroup.procs")
+
+        def move() -> None:
+            try:
+                if before is not None:
+                    before.acquire()
+                    before.release()
+                for pid in pids:
+                    _write(procs, str(pid))  # one that has ended already cannot move: gone
+            finally:
+                moving.release()
+
+        _thread.start_new_thread(move, ())
+
     def settle(self) -> bool:
         """Wait for ``enter_soon``'s move; whether this process is in the run's cgroup."""
         moving = self._moving

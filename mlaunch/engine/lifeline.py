@@ -72,8 +72,12 @@ class Lifeline:
         self._raising = True
         self._old_handlers: dict[int, object] = {}
         self._old_marker: str | None = None
+        self._entered = False
 
     def __enter__(self) -> Lifeline:
+        if self._entered:  # the quick start entered it (mlaunch.app.quick): the run goes on
+            return self
+        self._entered = True
         for sig in STOP_SIGNALS:
             self._old_handlers[sig] = signal.signal(sig, self._on_signal)
         self._old_marker = self.environ.get(proctable.MARKER)
@@ -130,6 +134,9 @@ class Lifeline:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
 
     def __exit__(self, kind: type[BaseException] | None, error: object, tb: object) -> None:
+        if not self._entered:
+            return  # left already (the quick start's lifeline, left by the run)
+        self._entered = False
         self._raising = False
         signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
         try:

@@ -350,6 +350,16 @@ class Process:
         )
         self.pid = self.popen.pid
 
+    def adopt(self, pid: int, fds: tuple[int, int, int], started_at: float) -> None:
+        """Take over a child the quick start started as this spec (mlaunch.app.quick): its
+        pid, its stdin pipe's write end and stdout and stderr pipes' read ends (``fds``)."""
+        self.pid = pid
+        self.stdin_fd = fds[0]
+        self.started_at = started_at
+        for name, fd in (("stdout", fds[1]), ("stderr", fds[2])):
+            os.set_blocking(fd, False)
+            self.streams[fd] = Stream(name, fd)
+
     def watch_pipes(self) -> None:
         """Take a Popen's stdout and stderr as non-blocking streams (a subclass's spawn)."""
         assert self.popen is not None

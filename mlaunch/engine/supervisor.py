@@ -73,7 +73,29 @@ from mlaunch.resolve.resolver import LabelCounter, ResolveOptions, resolve_defer
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
+    from typing import Protocol
+
     from mlaunch.engine.cgroup import RunCgroup
+
+    class PrestartedChild(Protocol):
+        """A child started before the run (mlaunch.app.quick.Child)."""
+
+        @property
+        def pid(self) -> int: ...
+
+        @property
+        def fds(self) -> tuple[int, int, int]: ...
+
+        @property
+        def started_at(self) -> float: ...
+
+    class Prestarted(Protocol):
+        """The children started before the run, for it to adopt (mlaunch.app.quick)."""
+
+        def take(self, spec: ProcessSpec, env: Mapping[str, str]) -> PrestartedChild | None: ...
+
+        def abandon(self) -> None: ...
+
 
 # How often the guard is told the groups of orphans re-parented to mlaunch (escaped daemons).
 ADOPTED_POLL = 1.0
@@ -113,8 +135,11 @@ class Supervisor:
         spawner: Callable[[ProcessSpec, int, int], Process] = Process,
         cgroup: RunCgroup | None = None,
         gentle_on_error: bool = False,
+        prestarted: Prestarted | None = None,
     ) -> None:
         self.plan = plan
+        # Children the quick start started as the plan's first processes: adopted by start().
+        self.prestarted = prestarted
         self.gentle_on_error = gentle_on_error
         # Subscribed below, and the terminal whose flow control the loop drives; parts are
         # handed the printer by the run (mlaunch.app.parts.Run), never through here.
@@ -265,6 +290,9 @@ class Supervisor:
         self.signals.start(self._selector)
         try:
             self.execute(self.plan.steps, self.plan.warnings)
+            if self.prestarted is not None:
+                self.prestarted.abandon()  # what the plan does not start (said), if anything
+                self._reap()  # an adopted child that ended before SIGCHLD was watched
             if self.guard is not None:
                 self.guard.flush()  # the first spawns' groups, in one write
             # After the first spawns, not before: ctypes costs milliseconds and the first child
@@ -415,13 +443,15 @@ class Supervisor:
         if record is None:
             record = self.states[spec.label] = ProcessState(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
+        child = None
+        if self.prestarted is not None and not restarts:
+            child = self.prestarted.take(spec, self._marker_env)
         try:
-            try:
-                process.spawn(self.clock, self._marker_env)
-            except OSError as e:
-                if e.errno != errno.EMFILE or not fdlimit.limit().make_room():
-                    raise
-                process.spawn(self.clock, self._marker_env)  # once more, with a higher limit
+            if child is not None:
+                process.adopt(child.pid, child.fds, child.started_at)
+                self.records.emit(Said("DEBUG", "launch", f"quick start: {spec.label} adopted"))
+            else:
+                self._spawn(process)
         except OSError as e:
             reason = e.strerror or str(e)
             process.returncode = 127
@@ -442,6 +472,14 @@ class Supervisor:
         self.pipes.watch(process)
         self.records.emit(Started(process))
         return process
+
+    def _spawn(self, process: Process) -> None:
+        try:
+            process.spawn(self.clock, self._marker_env)
+        except OSError as e:
+            if e.errno != errno.EMFILE or not fdlimit.limit().make_room():
+                raise
+            process.spawn(self.clock, self._marker_env)  # once more, with a higher limit
 
     def _deliver(self, process: Process, stream: str, data: bytes) -> None:
         """Complete lines of a child, onto the stream (the printer, then OnProcessIO handlers)."""
