@@ -68,10 +68,18 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
         _wrap(pipeline, "load_file", "load the launch file")
         _wrap(pipeline, "resolve_for_run", "resolve")
         supervise = pipeline.supervise
+        done = []
 
-        def first_spawn(*args, **kwargs):
-            _mark("before supervise")
-            import mlaunch.engine.supervisor as sup
+        def finish():
+            if done:
+                return
+            done.append(True)
+            text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
+            with open(_out + ".tmp", "w") as f:
+                f.write(text + "\n")
+            os.rename(_out + ".tmp", _out)
+
+        def wrap_supervisor(sup):
             start = sup.Supervisor.start
 
             count = [0]
@@ -88,13 +96,49 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
                 if _children > 1:
                     _mark(f"spawns of children 2 to {_children}")
                 sup.Supervisor.start = start
-                text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
-                with open(_out + ".tmp", "w") as f:
-                    f.write(text + "\n")
-                os.rename(_out + ".tmp", _out)
+                finish()
                 return result
 
             sup.Supervisor.start = started
+
+        # Wraps Supervisor.start when the supervisor's module is imported (not before: a run
+        # may start its first child before it imports it).
+        class SupervisorHook:
+
+            def find_spec(self, name, path, target=None):
+                if name != "mlaunch.engine.supervisor":
+                    return None
+                sys.meta_path.remove(self)
+                import importlib.util
+                spec = importlib.util.find_spec(name)
+                run_module = spec.loader.exec_module
+
+                def exec_module(module):
+                    run_module(module)
+                    wrap_supervisor(module)
+
+                spec.loader.exec_module = exec_module
+                return spec
+
+        def first_spawn(*args, **kwargs):
+            _mark("before supervise")
+            sys.meta_path.insert(0, SupervisorHook())
+            try:  # the plan's first processes start before the supervisor is made
+                import mlaunch.engine.spawning as spawning
+            except ImportError:
+                spawning = None
+            if spawning is not None:
+                spawn = spawning.start
+
+                def early(*a, **k):
+                    _mark("supervise: the descriptor limit, the first spawn's set-up")
+                    result = spawn(*a, **k)
+                    _mark("spawn of the first child")
+                    spawning.start = spawn
+                    finish()
+                    return result
+
+                spawning.start = early
             return supervise(*args, **kwargs)
 
         pipeline.supervise = first_spawn

@@ -57,16 +57,17 @@ def case(tmp_path: Path) -> tuple[Path, dict[str, str], Path]:
 
 
 def run(path: Path, env: dict[str, str], out: Path) -> tuple[str, list[str], dict[str, str]]:
-    """One run: (its output, the adopted labels launch.log names, the first child's env)."""
+    """One run: (its output, the labels launch.log says the quick start started, the first
+    child's environment)."""
     logs = Path(env["ROS_LOG_DIR"])
     before = run_logs(logs)
     done = run_mlaunch(str(path), env=env, timeout=60)
     assert done.returncode == 0, done.stdout + done.stderr
     (log_dir,) = run_logs(logs) - before
     adopted = [
-        line.split("quick start: ")[1].removesuffix(" adopted")
+        line.split("[launch]: ")[1].split(" (pid ")[0]
         for line in (log_dir / "launch.log").read_text().splitlines()
-        if "quick start: " in line and line.endswith(" adopted")
+        if line.endswith(" was started by the quick start, before mlaunch loaded its plan; adopted")
     ]
     (env_file,) = out.glob("env.*")
     (argv_file,) = out.glob("argv.*")
@@ -157,7 +158,7 @@ def test_mlaunch_killed_after_a_quick_start_leaves_nothing(tmp_path: Path) -> No
         "from launch.actions import ExecuteProcess\n"
         "def generate_launch_description():\n"
         "    return LaunchDescription([ExecuteProcess(cmd=['sh', '-c',"
-        f" 'echo $$ > {pids}/pid.$$; exec sleep 60'])])\n"
+        f" 'echo $$ > {pids}/.tmp.$$; mv {pids}/.tmp.$$ {pids}/pid.$$; exec sleep 60'])])\n"
     )
     env = clean_env(XDG_CACHE_HOME=str(tmp_path / "cache"), ROS_LOG_DIR=str(tmp_path / "log"))
     env.pop("MLAUNCH_NO_CACHE", None)
@@ -166,8 +167,8 @@ def test_mlaunch_killed_after_a_quick_start_leaves_nothing(tmp_path: Path) -> No
         proc = subprocess.Popen(
             mlaunch(str(path)), env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
         )
-        assert wait_until(lambda: any(pids.iterdir()), timeout=30)
-        (pid_file,) = pids.iterdir()
+        assert wait_until(lambda: any(pids.glob("pid.*")), timeout=30)  # written, then renamed
+        (pid_file,) = pids.glob("pid.*")
         pid = int(pid_file.read_text())
         pid_file.unlink()
         if attempt == 0:
@@ -179,7 +180,7 @@ def test_mlaunch_killed_after_a_quick_start_leaves_nothing(tmp_path: Path) -> No
         # The child runs before the run has made its log folder: looked for again each time.
         def adopted() -> bool:
             logs = [p / "launch.log" for p in run_logs(tmp_path / "log")]
-            return any("adopted" in p.read_text() for p in logs if p.exists())
+            return any("by the quick start" in p.read_text() for p in logs if p.exists())
 
         assert wait_until(adopted, timeout=30)
         proc.kill()  # SIGKILL: only the guard is left to end the child
@@ -193,3 +194,45 @@ def test_mlaunch_killed_after_a_quick_start_leaves_nothing(tmp_path: Path) -> No
             return False
 
         assert wait_until(gone, timeout=30), f"pid {pid} outlived mlaunch"
+
+
+def test_a_resolved_run_starts_its_first_processes_before_the_supervisor(
+    case: tuple[Path, dict[str, str], Path],
+) -> None:
+    path, env, _out = case
+    env["MLAUNCH_NO_CACHE"] = "1"
+    logs = Path(env["ROS_LOG_DIR"])
+    done = run_mlaunch(str(path), env=env, timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    (log_dir,) = run_logs(logs)
+    text = (log_dir / "launch.log").read_text()
+    assert text.count("was started as soon as its plan was known; adopted") == 2
+    assert "quick start" not in text and not entries(env)
+    assert "second from one" in done.stdout
+
+
+def test_what_the_supervisor_must_start_itself_is_left_to_it() -> None:
+    from mlaunch.plan.steps import COMPONENTS, EmitEvent, Plan, ProcessSpec, Spawn
+
+    def spec(label: str, **more: object) -> ProcessSpec:
+        return ProcessSpec(label=label, argv=("true",), env={}, env_changes={}, **more)  # type: ignore[arg-type]
+
+    plain = Plan(
+        [Spawn(spec=spec("a")), Spawn(spec=spec("b", emulate_tty=True)), Spawn(spec=spec("c"))]
+    )
+    first, why = quick._first_processes(plain, "1-x", ())
+    assert [f[0] for f in first] == ["a"] and "terminal" in why
+    assert first[0][2] == {"MLAUNCH_RUN_ID": "1-x"}  # the run's marker, as the supervisor adds it
+    # A participant must exist before the first child of a launch with composable nodes.
+    assert quick._first_processes(
+        Plan([Spawn(spec=spec("a"))], needs=set(COMPONENTS)), "1", ()
+    ) == (
+        [],
+        "the launch needs components",
+    )
+    # Only what comes before anything that can act: an event emitted first goes first.
+    event = Plan([EmitEvent(event=object()), Spawn(spec=spec("a"))])
+    assert quick._first_processes(event, "1", ())[0] == []
+    # A process naming the run's folders (a params file) is not in a quick entry.
+    named = Plan([Spawn(spec=spec("a", temp_files=("/run/x.yaml",)))])
+    assert quick._first_processes(named, "1", ("/run",))[0] == []

@@ -23,7 +23,7 @@ from mlaunch.plan.steps import SHARE, Plan
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
     from mlaunch.app.plan_cache import PlanCache
-    from mlaunch.app.quick import QuickStart
+    from mlaunch.app.quick import Prestart
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.launch.launch_description import LaunchDescription
     from mlaunch.launch.launch_description_entity import LaunchDescriptionEntity
@@ -187,11 +187,13 @@ def resolve_for_run(
 # --- the whole pipeline --------------------------------------------------------------------------
 
 
-def launch(opts: Options, attach: Sequence[PartMaker], quick: QuickStart | None = None) -> int:
+def launch(opts: Options, attach: Sequence[PartMaker], quick: Prestart | None = None) -> int:
     """``mlaunch FILE``: load, resolve, then list the arguments, print the plan, or run it.
 
     ``quick``: the quick start of this command line (mlaunch.app.quick): its lifeline and the
     children it started, which the run adopts; else its entry is written once the plan is known.
+    Given (a ``Prestart`` at least: ``mlaunch FILE``), the plan's first processes start as soon
+    as the plan is known, before the supervisor is made.
     """
     from mlaunch.engine.lifeline import Lifeline
 
@@ -226,7 +228,7 @@ def launch(opts: Options, attach: Sequence[PartMaker], quick: QuickStart | None 
             opts, path, description, temp_dir=life.temp_dir, log_dir=log_dir, search=search
         )
         streams_back(path)
-        return run_plan(opts, plan, options, labels, log_dir, life, attach, path)
+        return run_plan(opts, plan, options, labels, log_dir, life, attach, path, quick)
 
 
 def plan_cache(opts: Options) -> PlanCache | None:
@@ -242,10 +244,12 @@ def plan_cache(opts: Options) -> PlanCache | None:
 
 
 def note_quick(
-    quick: QuickStart | None, plan: Plan, life: Lifeline, log_dir: str, cache: PlanCache
+    quick: Prestart | None, plan: Plan, life: Lifeline, log_dir: str, cache: PlanCache
 ) -> None:
     """Write the quick entry of a plan the cache holds, unless this run was quick-started."""
-    if quick is None or quick.found or cache.inputs_data is None:
+    from mlaunch.app.quick import QuickStart
+
+    if not isinstance(quick, QuickStart) or quick.found or cache.inputs_data is None:
         return
     if not quick.note(plan, life.run_id, (life.temp_dir, log_dir), cache.inputs_data):
         cache.debug(f"no quick start: {quick.why_not}")
@@ -256,7 +260,7 @@ def resolve_recorded(
     cache: PlanCache,
     life: Lifeline,
     attach: Sequence[PartMaker],
-    quick: QuickStart | None = None,
+    quick: Prestart | None = None,
 ) -> int:
     """Load and resolve as ``launch`` does, noting every input, and store the plan when the
     recording saw everything it depends on (``--debug`` and ``--print`` say when not)."""
@@ -313,7 +317,7 @@ def run_plan(
     life: Lifeline,
     attach: Sequence[PartMaker],
     path: str,
-    quick: QuickStart | None = None,
+    quick: Prestart | None = None,
 ) -> int:
     """Print the plan (--print), or run it (adopting what ``quick`` started)."""
     if opts.print_plan:
@@ -376,14 +380,12 @@ def supervise(
     attach: Sequence[PartMaker],
     *,
     path: str = "",
-    quick: QuickStart | None = None,
+    quick: Prestart | None = None,
 ) -> int:
     """Run ``plan`` with the lifeline's guard, the printer and ``attach``'s parts; ``path`` is
-    the launch file (the parts' ``Run.launch_file``); ``quick``'s children are adopted."""
-    from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
-    from mlaunch.engine.output import Printer, stdout_is_color_terminal
-    from mlaunch.engine.process import Process
-    from mlaunch.engine.supervisor import Supervisor
+    the launch file (the parts' ``Run.launch_file``); ``quick``'s children are adopted, and
+    when it started none, the plan's first processes start before the supervisor is made
+    (``Prestart.start_first``) unless the run raised its descriptor limit for them."""
     from mlaunch.plan.errors import UsageError
 
     if opts.log_max_bytes is not None and opts.log_max_bytes < 0:
@@ -393,7 +395,15 @@ def supervise(
     from mlaunch.engine import fdlimit
 
     # 500 processes need more descriptors than the common soft limit: raised, or refused now.
-    fdlimit.limit().prepare(len(plan.processes()))
+    limit = fdlimit.limit()
+    limit.prepare(len(plan.processes()))
+    if quick is not None and not quick.children and not limit.raised:
+        quick.start_first(plan, life)
+    from mlaunch.engine.logfiles import DEFAULT_ROTATE_BYTES, DEFAULT_ROTATE_KEEP
+    from mlaunch.engine.output import Printer, stdout_is_color_terminal
+    from mlaunch.engine.process import Process
+    from mlaunch.engine.supervisor import Supervisor
+
     guard, run_id = life.guard, life.run_id
     color = stdout_is_color_terminal(os.environ) if opts.color is None else opts.color
     rotate = DEFAULT_ROTATE_BYTES if opts.log_max_bytes is None else opts.log_max_bytes

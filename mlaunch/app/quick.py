@@ -33,7 +33,7 @@ import sys
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
-    from collections.abc import Mapping, Sequence
+    from collections.abc import Callable, Mapping, Sequence
     from typing import Any
 
     from mlaunch.engine.lifeline import Lifeline
@@ -129,7 +129,18 @@ def key(argv: Sequence[str], environ: Mapping[str, str]) -> str:
 class Child:
     """A process the quick start started: what it was started with, and its ends."""
 
-    __slots__ = ("argv", "cwd", "env", "label", "pid", "started_at", "stderr", "stdin", "stdout")
+    __slots__ = (
+        "argv",
+        "cwd",
+        "env",
+        "how",
+        "label",
+        "pid",
+        "started_at",
+        "stderr",
+        "stdin",
+        "stdout",
+    )
 
     def __init__(
         self,
@@ -147,6 +158,7 @@ class Child:
         self.pid = pid
         self.stdin, self.stdout, self.stderr = fds  # our ends: stdin's write end, the reads
         self.started_at = started_at
+        self.how = ""  # how it was started, for the run's log: "by the quick start" ...
 
     @property
     def fds(self) -> tuple[int, int, int]:
@@ -162,17 +174,110 @@ class Child:
         )
 
 
-class QuickStart:
+class Prestart:
+    """Children started before the supervisor exists, which it adopts where its plan starts
+    them (``take``) or ends (``abandon``); ``life``: the lifeline entered for them, if they
+    entered one (the quick start's)."""
+
+    def __init__(self) -> None:
+        self.life: Lifeline | None = None
+        self.children: dict[str, Child] = {}
+
+    def start_first(self, plan: Plan, life: Lifeline) -> None:
+        """Start ``plan``'s leading processes now, before the supervisor and its parts are
+        made (their imports and set-up are most of a resolved launch's way to its first
+        child); it adopts them as the quick start's. The run's lifeline is settled (mlaunch in
+        its cgroup) first, as the supervisor has it before starting anything."""
+        from mlaunch.engine import spawning
+
+        if not spawning.AVAILABLE:
+            return
+        first, _why = _first_processes(plan, life.run_id, ())
+        if not first:
+            return
+        life.settle()
+        # A Ctrl-C now is the supervisor's to act on, as in its own spawn batch: the starts
+        # stop, and it gets the signal once its handlers are in (its shutdown then stops what
+        # started and says how many did not).
+        life.defer_signals()
+        try:
+            how = "as soon as its plan was known"
+            self._start_all(first, life, (), settled=True, how=how, stop=lambda: life.received)
+        finally:
+            life.pass_signals_on()
+
+    def _start_all(
+        self,
+        first: list[Any],
+        life: Lifeline,
+        rebase: Sequence[tuple[str, str]],
+        *,
+        settled: bool,
+        how: str,
+        stop: Callable[[], object] | None = None,
+    ) -> None:
+        """Start ``first`` (as ``_first_processes`` lists them; ``rebase``: old, new texts),
+        telling the guard, until one cannot start (the supervisor starts it and says why) or
+        ``stop()``. Unless mlaunch was ``settled`` in its cgroup, they are moved in after it."""
+        import time
+
+        from mlaunch.engine.spawning import start
+
+        guard = life.guard
+        for label, argv, env, cwd, grace in first:
+            if stop is not None and stop():
+                break
+            if rebase:
+                env = {name: _rebased(value, rebase) for name, value in env.items()}
+            child = _start(start, label, tuple(argv), env, cwd, time.monotonic)
+            if child is None:
+                break
+            child.how = how
+            self.children[label] = child
+            if guard is not None:
+                guard.watch(child.pid, grace)
+        if guard is not None:
+            guard.flush()
+        if life.cgroup is not None and self.children and not settled:
+            life.cgroup.move_soon([child.pid for child in self.children.values()])
+
+    def has(self, spec: ProcessSpec) -> bool:
+        """Whether a child was started as ``spec``'s label (taken or not yet)."""
+        return spec.label in self.children
+
+    def take(self, spec: ProcessSpec, env: Mapping[str, str]) -> Child | None:
+        """The child started as ``spec`` (the supervisor adopts it), or None; a child of that
+        label started otherwise is ended (its plan changed since the entry was written)."""
+        child = self.children.pop(spec.label, None)
+        if child is None or child.matches(spec, env):
+            return child
+        _end(child, f"started as {spec.label} by an older plan")
+        return None
+
+    def abandon(self, why: str = "its plan does not start it") -> None:
+        """End the children no one adopted (said, with ``why``)."""
+        children, self.children = self.children, {}
+        for child in children.values():
+            _end(child, why)
+
+    def close(self) -> None:
+        """At the program's end: what the run did not adopt is ended (it ended before it could:
+        a bad command line, a signal) and the lifeline left, if the run did not leave it."""
+        self.abandon("the run ended before it took it")
+        if self.life is not None:
+            self.life.__exit__(None, None, None)
+
+
+class QuickStart(Prestart):
     """One run's quick start: its key, and (when its entry was sound) the lifeline it entered
     and the children it started, which the run adopts or ends (``abandon``)."""
 
     def __init__(self, argv: Sequence[str], environ: Mapping[str, str]) -> None:
+        super().__init__()
         self.argv = tuple(argv)
         self.key = key(argv, environ)
         self.folder = cache_folder(environ)
         self.file = os.path.join(self.folder, self.key + SUFFIX)
-        self.life: Lifeline | None = None
-        self.children: dict[str, Child] = {}
         self.found = False  # the entry was sound: its children started (or could not start)
         self.why_not = ""  # why the last plan was not noted ("" when it was)
 
@@ -227,10 +332,6 @@ class QuickStart:
         return entry
 
     def _spawn(self, entry: dict[str, Any], life: Lifeline) -> None:
-        import time
-
-        from mlaunch.engine.spawning import start
-
         # What differs between two runs of the same plan: the run id, the order of the
         # REORDERED variables' entries (the key holds them sorted).
         rebase = [(entry["run_id"], life.run_id)]
@@ -238,41 +339,8 @@ class QuickStart:
             now = os.environ.get(name, "")
             if old and now and old != now:
                 rebase.append((old, now))
-        guard = life.guard
-        for label, argv, env, cwd, grace in entry["first"]:
-            env = {name: _rebased(value, rebase) for name, value in env.items()}
-            child = _start(start, label, tuple(argv), env, cwd, time.monotonic)
-            if child is None:
-                break  # it cannot start: the supervisor starts it, and says why it cannot
-            self.children[label] = child
-            if guard is not None:
-                guard.watch(child.pid, grace)
-        if guard is not None:
-            guard.flush()
-        if life.cgroup is not None and self.children:
-            life.cgroup.move_soon([child.pid for child in self.children.values()])
-
-    def take(self, spec: ProcessSpec, env: Mapping[str, str]) -> Child | None:
-        """The child started as ``spec`` (the supervisor adopts it), or None; a child of that
-        label started otherwise is ended (its plan changed since the entry was written)."""
-        child = self.children.pop(spec.label, None)
-        if child is None or child.matches(spec, env):
-            return child
-        _end(child, f"started as {spec.label} by an older plan")
-        return None
-
-    def abandon(self, why: str = "its plan does not start it") -> None:
-        """End the children no one adopted (said, with ``why``)."""
-        children, self.children = self.children, {}
-        for child in children.values():
-            _end(child, why)
-
-    def close(self) -> None:
-        """At the program's end: what the run did not adopt is ended (it ended before it could:
-        a bad command line, a signal) and the lifeline left, if the run did not leave it."""
-        self.abandon("the run ended before it took it")
-        if self.life is not None:
-            self.life.__exit__(None, None, None)
+        how = "by the quick start, before mlaunch loaded its plan"
+        self._start_all(entry["first"], life, rebase, settled=False, how=how)
 
     # --- the entry ------------------------------------------------------------------------------
 
@@ -353,9 +421,15 @@ def _start(
 ) -> Child | None:
     """Start one child (stdin a pipe we keep open, stdout and stderr pipes); None when its
     program cannot be started (the supervisor tries again and says why)."""
-    stdin_r, stdin_w = os.pipe()
-    out_r, out_w = os.pipe()
-    err_r, err_w = os.pipe()
+    fds: list[int] = []
+    try:
+        for _ in range(3):
+            fds.extend(os.pipe())
+    except OSError:  # out of descriptors: the supervisor raises its limit and starts it
+        for fd in fds:
+            os.close(fd)
+        return None
+    stdin_r, stdin_w, out_r, out_w, err_r, err_w = fds
     try:
         pid = start(argv, env, cwd=cwd, stdin=stdin_r, stdout=out_w, stderr=err_w)
     except OSError:

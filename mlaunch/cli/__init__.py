@@ -23,11 +23,11 @@ if TYPE_CHECKING:
 
     from mlaunch.app.options import Options
     from mlaunch.app.parts import Run
-    from mlaunch.app.quick import QuickStart
+    from mlaunch.app.quick import Prestart
     from mlaunch.engine.part import Part
 
 
-def main(argv: Sequence[str] | None = None, quick: QuickStart | None = None) -> int:
+def main(argv: Sequence[str] | None = None, quick: Prestart | None = None) -> int:
     """``mlaunch ...`` and its subcommands: the one place errors are caught and printed.
 
     ``quick``: the quick start of ``program`` (its children adopted by the run)."""
@@ -59,7 +59,7 @@ def report_error(error: BaseException, debug: bool) -> int:
     return report(error, debug=debug)
 
 
-def run_cli(argv: Sequence[str], quick: QuickStart | None = None) -> int:
+def run_cli(argv: Sequence[str], quick: Prestart | None = None) -> int:
     """``mlaunch FILE ...``: the pipeline with what every run attaches (or ``--check``)."""
     from mlaunch.app import pipeline
     from mlaunch.app.options import parse_options
@@ -71,6 +71,10 @@ def run_cli(argv: Sequence[str], quick: QuickStart | None = None) -> int:
     parts = standard_parts(opts)
     # Before the control socket opens: it answers wait-ready through it.
     parts.insert(0, PartMaker("the readiness checks", _readiness))
+    if quick is None:  # the plan's first processes start before the supervisor is made
+        from mlaunch.app.quick import Prestart
+
+        quick = Prestart()
     return pipeline.launch(opts, parts, quick)
 
 

@@ -60,6 +60,7 @@ class Executor:
         shutdown: Stopping,
         signals: SignalWatch,
         start: Callable[[ProcessSpec], object],
+        running: Callable[[ProcessSpec], bool] = lambda spec: False,
         resolve: Callable[[Deferred, object, bool | None], Plan],
         exit_status: Callable[[int], None],
     ) -> None:
@@ -69,6 +70,9 @@ class Executor:
         self.shutdown = shutdown
         self.signals = signals
         self.start = start
+        # Whether a spec's process runs already (started before the supervisor: adopted by
+        # start() even while shutting down, and then stopped with the rest).
+        self.running = running
         self.resolve = resolve
         self.exit_status = exit_status
         self._skipped = 0  # starts a description asked for while shutting down
@@ -100,7 +104,7 @@ class Executor:
 
     def _step(self, step: Step) -> None:
         if isinstance(step, Spawn):
-            if step.spec is not None and self.shutdown.active:
+            if step.spec is not None and self.shutdown.active and not self.running(step.spec):
                 self._skipped += 1
             elif step.spec is not None:
                 if self.handlers.wants_completion(step.spec.action):

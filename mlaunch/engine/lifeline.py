@@ -113,6 +113,22 @@ class Lifeline:
             self._raising = False  # once: the unwinding must not be cut short by a second one
             raise Stopped(signum)
 
+    def defer_signals(self) -> None:
+        """From now on a stop signal is only recorded (``received``), until ``pass_signals_on``:
+        the supervisor, not made yet, is to act on it (the first processes start before it)."""
+        self._raising = False
+
+    def pass_signals_on(self) -> None:
+        """Stop signals raise again; the ones recorded since ``defer_signals`` are sent again,
+        held in the kernel (blocked, as ``block`` holds them) until the supervisor's handlers
+        take them."""
+        received, self.received = self.received, []
+        if received:
+            signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+            for sig in dict.fromkeys(received):
+                os.kill(os.getpid(), sig)
+        self._raising = True
+
     def check(self) -> None:
         """Raise ``Stopped`` for a signal that arrived while the code running caught it."""
         if self.received and self._raising:

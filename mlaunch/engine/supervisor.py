@@ -89,8 +89,13 @@ if TYPE_CHECKING:
         @property
         def started_at(self) -> float: ...
 
+        @property
+        def how(self) -> str: ...
+
     class Prestarted(Protocol):
         """The children started before the run, for it to adopt (mlaunch.app.quick)."""
+
+        def has(self, spec: ProcessSpec) -> bool: ...
 
         def take(self, spec: ProcessSpec, env: Mapping[str, str]) -> PrestartedChild | None: ...
 
@@ -206,6 +211,7 @@ class Supervisor:
             shutdown=self.shutdown,
             signals=self.signals,
             start=self.start,
+            running=lambda spec: self.prestarted is not None and self.prestarted.has(spec),
             resolve=lambda body, event, shutting_down: resolve_deferred(
                 body,
                 labels=self.labels,
@@ -433,7 +439,10 @@ class Supervisor:
     # --- processes ---------------------------------------------------------------------------
 
     def start(self, spec: ProcessSpec, restarts: int = 0) -> Process | None:
-        if self.shutting_down:
+        child = None
+        if self.prestarted is not None and not restarts:
+            child = self.prestarted.take(spec, self._marker_env)
+        if self.shutting_down and child is None:
             self.records.emit(NotStarted(spec))
             return None
         if spec.prepare is not None:  # a stand-in's page keeps its port on a restart
@@ -443,13 +452,11 @@ class Supervisor:
         if record is None:
             record = self.states[spec.label] = ProcessState(spec.label, spec)
         record.restarts, record.restart_at = restarts, None
-        child = None
-        if self.prestarted is not None and not restarts:
-            child = self.prestarted.take(spec, self._marker_env)
         try:
             if child is not None:
                 process.adopt(child.pid, child.fds, child.started_at)
-                self.records.emit(Said("DEBUG", "launch", f"quick start: {spec.label} adopted"))
+                said = f"{spec.label} (pid {child.pid}) was started {child.how}; adopted"
+                self.records.emit(Said("DEBUG", "launch", said))
             else:
                 self._spawn(process)
         except OSError as e:
