@@ -20,12 +20,18 @@ from __future__ import annotations
 
 import os
 import pickle
-import sys
 import time
 from types import FunctionType
 
 from mlaunch.app.options import cache_wanted
-from mlaunch.app.quick import REORDERED, cache_folder, read_private
+from mlaunch.app.quick import (
+    REORDERED,
+    cache_folder,
+    environment_key,
+    host_key,
+    read_private,
+    write_private,
+)
 from mlaunch.app.quick import SUFFIX as QUICK
 from mlaunch.plan import inputs as plan_inputs
 from mlaunch.ros.files import write_all
@@ -97,36 +103,14 @@ NOT_IN_KEY = frozenset(
 
 def run_key(opts: Options, environ: Mapping[str, str]) -> str:
     """The digest of everything a plan depends on that is known before the launch file is read."""
-    uname = os.uname()
     parts = (
         FORMAT,
         _code_fingerprint(),
-        sys.version,
-        sys.executable,
-        sys.flags,
-        list(sys.path),
-        (uname.nodename, uname.machine, uname.release),
-        (os.getuid(), os.getgid()),
-        os.getcwd(),
-        _environment_key(environ),
+        host_key(),
+        environment_key(environ),
         [(name, value) for name, value in vars(opts).items() if name not in NOT_IN_KEY],
     )
     return plan_inputs.digest(repr(parts).encode("utf-8", "surrogateescape"))
-
-
-def _environment_key(environ: Mapping[str, str]) -> list[tuple[str, str]]:
-    """The environment as the key holds it: every variable but the run id (rebased), the
-    REORDERED ones as their sorted entries."""
-    from mlaunch.engine.proctable import MARKER
-
-    items = []
-    for name, value in sorted(environ.items()):
-        if name == MARKER:
-            continue
-        if name in REORDERED:
-            value = os.pathsep.join(sorted(value.split(os.pathsep)))
-        items.append((name, value))
-    return items
 
 
 def places(temp_dir: str, log_dir: str, run_id: str, environ: Mapping[str, str]) -> tuple[str, ...]:
@@ -338,20 +322,9 @@ class PlanCache:
         problem = self._private_folder()
         if problem:
             return problem  # said with --debug: a home folder that cannot be written is common
-        temporary = f"{self.file}.{os.getpid()}.tmp"
-        try:
-            fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
-            try:
-                write_all(fd, data)
-            finally:
-                os.close(fd)
-            os.replace(temporary, self.file)
-        except OSError as e:
-            try:
-                os.unlink(temporary)
-            except OSError:
-                pass
-            return f"cannot write {self.file}: {e.strerror or e}"
+        problem = write_private(self.file, data)
+        if problem:
+            return problem
         self._prune()
         return ""
 

@@ -91,6 +91,28 @@ def read_private(path: str, limit: int) -> tuple[bytes | None, str]:
         os.close(fd)
 
 
+def write_private(path: str, data: bytes) -> str:
+    """Write a cache entry atomically (a temporary file of mode 0600 renamed) into its folder,
+    which the plan cache made private; why not, or ""."""
+    from mlaunch.ros.files import write_all
+
+    temporary = f"{path}.{os.getpid()}.tmp"
+    try:
+        fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
+        try:
+            write_all(fd, data)
+        finally:
+            os.close(fd)
+        os.replace(temporary, path)
+    except OSError as e:
+        try:
+            os.unlink(temporary)
+        except OSError:
+            pass
+        return f"cannot write {path}: {e.strerror or e}"
+    return ""
+
+
 def eligible(argv: Sequence[str], environ: Mapping[str, str]) -> bool:
     """A command line the quick start may serve: a launch file (or package and file) and
     ``name:=value`` arguments only, the cache wanted, no shell completion."""
@@ -103,27 +125,34 @@ def key(argv: Sequence[str], environ: Mapping[str, str]) -> str:
     """The digest of everything a quick entry is found by (see the module)."""
     from mlaunch.plan.inputs import digest
 
-    env = []
+    parts = (FORMAT, tuple(argv), environment_key(environ), host_key())
+    return digest(repr(parts).encode("utf-8", "surrogateescape"))
+
+
+def environment_key(environ: Mapping[str, str]) -> list[tuple[str, str]]:
+    """The environment as a key holds it: every variable but the run id (rebased), the
+    REORDERED ones as their sorted entries (this run's values replace them where a plan names
+    them)."""
+    items = []
     for name, value in sorted(environ.items()):
         if name == MARKER:
             continue
         if name in REORDERED:
             value = os.pathsep.join(sorted(value.split(os.pathsep)))
-        env.append((name, value))
+        items.append((name, value))
+    return items
+
+
+def host_key() -> tuple[object, ...]:
+    """What a key holds of where the run is: the working folder, the user and group, the
+    computer (name, machine, kernel release) and Python (version, executable, flags, path)."""
     uname = os.uname()
-    parts = (
-        FORMAT,
-        tuple(argv),
+    return (
         os.getcwd(),
-        env,
-        sys.executable,
-        sys.version,
-        sys.flags,
-        list(sys.path),
-        (uname.nodename, uname.machine, uname.release),
         (os.getuid(), os.getgid()),
+        (uname.nodename, uname.machine, uname.release),
+        (sys.version, sys.executable, sys.flags, list(sys.path)),
     )
-    return digest(repr(parts).encode("utf-8", "surrogateescape"))
 
 
 class Child:
@@ -376,22 +405,8 @@ class QuickStart(Prestart):
         }
         rest = marshal.dumps(entry)
         data = FORMAT + inputs.digest(rest).encode("ascii") + b"\n" + rest
-        from mlaunch.ros.files import write_all
-
-        try:
-            os.makedirs(self.folder, mode=0o700, exist_ok=True)
-            temporary = f"{self.file}.{os.getpid()}.tmp"
-            fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
-            try:
-                write_all(fd, data)
-            finally:
-                os.close(fd)
-            os.replace(temporary, self.file)
-        except OSError as e:
-            self.why_not = f"cannot write {self.file}: {e.strerror or e}"
-            return False
-        self.why_not = ""
-        return True
+        self.why_not = write_private(self.file, data)
+        return not self.why_not
 
 
 def prestart(argv: Sequence[str], environ: Mapping[str, str]) -> QuickStart | None:
