@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
-from procutil import clean_env, mlaunch, run_mlaunch, wait_until
+from procutil import clean_env, install_package, mlaunch, run_mlaunch, wait_until
 
 from mlaunch.app import quick
 from mlaunch.plan.inputs import RACY_NS
@@ -211,28 +211,73 @@ def test_a_resolved_run_starts_its_first_processes_before_the_supervisor(
     assert "second from one" in done.stdout
 
 
-def test_what_the_supervisor_must_start_itself_is_left_to_it() -> None:
+def test_what_the_supervisor_must_start_itself_is_left_to_it(tmp_path: Path) -> None:
     from mlaunch.plan.steps import COMPONENTS, EmitEvent, Plan, ProcessSpec, Spawn
 
     def spec(label: str, **more: object) -> ProcessSpec:
-        return ProcessSpec(label=label, argv=("true",), env={}, env_changes={}, **more)  # type: ignore[arg-type]
+        fields: dict[str, object] = {"argv": ("true",), **more}
+        return ProcessSpec(label=label, env={}, env_changes={}, **fields)  # type: ignore[arg-type]
 
     plain = Plan(
         [Spawn(spec=spec("a")), Spawn(spec=spec("b", emulate_tty=True)), Spawn(spec=spec("c"))]
     )
-    first, why = quick._first_processes(plain, "1-x", ())
+    first, why = quick._first_processes(plain, "1-x")
     assert [f[0] for f in first] == ["a"] and "terminal" in why
     assert first[0][2] == {"MLAUNCH_RUN_ID": "1-x"}  # the run's marker, as the supervisor adds it
     # A participant must exist before the first child of a launch with composable nodes.
-    assert quick._first_processes(
-        Plan([Spawn(spec=spec("a"))], needs=set(COMPONENTS)), "1", ()
-    ) == (
-        [],
-        "the launch needs components",
-    )
+    components = Plan([Spawn(spec=spec("a"))], needs=set(COMPONENTS))
+    assert quick._first_processes(components, "1") == ([], "the launch needs components")
     # Only what comes before anything that can act: an event emitted first goes first.
     event = Plan([EmitEvent(event=object()), Spawn(spec=spec("a"))])
-    assert quick._first_processes(event, "1", ())[0] == []
-    # A process naming the run's folders (a params file) is not in a quick entry.
-    named = Plan([Spawn(spec=spec("a", temp_files=("/run/x.yaml",)))])
-    assert quick._first_processes(named, "1", ("/run",))[0] == []
+    assert quick._first_processes(event, "1")[0] == []
+    # In a quick entry, the run's folder only through a params file of the process (written
+    # again in the next run's folder), never the run's log folder.
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "p.yaml").write_text("x: 1\n")
+    params = spec("a", argv=("n", "--params-file", f"{run}/p.yaml"))
+    files: dict[str, bytes] = {}
+    first, _ = quick._first_processes(Plan([Spawn(spec=params)]), "1", str(run), "/log", files)
+    assert len(first) == 1 and files == {"p.yaml": b"x: 1\n"}
+    for argv in ((f"{run}/missing",), (f"{run}",), (f"{run}/../escape",), ("/log/x",)):
+        named = Plan([Spawn(spec=spec("a", argv=("n", *argv)))])
+        assert quick._first_processes(named, "1", str(run), "/log")[0] == [], argv
+
+
+def test_a_node_with_parameters_starts_quick_with_its_params_file(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    prefix = tmp_path / "install"
+    program = (  # copies the file after --params-file
+        '#!/bin/sh\nwhile [ $# -gt 0 ]; do [ "$1" = --params-file ] && cat "$2" > "$OUT/params.$$"; '
+        "shift; done\n"
+    )
+    install_package(prefix, "qpkg", {"show": program})
+    path = tmp_path / "node.launch.py"
+    path.write_text(
+        "from launch import LaunchDescription\n"
+        "from launch_ros.actions import Node\n"
+        "def generate_launch_description():\n"
+        "    return LaunchDescription([Node(package='qpkg', executable='show', name='n',\n"
+        "                                   parameters=[{'rate': 5, 'frame': 'map'}])])\n"
+    )
+    env = clean_env(
+        XDG_CACHE_HOME=str(tmp_path / "cache"),
+        ROS_LOG_DIR=str(tmp_path / "log"),
+        AMENT_PREFIX_PATH=str(prefix),
+        OUT=str(out),
+    )
+    env.pop("MLAUNCH_NO_CACHE", None)
+    settled(path, tmp_path, prefix)
+    seen = []
+    for _ in range(2):
+        logs = run_logs(tmp_path / "log")
+        done = run_mlaunch(str(path), env=env, timeout=60)
+        assert done.returncode == 0, done.stdout + done.stderr
+        (log_dir,) = run_logs(tmp_path / "log") - logs
+        text = (log_dir / "launch.log").read_text()
+        seen.append("was started by the quick start" in text)
+        (params,) = out.glob("params.*")
+        assert "rate: 5" in params.read_text() and "frame: map" in params.read_text()
+        params.unlink()
+    assert seen == [False, True]

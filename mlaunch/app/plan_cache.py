@@ -30,11 +30,11 @@ from mlaunch.app.quick import (
     environment_key,
     host_key,
     read_private,
+    write_files,
     write_private,
 )
 from mlaunch.app.quick import SUFFIX as QUICK
 from mlaunch.plan import inputs as plan_inputs
-from mlaunch.ros.files import write_all
 
 TYPE_CHECKING = False  # mypy treats this name as typing.TYPE_CHECKING; typing costs ~4 ms
 if TYPE_CHECKING:
@@ -226,7 +226,7 @@ class PlanCache:
         except Exception as e:  # a class gone from the code, a damaged pickle: never fatal
             self._ignore(f"cannot be read back ({type(e).__name__}: {e})")
             return None
-        _write_made_files(made, temp_dir)
+        write_files(temp_dir, made)
         self._touch()
         self.debug(
             f"the plan of {path} from {self.file} ({entry.inputs} inputs unchanged;"
@@ -467,17 +467,6 @@ def _made_files(temp_dir: str) -> dict[str, bytes]:
             with open(full, "rb") as f:
                 made[os.path.relpath(full, temp_dir)] = f.read()
     return made
-
-
-def _write_made_files(made: dict[str, bytes], temp_dir: str) -> None:
-    for relative, data in made.items():
-        full = os.path.join(temp_dir, relative)
-        os.makedirs(os.path.dirname(full), mode=0o700, exist_ok=True)
-        fd = os.open(full, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
-        try:
-            write_all(fd, data)
-        finally:
-            os.close(fd)
 
 
 class _ModulesPickler(pickle.Pickler):

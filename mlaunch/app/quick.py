@@ -39,7 +39,7 @@ if TYPE_CHECKING:
     from mlaunch.engine.lifeline import Lifeline
     from mlaunch.plan.steps import Plan, ProcessSpec
 
-FORMAT = b"mlaunch quick start 2\n"
+FORMAT = b"mlaunch quick start 3\n"
 SUFFIX = ".quick"
 MAX_ENTRY_BYTES = 4 << 20
 NO_CACHE_ENV = "MLAUNCH_NO_CACHE"
@@ -193,14 +193,18 @@ class Child:
     def fds(self) -> tuple[int, int, int]:
         return (self.stdin, self.stdout, self.stderr)
 
-    def matches(self, spec: ProcessSpec, env: Mapping[str, str]) -> bool:
-        """Whether ``spec`` (with the run's ``env`` added) is what this child was started as."""
-        return (
-            spec.label == self.label
-            and _argv(spec) == self.argv
-            and spec.cwd == self.cwd
-            and {**spec.env, **env} == self.env
-        )
+    def difference(self, spec: ProcessSpec, env: Mapping[str, str]) -> str:
+        """How ``spec`` (with the run's ``env`` added) differs from what this child was started
+        as ("" when it does not)."""
+        if spec.label != self.label:
+            return f"its label is {spec.label}"
+        if _argv(spec) != self.argv:
+            return f"its command line is {list(_argv(spec))}"
+        if spec.cwd != self.cwd:
+            return f"its folder is {spec.cwd}"
+        full = {**spec.env, **env}
+        names = sorted(n for n in {*full, *self.env} if full.get(n) != self.env.get(n))
+        return f"its environment differs in {', '.join(names)}" if names else ""
 
 
 class Prestart:
@@ -221,7 +225,7 @@ class Prestart:
 
         if not spawning.AVAILABLE:
             return
-        first, _why = _first_processes(plan, life.run_id, ())
+        first, _why = _first_processes(plan, life.run_id)
         if not first:
             return
         life.settle()
@@ -257,7 +261,9 @@ class Prestart:
             if stop is not None and stop():
                 break
             if rebase:
+                argv = [_rebased(arg, rebase) for arg in argv]
                 env = {name: _rebased(value, rebase) for name, value in env.items()}
+                cwd = None if cwd is None else _rebased(cwd, rebase)
             child = _start(start, label, tuple(argv), env, cwd, time.monotonic)
             if child is None:
                 break
@@ -278,9 +284,12 @@ class Prestart:
         """The child started as ``spec`` (the supervisor adopts it), or None; a child of that
         label started otherwise is ended (its plan changed since the entry was written)."""
         child = self.children.pop(spec.label, None)
-        if child is None or child.matches(spec, env):
+        if child is None:
+            return None
+        difference = child.difference(spec, env)
+        if not difference:
             return child
-        _end(child, f"started as {spec.label} by an older plan")
+        _end(child, f"the run's plan starts it otherwise ({difference})")
         return None
 
     def abandon(self, why: str = "its plan does not start it") -> None:
@@ -364,6 +373,9 @@ class QuickStart(Prestart):
         # What differs between two runs of the same plan: the run id, the order of the
         # REORDERED variables' entries (the key holds them sorted).
         rebase = [(entry["run_id"], life.run_id)]
+        if entry["files"]:
+            write_files(life.temp_dir, entry["files"])
+            rebase.append((entry["temp_dir"], life.temp_dir))
         for name, old in entry["reordered"].items():
             now = os.environ.get(name, "")
             if old and now and old != now:
@@ -373,11 +385,13 @@ class QuickStart(Prestart):
 
     # --- the entry ------------------------------------------------------------------------------
 
-    def note(self, plan: Plan, run_id: str, places: Sequence[str], inputs_data: Any) -> bool:
+    def note(self, plan: Plan, run_id: str, places: tuple[str, str], inputs_data: Any) -> bool:
         """Write the quick entry of ``plan`` (its processes started in the run ``run_id``, whose
         temp and log folders are ``places``; ``inputs_data``: what its resolution read, as the
         plan cache holds it); False (``why_not`` says why) when it has none to write."""
-        first, why = _first_processes(plan, run_id, [p for p in places if p])
+        temp_dir, log_dir = places
+        files: dict[str, bytes] = {}
+        first, why = _first_processes(plan, run_id, temp_dir, log_dir, files)
         if not first:
             self.why_not = why
             return False
@@ -400,6 +414,8 @@ class QuickStart(Prestart):
             "inputs": inputs_data,
             "run_id": run_id,
             "reordered": {name: os.environ.get(name, "") for name in REORDERED},
+            "temp_dir": temp_dir,
+            "files": files,
             "first": first,
             "made": time.time_ns(),
         }
@@ -513,9 +529,17 @@ def _rebased(text: str, rebase: Sequence[tuple[str, str]]) -> str:
     return text
 
 
-def _first_processes(plan: Plan, run_id: str, places: Sequence[str]) -> tuple[list[Any], str]:
+def _first_processes(
+    plan: Plan,
+    run_id: str,
+    temp_dir: str = "",
+    log_dir: str = "",
+    files: dict[str, bytes] | None = None,
+) -> tuple[list[Any], str]:
     """The processes ``plan`` starts before anything else happens, as the entry holds them;
-    or ([], why there are none)."""
+    or ([], why there are none). For a quick entry, ``temp_dir`` and ``log_dir`` are the run's
+    folders: a process may name a file in the first (a params file: ``files`` gets its bytes,
+    by its path in the folder, to be written again in the next run's), never the second."""
     from mlaunch.plan.steps import AddHandler, Log, Spawn, StartTimer
 
     if plan.needs:
@@ -527,7 +551,7 @@ def _first_processes(plan: Plan, run_id: str, places: Sequence[str]) -> tuple[li
         if not isinstance(step, Spawn) or step.spec is None:
             break
         spec = step.spec
-        why = _not_quick(spec, places)
+        why = _not_quick(spec, temp_dir, log_dir, files)
         if why:
             return first, why
         env = {**spec.env, MARKER: run_id}  # as the supervisor starts it (its marker)
@@ -535,18 +559,65 @@ def _first_processes(plan: Plan, run_id: str, places: Sequence[str]) -> tuple[li
     return first, "the launch starts no process first"
 
 
-def _not_quick(spec: ProcessSpec, places: Sequence[str]) -> str:
-    """Why the quick start cannot start ``spec`` itself ("" when it can)."""
+def _not_quick(
+    spec: ProcessSpec, temp_dir: str, log_dir: str, files: dict[str, bytes] | None
+) -> str:
+    """Why the quick start cannot start ``spec`` itself ("" when it can); the run's files it
+    names go in ``files``."""
     if spec.emulate_tty:
         return f"{spec.label} wants a terminal"
     if spec.machine is not None or spec.standin or spec.prepare is not None:
         return f"{spec.label} is started otherwise"
-    if spec.temp_files or spec.announce is not None:
-        return f"{spec.label} has files of the run"
+    if spec.announce is not None:
+        return f"{spec.label} is told what to do on its stdin"
     texts = [*spec.argv, *spec.env.values(), spec.cwd or ""]
-    if any(place in text for place in places for text in texts):
-        return f"{spec.label} names the run's folders"
+    if log_dir and any(log_dir in text for text in texts):
+        return f"{spec.label} names the run's log folder"
+    if not temp_dir:
+        return ""
+    # A file of the run's folder it names to the end of an argument (--params-file PATH,
+    # __params:=PATH) is written again in the new run's folder; nothing else of the folder.
+    named = {}
+    for text in texts:
+        start = text.find(temp_dir + os.sep)
+        if start < 0:
+            if temp_dir in text:
+                return f"{spec.label} names the run's folder"
+            continue
+        path = text[start:]
+        relative = path[len(temp_dir) + 1 :]
+        if ".." in relative.split(os.sep) or temp_dir in relative:
+            return f"{spec.label} names the run's folder"
+        try:
+            with open(path, "rb") as f:
+                data = f.read()
+        except OSError:
+            return f"{spec.label} names {path}, which cannot be read"
+        named[relative] = data
+    if files is not None:
+        files.update(named)
     return ""
+
+
+def write_files(folder: str, files: Mapping[str, bytes]) -> None:
+    """Write the run's params files (relative path: bytes) into its ``folder`` (0700 folders,
+    0600 files); one already there with the same bytes is left (the quick start wrote it)."""
+    from mlaunch.ros.files import write_all
+
+    for relative, data in files.items():
+        full = os.path.join(folder, relative)
+        os.makedirs(os.path.dirname(full), mode=0o700, exist_ok=True)
+        try:
+            fd = os.open(full, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_CLOEXEC, 0o600)
+        except FileExistsError:
+            with open(full, "rb") as f:
+                if f.read() == data:
+                    continue
+            raise
+        try:
+            write_all(fd, data)
+        finally:
+            os.close(fd)
 
 
 def _code_identities() -> list[tuple[str, tuple[int, ...] | None]] | None:
