@@ -668,16 +668,26 @@ class Bench:
         self.node_startup(venv, floors.get(1, []))
 
     def repeated_startup(
-        self, venv: Venv, path: Path, n: int, floor_argv: list[str], refs: list[dict[str, float]]
+        self,
+        venv: Venv,
+        path: Path,
+        n: int,
+        floor_argv: list[str],
+        refs: list[dict[str, float]],
+        *,
+        kind: str = "py",
+        more_env: dict[str, str] | None = None,
+        inputs: Sequence[Path] = (),
     ) -> None:
         """A repeated start as a user has it: the plan cache on (a cache folder of the run's
         own), so the quick start (mlaunch.app.quick) starts the children; the floor again,
         alternating. Two runs first, not measured: the first resolves and stores the plan and
-        the quick entry, the second is the first quick start (its bytecode written)."""
-        env = {**self.env, "XDG_CACHE_HOME": str(self.launches / "cache")}
+        the quick entry, the second is the first quick start (its bytecode written).
+        ``kind``: the rows' name for the launch; ``inputs``: files it reads besides its own."""
+        env = {**self.env, "XDG_CACHE_HOME": str(self.launches / "cache"), **(more_env or {})}
         env.pop("MLAUNCH_NO_CACHE", None)
         # An entry is written only for files settled two seconds (mlaunch.plan.inputs.RACY_NS).
-        newest = max(p.stat().st_ctime for p in (path, path.parent))
+        newest = max(p.stat().st_ctime for p in (path, path.parent, *inputs))
         time.sleep(max(0.0, newest + 2.2 - time.time()))
         samples: list[dict[str, float]] = []
         floors: list[dict[str, float]] = []
@@ -690,14 +700,16 @@ class Bench:
                     floors.append(floor)
                     samples.append(one)
         except BenchError as e:
-            self.results.skip("startup", venv.name, f"py N={n} repeated", str(e))
+            self.results.skip("startup", venv.name, f"{kind} N={n} repeated", str(e))
             return
-        params = {"format": "py", "n": n, "repeated": True}
+        params = {"format": "py", "n": n, "repeated": True, "kind": kind}
         key = "first" if n == 1 else "all"
         what = "first child running" if n == 1 else f"all {n} children running"
-        rows = [(f"{what}, py, repeated start (quick start)", key, "s")]
+        rows = [(f"{what}, {kind}, repeated start (quick start)", key, "s")]
         if n == 1:
-            rows.append(("CPU until the first child runs, py, repeated start", "first_cpu", "s"))
+            rows.append(
+                (f"CPU until the first child runs, {kind}, repeated start", "first_cpu", "s")
+            )
         for name, field_name, unit in rows:
             self.results.rows.append(
                 Row(
@@ -751,6 +763,22 @@ class Bench:
         except BenchError as e:
             self.results.skip("startup", venv.name, "py one Node", str(e))
             return
+        self.repeated_startup(
+            venv,
+            path,
+            1,
+            [
+                str(venv.python),
+                str(HERE / "floor_spawn.py"),
+                "1",
+                str(self.scripts.ready),
+                str(self.fifo),
+            ],
+            self.reference_samples("py one Node"),
+            kind="py, one Node",
+            more_env={"AMENT_PREFIX_PATH": str(prefix)},
+            inputs=[p for p in prefix.rglob("*")],
+        )
         self.results.rows.append(
             Row(
                 "startup",
