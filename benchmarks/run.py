@@ -1834,10 +1834,34 @@ README_BEGIN = "<!-- benchmarks/run.py --readme: begin -->"
 README_END = "<!-- benchmarks/run.py --readme: end -->"
 # (what the README calls it, the row's group and name in the results); ros venv first.
 README_ROWS = (
-    ("first child running, one-process launch", "startup", "first child running, py, N=1"),
+    (
+        "first child running, one-process launch, resolved",
+        "startup",
+        "first child running, py, N=1",
+    ),
     ("its CPU until then (from exec)", "startup", "CPU until the first child runs, py, N=1"),
-    ("first child running, one-Node launch", "startup", "first child running, py, one Node"),
-    ("all 100 children running", "startup", "all 100 children running, py"),
+    (
+        "the same, a repeated start (quick start)",
+        "startup",
+        "first child running, py, repeated start (quick start)",
+    ),
+    ("its CPU until then", "startup", "CPU until the first child runs, py, repeated start"),
+    (
+        "first child running, one-Node launch, resolved",
+        "startup",
+        "first child running, py, one Node",
+    ),
+    (
+        "the same, a repeated start (quick start)",
+        "startup",
+        "first child running, py, one Node, repeated start (quick start)",
+    ),
+    ("all 100 children running, resolved", "startup", "all 100 children running, py"),
+    (
+        "the same, a repeated start (quick start)",
+        "startup",
+        "all 100 children running, py, repeated start (quick start)",
+    ),
     ("100 children gone after Ctrl-C", "shutdown", "SIGINT until all gone, N=100"),
     ("peak memory with 100 children", "memory", "peak RSS (VmHWM), 100 children"),
     ("lines/s from 4 children to a pipe", "output", "lines to its stdout (a pipe)"),
