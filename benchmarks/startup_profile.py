@@ -58,11 +58,17 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
 
     def _setup():
         import mlaunch.cli
-        _mark("import mlaunch.cli (argparse, options)")
+        _mark("import mlaunch.cli")
         import mlaunch.app.pipeline as pipeline
         import mlaunch.engine.lifeline as lifeline
-        _mark("import app.pipeline, engine.lifeline")
-        _wrap(mlaunch.cli, "parse_options", "parse the command line")
+        _mark("import app.pipeline (argparse, options), engine.lifeline")
+        try:  # imported where it is used, since the quick start
+            import mlaunch.app.options as options
+        except ImportError:
+            options = mlaunch.cli
+        if not hasattr(options, "parse_options"):
+            options = mlaunch.cli
+        _wrap(options, "parse_options", "parse the command line")
         _wrap(lifeline.Lifeline, "__enter__", "lifeline (params folder, cgroup, guard fork)")
         _wrap(pipeline, "plan_cache", "plan cache: open")
         _wrap(pipeline, "load_file", "load the launch file")
@@ -131,7 +137,7 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
                 spawn = spawning.start
 
                 def early(*a, **k):
-                    _mark("supervise: the descriptor limit, the first spawn's set-up")
+                    _mark("supervise: the descriptor limit, the first spawns' set-up")
                     result = spawn(*a, **k)
                     _mark("spawn of the first child")
                     spawning.start = spawn

@@ -501,12 +501,14 @@ def test_startup_profile_follows_mlaunch_to_its_first_child(tmp_path: Path) -> N
     found = startup_profile.profile([sys.executable, "-m", "mlaunch", str(path)], env, 1)
     steps = [
         "interpreter and site (from exec)",
-        "import mlaunch.cli (argparse, options)",
+        "import mlaunch.cli",
+        "import app.pipeline (argparse, options), engine.lifeline",
         "parse the command line",
         "lifeline (params folder, cgroup, guard fork)",
         "load the launch file",
         "resolve",
-        "supervisor: imports, set-up, parts",
+        # The first processes start before the supervisor is made (mlaunch.app.quick).
+        "supervise: the descriptor limit, the first spawns' set-up",
         "spawn of the first child",
     ]
     assert [s for s in steps if s not in found] == []

@@ -273,6 +273,13 @@ class Prestart:
                 guard.watch(child.pid, grace)
         if guard is not None:
             guard.flush()
+        if self.children:
+            # After them, not before (ctypes costs milliseconds): a daemon among them that
+            # forks away while the supervisor is being made is re-parented to mlaunch, whose
+            # supervisor finds it (it becomes the subreaper again itself, as in every run).
+            from mlaunch.engine.strays import set_subreaper
+
+            set_subreaper(True)
         if life.cgroup is not None and self.children and not settled:
             life.cgroup.move_soon([child.pid for child in self.children.values()])
 

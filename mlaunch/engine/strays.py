@@ -29,6 +29,18 @@ STRAY_GRACE = 2.0
 PR_SET_CHILD_SUBREAPER = 36
 
 
+def set_subreaper(on: bool) -> bool:
+    """Make this process the subreaper of its descendants (or not): an orphan among them is
+    re-parented to it, not to init. Whether the kernel took it."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        return bool(libc.prctl(PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0) == 0)
+    except (OSError, AttributeError):
+        return False
+
+
 class Strays:
     """Finds and ends one run's stray processes (SIGTERM, then SIGKILL after ``grace``).
 
@@ -70,14 +82,7 @@ class Strays:
 
     def set_subreaper(self, on: bool) -> None:
         """As subreaper, orphaned descendants are re-parented to mlaunch, not to init."""
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            ok = libc.prctl(PR_SET_CHILD_SUBREAPER, int(on), 0, 0, 0) == 0
-        except (OSError, AttributeError):
-            ok = False
-        self.subreaper = ok and on
+        self.subreaper = set_subreaper(on) and on
 
     def a_child_has_exited(self) -> bool:
         """Whether a child is already a zombie (exited before we became subreaper)."""
