@@ -128,23 +128,37 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
 
         def first_spawn(*args, **kwargs):
             _mark("before supervise")
-            sys.meta_path.insert(0, SupervisorHook())
-            try:  # the plan's first processes start before the supervisor is made
+            try:  # every child starts through it (before the supervisor is made, or by it)
                 import mlaunch.engine.spawning as spawning
             except ImportError:
                 spawning = None
-            if spawning is not None:
-                spawn = spawning.start
+            if spawning is None or not getattr(spawning, "AVAILABLE", False):
+                sys.meta_path.insert(0, SupervisorHook())  # a revision that Popen()s
+                return supervise(*args, **kwargs)
+            spawn = spawning.start
+            count = [0]
 
-                def early(*a, **k):
-                    _mark("supervise: the descriptor limit, the first spawns' set-up")
-                    result = spawn(*a, **k)
+            def counted(*a, **k):
+                count[0] += 1
+                if count[0] == 1:
+                    made = "mlaunch.engine.supervisor" in sys.modules
+                    _mark(
+                        "supervisor: imports, set-up, parts"
+                        if made
+                        else "supervise: the descriptor limit, the first spawns' set-up"
+                    )
+                result = spawn(*a, **k)
+                if count[0] == 1:
                     _mark("spawn of the first child")
-                    spawning.start = spawn
-                    finish()
+                if count[0] < _children:
                     return result
+                if _children > 1:
+                    _mark(f"spawns of children 2 to {_children}")
+                spawning.start = spawn
+                finish()
+                return result
 
-                spawning.start = early
+            spawning.start = counted
             return supervise(*args, **kwargs)
 
         pipeline.supervise = first_spawn
