@@ -319,6 +319,7 @@ def test_garbage_and_mangled_datagrams_are_dropped_without_an_exception(
     for noise in (b"", b"RTPS", b"RTPS\x02\x03" + bytes(14), chance.randbytes(65507)):
         assert participant.receive(noise) in (True, False)
     assert len(participant.remotes) <= rtps.MAX_PARTICIPANTS
+    assert participant.error == ""  # each was dropped where the parser expects bad input
 
 
 def test_a_reply_for_another_client_or_an_unknown_request_is_ignored(

@@ -414,6 +414,7 @@ class Participant:
         self.announced: dict[bytes, list[tuple[int, bytes]]] = {PUB_WRITER: [], SUB_WRITER: []}
         self.count = 0
         self.closed = threading.Event()
+        self.error = ""  # the last unexpected failure it lived through (the tests look)
         self.unicast, self.port = self._bind_unicast()
         self.multicast = self._bind_multicast() if scope == "SUBNET" else None
         self.addresses = ["127.0.0.1"]
@@ -582,16 +583,19 @@ class Participant:
         try:
             while not self.closed.is_set():
                 now = time.monotonic()
-                if now >= next_announce:
-                    self._send(self.spdp, self._peers())
-                    announced += 1
-                    # quick at first (a container just started finds us at once), then slow
-                    next_announce = now + (0.1 * announced if announced < 5 else ANNOUNCE)
-                    self._expire(now)
-                if now >= next_beat:
-                    with self.lock:
-                        self._beat()
-                    next_beat = now + HEARTBEAT
+                try:
+                    if now >= next_announce:
+                        announced += 1
+                        # quick at first (a container just started finds us at once), then slow
+                        next_announce = now + (0.1 * announced if announced < 5 else ANNOUNCE)
+                        self._send(self.spdp, self._peers())
+                        self._expire(now)
+                    if now >= next_beat:
+                        next_beat = now + HEARTBEAT
+                        with self.lock:
+                            self._beat()
+                except Exception as e:  # the loads wait on this thread: it lives on
+                    self.error = f"{type(e).__name__}: {e}"
                 wait = max(0.0, min(next_announce, next_beat) - time.monotonic())
                 for key, _ in selector.select(min(wait, 0.2)):
                     self._drain(key.fileobj)  # type: ignore[arg-type]
@@ -612,6 +616,9 @@ class Participant:
             with self.lock:
                 self._message(data)
         except (ValueError, struct.error, IndexError, KeyError):  # UnicodeDecodeError too
+            return False
+        except Exception as e:  # a case the parser missed: dropped all the same
+            self.error = f"{type(e).__name__}: {e}"
             return False
         return True
 
