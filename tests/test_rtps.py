@@ -209,21 +209,23 @@ def test_the_discovery_range_is_rcls(environ: dict[str, str], scope: str | None)
 
 
 def test_the_driver_takes_rtps_without_importing_rclpy() -> None:
-    from mlaunch.parts.components import make_link
+    from mlaunch.parts.components import _describe, make_link
     from mlaunch.parts.loadnode_links import RtpsLink
 
     link = make_link({"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}, [], 0)
     assert isinstance(link, RtpsLink) and link.scope == "LOCALHOST"
+    assert _describe(link) == "LoadNode requests go over RTPS (domain 0, discovery LOCALHOST)"
 
 
 @requires_interfaces
 def test_the_driver_takes_rclpy_when_told() -> None:
-    from mlaunch.parts.components import make_link
+    from mlaunch.parts.components import _describe, make_link
     from mlaunch.parts.loadnode_links import RclpyLink
 
     link = make_link({"MLAUNCH_LOADER": "rclpy"}, [], 0)
     try:
         assert isinstance(link, RclpyLink)
+        assert _describe(link) == "LoadNode requests go through rclpy (MLAUNCH_LOADER=rclpy)"
     finally:
         link.close()
 

@@ -418,7 +418,8 @@ def make_link(environ: Mapping[str, str], processes: list[dict[str, str]], domai
     else rclpy's; ``environ`` is the launcher's, ``processes`` the launched processes'."""
     from mlaunch.parts.rtps import discovery_range, unusable
 
-    if not unusable(environ, processes):
+    why = unusable(environ, processes)
+    if not why:
         from mlaunch.parts.loadnode_links import RtpsLink
 
         return RtpsLink(domain, discovery_range(environ) or "SUBNET")
@@ -427,12 +428,21 @@ def make_link(environ: Mapping[str, str], processes: list[dict[str, str]], domai
 
         from mlaunch.parts.loadnode_links import rclpy_link
 
-        return rclpy_link(domain)
+        link = rclpy_link(domain)
     except ImportError as e:
         raise MlaunchError(
-            f"composable nodes are loaded with rclpy and composition_interfaces ({e}):"
-            " run ./scripts/setup, or source a ROS 2 installation"
+            f"composable nodes are loaded with rclpy here ({why}), which needs rclpy and"
+            f" composition_interfaces ({e}): run ./scripts/setup, or source a ROS 2 installation"
         ) from e
+    link.reason = why
+    return link
+
+
+def _describe(link: Any) -> str:
+    """How this run's loads are sent (a --debug line)."""
+    if link.name == "rtps":
+        return f"LoadNode requests go over RTPS (domain {link.domain}, discovery {link.scope})"
+    return f"LoadNode requests go through rclpy ({link.reason})"
 
 
 def _note(component: Component, result: LoadResult) -> None:
@@ -474,6 +484,7 @@ class ComponentDriver(Part):
         )
         # The participant (and rclpy's loader node), here on the run's thread (the lean
         # participant's setting is in os.environ while it is made; no one spawns meanwhile).
+        self._say("DEBUG", _describe(link))
         try:
             self.loader.prepare()
         except OSError as e:  # RTPS: no port of the domain free, no UDP at all

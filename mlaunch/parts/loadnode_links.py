@@ -104,6 +104,7 @@ class RclpyLink:
 
     def __init__(self, context: Any) -> None:
         self.context = context  # an initialised rclpy Context
+        self.reason = ""  # why not RTPS (mlaunch.parts.rtps.unusable)
         # The node every client belongs to and its executor (made at the first load); held
         # by whichever thread spins it, or makes or destroys a client.
         self._shared: tuple[Any, Any] | None = None
