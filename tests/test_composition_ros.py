@@ -479,3 +479,52 @@ def test_a_request_larger_than_a_datagram_arrives_whole(
     assert [r.success for r in driver.results] == [True]
     assert wait_until(recorded(container, 1), 10)
     assert json.loads(container.stdout().splitlines()[0]) == as_lists(request)
+
+
+def test_a_flood_of_garbage_on_the_rtps_port_does_not_stall_a_load(
+    ros_env: dict[str, str], spawn: Callable[..., Proc]
+) -> None:
+    """Datagrams of noise and truncated RTPS sent to the launcher's discovery port as fast as
+    a thread can while it discovers the container and loads: the load completes."""
+    import os
+    import socket
+    import threading
+
+    from mlaunch.parts.components import ComponentLoader
+    from mlaunch.parts.loadnode_links import RtpsLink
+
+    link = RtpsLink(int(ros_env["ROS_DOMAIN_ID"]), "LOCALHOST")
+    lines: list[tuple[str, str]] = []
+    driver = ComponentLoader(link, lambda *line: lines.append(line))
+    link.prepare()
+    port = link._made().port
+    done = threading.Event()
+    sent = [0]
+
+    def flood() -> None:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        noise = [os.urandom(n) for n in (0, 7, 20, 300, 1400)]
+        noise += [b"RTPS\x02\x03\x01\x0f" + os.urandom(12) + os.urandom(n) for n in (4, 40, 900)]
+        while not done.is_set():
+            for data in noise:
+                try:
+                    sock.sendto(data, ("127.0.0.1", port))
+                    sent[0] += 1
+                except OSError:
+                    pass
+        sock.close()
+
+    flooder = threading.Thread(target=flood, daemon=True)
+    flooder.start()
+    try:
+        container = spawn([sys.executable, RECORDER, "--ros-args", "-r", "__node:=fbox"], "rec")
+        driver.start(LoadComponents("t", "/fbox", (LoadRequest("p", "p::A", "a"),)))
+        assert driver.join(60.0), stalled(container, lines)
+        assert [r.success for r in driver.results] == [True]
+    finally:
+        done.set()
+        flooder.join(5.0)
+        driver.stop.set()
+        driver.join(5.0)
+        driver.close()
+    assert sent[0] > 1000
