@@ -415,11 +415,11 @@ class Participant:
         self.count = 0
         self.closed = threading.Event()
         self.error = ""  # the last unexpected failure it lived through (the tests look)
-        self.unicast, self.port = self._bind_unicast()
-        self.multicast = self._bind_multicast() if scope == "SUBNET" else None
         self.addresses = ["127.0.0.1"]
         if scope == "SUBNET":
             self.addresses = _interface_addresses() or ["127.0.0.1"]
+        self.unicast, self.port = self._bind_unicast()
+        self.multicast = self._bind_multicast() if scope == "SUBNET" else None
         self.spdp = self._spdp()
         self._thread = threading.Thread(target=self._run, name="rtps", daemon=True)
         self._thread.start()
@@ -450,11 +450,14 @@ class Participant:
         if hasattr(socket, "SO_REUSEPORT"):
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
         sock.bind(("", PB + DG * self.domain + D0))
-        group = socket.inet_aton(MULTICAST) + socket.inet_aton("0.0.0.0")
-        try:
-            sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group)
-        except OSError:
-            pass  # no multicast route: unicast answers still come
+        # The group on every interface, as Fast DDS joins it (a container on another subnet
+        # of this host is heard too).
+        for address in ["0.0.0.0", *self.addresses]:
+            group = socket.inet_aton(MULTICAST) + socket.inet_aton(address)
+            try:
+                sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, group)
+            except OSError:
+                pass  # joined already (the default interface), or no multicast there
         _buffers(sock)
         sock.setblocking(False)
         self.unicast.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
@@ -462,10 +465,25 @@ class Participant:
 
     def _send(self, data: bytes, addresses: list[tuple[str, int]]) -> None:
         for address in addresses:
+            if address[0] == MULTICAST:
+                self._send_multicast(data, address)
+                continue
             try:
                 self.unicast.sendto(data, address)
             except OSError:
                 pass  # a peer gone, a full buffer: reliability sends again
+
+    def _send_multicast(self, data: bytes, address: tuple[str, int]) -> None:
+        """Out of every interface, as Fast DDS sends its announcements (only this participant's
+        thread, and ``close`` after it, send to the group)."""
+        for interface in self.addresses:
+            try:
+                self.unicast.setsockopt(
+                    socket.IPPROTO_IP, socket.IP_MULTICAST_IF, socket.inet_aton(interface)
+                )
+                self.unicast.sendto(data, address)
+            except OSError:
+                pass  # no multicast out of this one: the others, and unicast, still go
 
     def _peers(self) -> list[tuple[str, int]]:
         """Where this participant's periodic announcement goes: LOCALHOST, the discovery ports
