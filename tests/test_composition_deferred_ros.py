@@ -503,3 +503,25 @@ def test_the_driver_loads_through_rclpy_when_rtps_cannot_start(
     h.printer.flush()
     assert "the RTPS loader could not start (no free RTPS port" in h.text
     assert "loading through rclpy" in h.text
+
+
+def test_an_unknown_loader_choice_is_warned_and_rclpy_loads(
+    ros_env: dict[str, str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from test_supervision import Harness
+
+    from mlaunch.launch_ros.composition import LoadComponents
+    from mlaunch.launch_ros.load_request import LoadRequest
+    from mlaunch.parts.components import ComponentDriver
+    from mlaunch.plan.steps import Plan
+
+    monkeypatch.setenv("MLAUNCH_LOADER", "rcply")
+    request = LoadRequest("p", "p::A", "a")
+    h = Harness(Plan(steps=[LoadComponents("x.launch.py:1", "/nobody", (request,))]))
+    driver = ComponentDriver(h.sup)
+    try:
+        assert driver.loader.link.name == "rclpy"
+    finally:
+        driver.close()
+    h.printer.flush()
+    assert "MLAUNCH_LOADER='rcply' is not 'rtps' or 'rclpy': loading through rclpy" in h.text

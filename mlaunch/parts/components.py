@@ -485,6 +485,8 @@ class ComponentDriver(Part):
         # The participant (and rclpy's loader node), here on the run's thread (the lean
         # participant's setting is in os.environ while it is made; no one spawns meanwhile).
         self._say("DEBUG", _describe(link))
+        if link.name == "rclpy" and "is not 'rtps' or 'rclpy'" in link.reason:
+            self._say("WARNING", f"{link.reason}: loading through rclpy")
         try:
             self.loader.prepare()
         except OSError as e:  # RTPS: no port of the domain free, no UDP at all
