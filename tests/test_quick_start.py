@@ -281,3 +281,35 @@ def test_a_node_with_parameters_starts_quick_with_its_params_file(tmp_path: Path
         assert "rate: 5" in params.read_text() and "frame: map" in params.read_text()
         params.unlink()
     assert seen == [False, True]
+
+
+def test_a_damaged_or_foreign_entry_is_never_used(case: tuple[Path, dict[str, str], Path]) -> None:
+    path, env, out = case
+    run(path, env, out)
+    (entry,) = entries(env)
+    good = entry.read_bytes()
+    # Cut short, a bit flipped, garbage after a right header, others let in: each is ignored
+    # (the run resolves, or takes the plan cache's entry) and the run is the same.
+    flipped = bytearray(good)
+    flipped[-5] ^= 0x40
+    for data, mode in (
+        (good[: len(good) // 2], 0o600),
+        (bytes(flipped), 0o600),
+        (quick.FORMAT + b"0" * 40 + b"\n" + b"\xff" * 64, 0o600),
+        (good, 0o644),
+    ):
+        entry.write_bytes(data)
+        entry.chmod(mode)
+        output, adopted, _ = run(path, env, out)
+        assert adopted == [] and "second from one" in output, (data[:60], oct(mode))
+        entry.unlink(missing_ok=True)
+    # A sound entry of this command line under another command line's name: refused too.
+    argv = [str(path), "x:=1"]
+    other = entry.with_name(quick.key(argv, env) + quick.SUFFIX)
+    other.write_bytes(good)
+    other.chmod(0o600)
+    logs = run_logs(Path(env["ROS_LOG_DIR"]))
+    done = run_mlaunch(*argv, env=env, timeout=60)
+    assert done.returncode == 0, done.stdout + done.stderr
+    (log_dir,) = run_logs(Path(env["ROS_LOG_DIR"])) - logs
+    assert "by the quick start" not in (log_dir / "launch.log").read_text()
