@@ -85,27 +85,35 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
                 f.write(text + "\n")
             os.rename(_out + ".tmp", _out)
 
-        def wrap_supervisor(sup):
-            start = sup.Supervisor.start
-
+        def counting(start, before_first, undo):
+            # ``start`` marked around its first call and ended at the _children-th.
             count = [0]
 
-            def started(self, *a, **k):
+            def started(*a, **k):
                 count[0] += 1
                 if count[0] == 1:
-                    _mark("supervisor: imports, set-up, parts")
-                result = start(self, *a, **k)
+                    _mark(before_first())
+                result = start(*a, **k)
                 if count[0] == 1:
                     _mark("spawn of the first child")
                 if count[0] < _children:
                     return result
                 if _children > 1:
                     _mark(f"spawns of children 2 to {_children}")
-                sup.Supervisor.start = start
+                undo()
                 finish()
                 return result
 
-            sup.Supervisor.start = started
+            return started
+
+        def wrap_supervisor(sup):
+            start = sup.Supervisor.start
+
+            def undo():
+                sup.Supervisor.start = start
+
+            made = lambda: "supervisor: imports, set-up, parts"  # noqa: E731
+            sup.Supervisor.start = counting(start, made, undo)
 
         # Wraps Supervisor.start when the supervisor's module is imported (not before: a run
         # may start its first child before it imports it).
@@ -136,29 +144,16 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
                 sys.meta_path.insert(0, SupervisorHook())  # a revision that Popen()s
                 return supervise(*args, **kwargs)
             spawn = spawning.start
-            count = [0]
 
-            def counted(*a, **k):
-                count[0] += 1
-                if count[0] == 1:
-                    made = "mlaunch.engine.supervisor" in sys.modules
-                    _mark(
-                        "supervisor: imports, set-up, parts"
-                        if made
-                        else "supervise: the descriptor limit, the first spawns' set-up"
-                    )
-                result = spawn(*a, **k)
-                if count[0] == 1:
-                    _mark("spawn of the first child")
-                if count[0] < _children:
-                    return result
-                if _children > 1:
-                    _mark(f"spawns of children 2 to {_children}")
+            def undo():
                 spawning.start = spawn
-                finish()
-                return result
 
-            spawning.start = counted
+            def before_first():
+                if "mlaunch.engine.supervisor" in sys.modules:
+                    return "supervisor: imports, set-up, parts"
+                return "supervise: the descriptor limit, the first spawns' set-up"
+
+            spawning.start = counting(spawn, before_first, undo)
             return supervise(*args, **kwargs)
 
         pipeline.supervise = first_spawn
