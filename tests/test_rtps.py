@@ -366,9 +366,9 @@ def test_a_participant_that_says_it_left_is_forgotten(participant: rtps.Particip
 
 
 def test_close_ends_the_thread_and_the_sockets(ros_env: dict[str, str]) -> None:
-    before = {t.name for t in threading.enumerate()}
+    before = set(threading.enumerate())
     made = rtps.Participant(int(ros_env["ROS_DOMAIN_ID"]), "SUBNET")
-    assert "rtps" in {t.name for t in threading.enumerate()} - before
+    assert [t.name for t in set(threading.enumerate()) - before] == ["rtps"]
     made.close()
     assert not made._thread.is_alive()
     assert made.unicast.fileno() == -1
@@ -403,6 +403,7 @@ def test_a_container_that_never_answers_is_abandoned_at_shutdown(
     from mlaunch.parts.loadnode_links import RtpsLink
 
     domain = int(ros_env["ROS_DOMAIN_ID"])
+    before = set(threading.enumerate())
     mute = _mute_container(domain, "/mute")
     lines: list[tuple[str, str]] = []
     link = RtpsLink(domain, "LOCALHOST")
@@ -426,7 +427,7 @@ def test_a_container_that_never_answers_is_abandoned_at_shutdown(
             " shutdown: node 'a' of type 'p::A' may not have been loaded",
         )
     ]
-    assert not [t for t in threading.enumerate() if t.name == "rtps" and t.is_alive()]
+    assert not [t for t in set(threading.enumerate()) - before if t.is_alive()]
 
 
 def test_a_container_that_leaves_is_no_longer_ready(ros_env: dict[str, str]) -> None:
