@@ -36,6 +36,7 @@ SITECUSTOMIZE = r"""
 import os, sys, time
 _out = os.environ.pop("MLAUNCH_STARTUP_PROFILE", "")
 _children = int(os.environ.pop("MLAUNCH_STARTUP_PROFILE_CHILDREN", "1"))
+_quick = os.environ.pop("MLAUNCH_STARTUP_PROFILE_QUICK", "")
 if _out:  # popped: the Python programs mlaunch starts are not profiled
     _marks = [("interpreter and site (from exec)", time.process_time())]
 
@@ -56,6 +57,43 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
 
         setattr(owner, name, wrapped)
 
+    _done = []
+
+    def _finish():
+        if _done:
+            return
+        _done.append(True)
+        text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
+        with open(_out + ".tmp", "w") as f:
+            f.write(text + "\n")
+        os.rename(_out + ".tmp", _out)
+
+    def _setup_quick():
+        # A repeated start (--quick): only what the quick start does is wrapped, nothing of the
+        # rest of mlaunch imported ahead of it.
+        import mlaunch.app.quick as quick
+        _mark("import mlaunch.app.quick")
+        _wrap(quick, "key", "quick start: the key (command line, environment, interpreter)")
+        _wrap(quick.QuickStart, "_entry", "quick start: read the entry, stat its inputs and modules")
+        start = quick._start
+        count = [0]
+
+        def counted(*a, **k):
+            count[0] += 1
+            if count[0] == 1:
+                _mark("quick start: the lifeline (params folder, cgroup, guard fork), imports")
+            result = start(*a, **k)
+            if count[0] == 1:
+                _mark("spawn of the first child")
+            if count[0] >= _children:
+                if _children > 1:
+                    _mark(f"spawns of children 2 to {_children}")
+                quick._start = start
+                _finish()
+            return result
+
+        quick._start = counted
+
     def _setup():
         import mlaunch.cli
         _mark("import mlaunch.cli")
@@ -74,16 +112,7 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
         _wrap(pipeline, "load_file", "load the launch file")
         _wrap(pipeline, "resolve_for_run", "resolve")
         supervise = pipeline.supervise
-        done = []
-
-        def finish():
-            if done:
-                return
-            done.append(True)
-            text = "\n".join(f"{n}\t{c!r}" for n, c in _marks)
-            with open(_out + ".tmp", "w") as f:
-                f.write(text + "\n")
-            os.rename(_out + ".tmp", _out)
+        finish = _finish
 
         def counting(start, before_first, undo):
             # ``start`` marked around its first call and ended at the _children-th.
@@ -158,7 +187,10 @@ if _out:  # popped: the Python programs mlaunch starts are not profiled
 
         pipeline.supervise = first_spawn
 
-    _setup()
+    if _quick:
+        _setup_quick()
+    else:
+        _setup()
 """
 
 
@@ -181,6 +213,7 @@ def profile(
     runs: int,
     tree: str | None = None,
     children: int = 1,
+    quick: bool = False,
 ) -> dict[str, list[float]]:
     """Run ``argv`` ``runs`` times (plus a warm-up); each bucket's CPU seconds per run, until
     the first child was started, or the ``children``-th."""
@@ -189,22 +222,41 @@ def profile(
         site = Path(tmp) / "site"
         site.mkdir()
         (site / "sitecustomize.py").write_text(SITECUSTOMIZE)
+        if quick:
+            # A run reads it (it is on sys.path): a quick entry is written only once every file
+            # a resolution read is two seconds old (mlaunch.plan.inputs.RACY_NS).
+            import time
+
+            settled = (site / "sitecustomize.py").stat().st_ctime + 2.2
+            time.sleep(max(0.0, settled - time.time()))
         paths = [p for p in (tree, str(site), env.get("PYTHONPATH")) if p]
-        for i in range(runs + 1):
+        # The warm-up: bytecode written, caches warm; with --quick, the runs until the quick
+        # start starts the children (the first writes the plan and the quick entry).
+        warm = 3 if quick else 1
+        measured = 0
+        for i in range(runs + warm):
+            if measured == runs:
+                break
             out = Path(tmp) / f"marks-{i}.txt"
             run_env = {**env, "PYTHONPATH": os.pathsep.join(paths)}
             run_env["MLAUNCH_STARTUP_PROFILE"] = str(out)
             run_env["MLAUNCH_STARTUP_PROFILE_CHILDREN"] = str(children)
+            if quick:
+                run_env["MLAUNCH_STARTUP_PROFILE_QUICK"] = "1"
             done = subprocess.run(
                 list(argv), env=run_env, capture_output=True, text=True, timeout=120
             )
             if not out.exists():
+                if i < warm - 1:
+                    continue  # no quick start yet
                 raise RuntimeError(
                     f"no marks from {' '.join(argv)} (exit {done.returncode}):"
                     f" {done.stderr.strip()[-500:] or done.stdout.strip()[-500:]}"
                 )
-            if i == 0:
-                continue  # the warm-up: bytecode written, caches warm
+            if warm > 0:
+                warm = 0  # the first run that has marks is the warm-up
+                continue
+            measured += 1
             marks = []
             for line in out.read_text().splitlines():
                 name, _, cpu = line.rpartition("\t")
@@ -234,6 +286,12 @@ def main(args: Sequence[str] | None = None) -> int:
         default=1,
         help="profile until the N-th child was started (the launch's first N), not the first",
     )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="profile a repeated start's quick start (the plan cache on; the first run writes"
+        " the entry: give a launch file settled for two seconds)",
+    )
     parser.add_argument("command", nargs=argparse.REMAINDER)
     opts = parser.parse_args(args)
     command = [c for c in opts.command if c != "--"] if opts.command[:1] == ["--"] else opts.command
@@ -245,7 +303,7 @@ def main(args: Sequence[str] | None = None) -> int:
         for k, v in os.environ.items()
         if k not in ("PYTHONDONTWRITEBYTECODE", "PYTHONUNBUFFERED")
     }
-    found = profile(command, env, opts.runs, opts.tree, opts.children)
+    found = profile(command, env, opts.runs, opts.tree, opts.children, opts.quick)
     sys.stdout.write(table(found))
     if opts.json:
         Path(opts.json).write_text(json.dumps(found, indent=2) + "\n")

@@ -12,7 +12,6 @@ closes its copy).
 from __future__ import annotations
 
 import os
-import re
 
 # Matched in the guard's sweep only (re's cache compiles it there, not before the first child).
 _NAME = r"mlaunch-([0-9]+)-[0-9a-f]{8}"
@@ -75,6 +74,7 @@ def _remove_tree(path: str) -> None:
 def sweep_dead_runs(base: str | None = None) -> list[str]:
     """Remove the private folders of this user's runs that died with their guard; the paths."""
     import fcntl
+    import re  # here, in the guard: not on mlaunch's way to its first child (the quick start)
 
     base = base or temp_base()
     try:
