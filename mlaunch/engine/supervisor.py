@@ -143,7 +143,8 @@ class Supervisor:
         prestarted: Prestarted | None = None,
     ) -> None:
         self.plan = plan
-        # Children the quick start started as the plan's first processes: adopted by start().
+        # The plan's first processes, started before the supervisor was made (by the quick start,
+        # or as soon as the plan was known: mlaunch.app.quick): adopted by start().
         self.prestarted = prestarted
         self.gentle_on_error = gentle_on_error
         # Subscribed below, and the terminal whose flow control the loop drives; parts are
