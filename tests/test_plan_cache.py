@@ -109,37 +109,12 @@ RUN_CASES = [
 
 
 def run_case(case: str, work: Path, prefix: Path) -> tuple[dict[str, object], str]:
-    """The conformance summary of one mlaunch run of ``case`` in ``work``, and its cache notes."""
-    records = work / "records"
-    shutil.rmtree(records, ignore_errors=True)
-    records.mkdir()
-    options = harness.case_options(case)
-    env = harness.base_environ(prefix, records, None)
-    env["XDG_CACHE_HOME"] = str(work.parent / "cache")
-    if "PYTHONPATH" in os.environ:
-        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
-    argv = harness.launcher_argv("mlaunch", case, prefix, options["args"], options["pkg"])
-    done = subprocess.run(
-        [*argv, "--debug"],
-        env=env,
-        cwd=str(work),
-        stdin=subprocess.DEVNULL,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        start_new_session=True,
-    )
-    notes = cache_lines(done)
-    stderr = "".join(x + "\n" for x in done.stderr.splitlines() if "mlaunch: plan cache:" not in x)
-    lines = (records / "records.jsonl").read_text().splitlines()
-    summary = harness.summarize(
-        rc=done.returncode,
-        text=done.stdout + stderr,
-        records=[json.loads(line) for line in lines],
-        given=env,
-        paths={str(prefix): "<prefix>", str(work): "<work>"},
-    )
-    return summary, notes
+    """The conformance summary of one mlaunch run of ``case`` in ``work``, and its cache notes
+    (--debug's ``mlaunch: plan cache:`` lines, which the summary, as a ros2 launch run's, reads
+    neither as log nor as output)."""
+    cache = {"XDG_CACHE_HOME": str(work.parent / "cache")}
+    summary, done = harness.run_mlaunch_case(case, work, prefix, ["--debug"], cache)
+    return summary, cache_lines(done)
 
 
 @pytest.mark.parametrize("case", RUN_CASES)

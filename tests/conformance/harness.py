@@ -25,6 +25,7 @@ import re
 import shutil
 import subprocess
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -160,28 +161,58 @@ def run_case(
     launcher: str, name: str, work: Path, reference: dict[str, str] | None
 ) -> dict[str, Any]:
     """Run case ``name`` under ``launcher`` ('ros2' or 'mlaunch') in ``work``; return its summary."""
-    opts = case_options(name)
     prefix = make_prefix(work)
+    if launcher == "mlaunch":
+        return run_mlaunch_case(name, work, prefix)[0]
+    opts = case_options(name)
     records = work / "records"
     records.mkdir()
-    env = base_environ(prefix, records, reference if launcher == "ros2" else None)
-    if launcher == "mlaunch" and "PYTHONPATH" in os.environ:
-        env["PYTHONPATH"] = os.environ["PYTHONPATH"]  # the mlaunch this test imports
+    env = base_environ(prefix, records, reference)
     argv = launcher_argv(launcher, name, prefix, opts["args"], opts["pkg"])
-    if launcher == "ros2":
-        argv[0] = shutil.which("ros2", path=env["PATH"]) or "ros2"
-        proc = run_ros2(argv, env=env, cwd=work, timeout=60)
-    else:
-        proc = subprocess.run(
-            argv,
-            env=env,
-            cwd=str(work),
-            stdin=subprocess.DEVNULL,
-            capture_output=True,
-            text=True,
-            timeout=60,
-            start_new_session=True,
-        )
+    argv[0] = shutil.which("ros2", path=env["PATH"]) or "ros2"
+    proc = run_ros2(argv, env=env, cwd=work, timeout=60)
+    return _summary(proc, records, env, prefix, work)
+
+
+def run_mlaunch_case(
+    name: str,
+    work: Path,
+    prefix: Path,
+    more: Sequence[str] = (),
+    env_more: dict[str, str] | None = None,
+) -> tuple[dict[str, Any], subprocess.CompletedProcess[str]]:
+    """Run case ``name`` under mlaunch in ``work`` with the case files in ``prefix`` (again
+    and again: its records are new each run), options ``more`` after the case's arguments and
+    ``env_more`` in its environment; its summary, and what it printed."""
+    opts = case_options(name)
+    records = work / "records"
+    shutil.rmtree(records, ignore_errors=True)
+    records.mkdir()
+    env = base_environ(prefix, records, None)
+    if "PYTHONPATH" in os.environ:
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]  # the mlaunch this test imports
+    env.update(env_more or {})
+    argv = launcher_argv("mlaunch", name, prefix, opts["args"], opts["pkg"])
+    proc = subprocess.run(
+        [*argv, *more],
+        env=env,
+        cwd=str(work),
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        start_new_session=True,
+    )
+    return _summary(proc, records, env, prefix, work), proc
+
+
+def _summary(
+    proc: subprocess.CompletedProcess[str],
+    records: Path,
+    env: dict[str, str],
+    prefix: Path,
+    work: Path,
+) -> dict[str, Any]:
     lines = (
         (records / "records.jsonl").read_text().splitlines()
         if (records / "records.jsonl").exists()
