@@ -12,6 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -20,6 +21,9 @@ from procutil import clean_env, install_package, mlaunch, run_mlaunch, wait_unti
 
 from mlaunch.app import quick
 from mlaunch.plan.inputs import RACY_NS
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "conformance"))
+import harness
 
 LAUNCH = """\
 from launch import LaunchDescription
@@ -313,3 +317,36 @@ def test_a_damaged_or_foreign_entry_is_never_used(case: tuple[Path, dict[str, st
     assert done.returncode == 0, done.stdout + done.stderr
     (log_dir,) = run_logs(Path(env["ROS_LOG_DIR"])) - logs
     assert "by the quick start" not in (log_dir / "launch.log").read_text()
+
+
+# Conformance cases (tests/conformance) whose processes the quick start starts: what they
+# record must be what ros2 launch did (their recordings, made from the reference).
+QUICK_CASES = [
+    "node_basic.launch.py",
+    "node_basic.launch.xml",
+    "frontend_process.launch.xml",
+    "frontend_process.launch.yaml",
+    "env_actions.launch.py",
+    "typed_values.launch.yaml",
+    "ros_scoping.launch.xml",
+    "include.launch.xml",
+]
+
+
+@pytest.mark.parametrize("case", QUICK_CASES)
+def test_a_quick_start_runs_as_ros2_launch_does(case: str, tmp_path: Path) -> None:
+    work = tmp_path / "work"
+    prefix = harness.make_prefix(work)
+    logs = work / "log"
+    logs.mkdir()
+    settled(*[p for p in (work, *work.rglob("*")) if not p.is_symlink()])
+    cache = {"XDG_CACHE_HOME": str(tmp_path / "cache")}
+    expected = harness.expected(case)
+    ways = []
+    for _ in range(2):  # resolved (the entry written), then quick-started
+        before = run_logs(logs)
+        summary, _done = harness.run_mlaunch_case(case, work, prefix, (), cache)
+        assert summary == expected
+        (log_dir,) = run_logs(logs) - before
+        ways.append("by the quick start" in (log_dir / "launch.log").read_text())
+    assert ways == [False, True]
