@@ -176,6 +176,7 @@ class Child:
         label: str,
         argv: tuple[str, ...],
         env: dict[str, str],
+        cwd: str | None,
         pid: int,
         fds: tuple[int, int, int],
         started_at: float,
@@ -183,7 +184,7 @@ class Child:
         self.label = label
         self.argv = argv
         self.env = env
-        self.cwd: str | None = None
+        self.cwd = cwd
         self.pid = pid
         self.stdin, self.stdout, self.stderr = fds  # our ends: stdin's write end, the reads
         self.started_at = started_at
@@ -459,27 +460,16 @@ def _start(
 ) -> Child | None:
     """Start one child (stdin a pipe we keep open, stdout and stderr pipes); None when its
     program cannot be started (the supervisor tries again and says why)."""
-    fds: list[int] = []
+    from mlaunch.engine.spawning import with_pipes
+
+    def start_child(stdin: int, out: int, err: int) -> int:
+        return int(start(argv, env, cwd=cwd, stdin=stdin, stdout=out, stderr=err))
+
     try:
-        for _ in range(3):
-            fds.extend(os.pipe())
-    except OSError:  # out of descriptors: the supervisor raises its limit and starts it
-        for fd in fds:
-            os.close(fd)
-        return None
-    stdin_r, stdin_w, out_r, out_w, err_r, err_w = fds
-    try:
-        pid = start(argv, env, cwd=cwd, stdin=stdin_r, stdout=out_w, stderr=err_w)
-    except OSError:
-        for fd in (stdin_w, out_r, err_r):
-            os.close(fd)
-        return None
-    finally:
-        for fd in (stdin_r, out_w, err_w):
-            os.close(fd)
-    child = Child(label, argv, env, pid, (stdin_w, out_r, err_r), clock())
-    child.cwd = cwd
-    return child
+        pid, stdin_write, (out_read, err_read) = with_pipes(start_child)
+    except (OSError, ValueError):  # out of descriptors, or it cannot start: the supervisor
+        return None  # starts it (raising its limit) and says why it cannot
+    return Child(label, argv, env, cwd, pid, (stdin_write, out_read, err_read), clock())
 
 
 def _end(child: Child, why: str) -> None:

@@ -284,43 +284,30 @@ class Process:
 
         # The user's own open-file limit, when the run raised its own (only then).
         setup = fdlimit.LIMIT.child_setup() if fdlimit.LIMIT is not None else None
-        # stdout and stderr: (read, write) pipes, or (master, slave) terminals for emulate_tty.
-        outputs = _ptys() if spec.emulate_tty else None
-        made: list[int] = [fd for pair in outputs or () for fd in pair]
-        try:
-            if outputs is None:
-                outputs = (os.pipe(), os.pipe())  # close-on-exec, as every fd below
-                made += (*outputs[0], *outputs[1])
-            # A pipe nobody writes to, open while the child lives, as launch gives: a child
-            # that reads its stdin waits (DEVNULL would hand it EOF at once). Its write end is
-            # held (``stdin_fd``) and only ever closed, so it is a bare fd, not a file object.
-            stdin_read, stdin_write = os.pipe()
-            made += (stdin_read, stdin_write)
-            out, err = outputs[0][1], outputs[1][1]
+
+        def start_child(stdin: int, out: int, err: int) -> int:
             try:
                 if self.direct:
-                    self.pid = spawning.start(
+                    return spawning.start(
                         argv,
                         spawning.environment(env),
-                        stdin=stdin_read,
+                        stdin=stdin,
                         stdout=out,
                         stderr=err,
                         cwd=spec.cwd,
                         child_setup=setup,
                     )
-                else:
-                    self._popen(argv, env, stdin_read, out, err, setup)
+                return self._popen(argv, env, stdin, out, err, setup)
             except ValueError as e:  # a value no exec can take: this child fails to start
                 raise OSError(errno.EINVAL, unstartable(argv, env, spec.cwd) or str(e)) from e
-        except BaseException:
-            for fd in made:
-                os.close(fd)
-            raise
-        os.close(stdin_read)
-        self.stdin_fd = stdin_write
+
+        # stdout and stderr on pipes, or (master, slave) terminals for emulate_tty; stdin's
+        # write end is held (``stdin_fd``) and only ever closed, so it is a bare fd.
+        outputs = _ptys() if spec.emulate_tty else None
+        self.pid, self.stdin_fd, reads = spawning.with_pipes(start_child, outputs)
         self.started_at = clock()
-        for name, (read, write) in zip(("stdout", "stderr"), outputs, strict=True):
-            os.close(write)  # the child has it: the read end sees EOF (a pty EIO) once it is gone
+        for name, read in zip(("stdout", "stderr"), reads, strict=True):
+            # the read end sees EOF (a pty EIO) once the child is gone
             os.set_blocking(read, False)
             self.streams[read] = Stream(name, read)
 
@@ -332,9 +319,9 @@ class Process:
         stdout: int,
         stderr: int,
         setup: Callable[[], None] | None,
-    ) -> None:
+    ) -> int:
         """Start the child with subprocess.Popen (a Python whose fork_exec engine.spawning
-        does not know): the same child, at three times the cost."""
+        does not know): the same child, at three times the cost; its pid."""
         import subprocess
 
         self.popen = subprocess.Popen(
@@ -348,7 +335,7 @@ class Process:
             close_fds=True,
             preexec_fn=setup,
         )
-        self.pid = self.popen.pid
+        return self.popen.pid
 
     def adopt(self, pid: int, fds: tuple[int, int, int], started_at: float) -> None:
         """Take over a child the quick start started as this spec (mlaunch.app.quick): its

@@ -200,6 +200,32 @@ def start(
     return pid
 
 
+def with_pipes(
+    start_child: Callable[[int, int, int], int],
+    outputs: tuple[tuple[int, int], tuple[int, int]] | None = None,
+) -> tuple[int, int, tuple[int, int]]:
+    """``start_child(stdin, stdout, stderr)`` (a pid) with the ends a launch gives a child:
+    stdin a pipe nobody writes to, held open while it lives (a child that reads it waits, where
+    /dev/null would hand it EOF at once), stdout and stderr pipes, or the (read, write) pairs of
+    ``outputs`` (terminals). Returns (pid, stdin's write end, the two read ends); the child's
+    ends are closed here, and every end if it raises."""
+    made: list[int] = [fd for pair in outputs or () for fd in pair]
+    try:
+        if outputs is None:
+            outputs = (os.pipe(), os.pipe())  # close-on-exec, as every fd here
+            made += (*outputs[0], *outputs[1])
+        stdin_read, stdin_write = os.pipe()
+        made += (stdin_read, stdin_write)
+        pid = start_child(stdin_read, outputs[0][1], outputs[1][1])
+    except BaseException:
+        for fd in made:
+            os.close(fd)
+        raise
+    for fd in (stdin_read, outputs[0][1], outputs[1][1]):
+        os.close(fd)
+    return pid, stdin_write, (outputs[0][0], outputs[1][0])
+
+
 def _raise_failure(pid: int, report: bytes, program: object, cwd: str | None) -> None:
     """Reap the child that could not exec and raise what Popen raises for ``report``."""
     try:
