@@ -230,22 +230,13 @@ class Prestart:
         if not first:
             return
         life.settle()
-        # Before them, as the guarantee needs: a daemon among them that double-forks at once
-        # is re-parented to mlaunch, whose supervisor tells the guard its group, even if it
-        # dropped the marker and left the cgroup (ctypes: ~2 ms, on a path that has just
-        # loaded and resolved the file; the quick start does it after its spawns instead).
-        from mlaunch.engine.strays import set_subreaper
-
-        set_subreaper(True)
         # A Ctrl-C now is the supervisor's to act on, as in its own spawn batch: the starts
         # stop, and it gets the signal once its handlers are in (its shutdown then stops what
         # started and says how many did not).
         life.defer_signals()
         try:
             how = "as soon as its plan was known"
-            self._start_all(
-                first, life, (), settled=True, how=how, stop=lambda: life.received, reaper=False
-            )
+            self._start_all(first, life, (), settled=True, how=how, stop=lambda: life.received)
         finally:
             life.pass_signals_on()
 
@@ -258,12 +249,10 @@ class Prestart:
         settled: bool,
         how: str,
         stop: Callable[[], object] | None = None,
-        reaper: bool = True,
     ) -> None:
         """Start ``first`` (as ``_first_processes`` lists them; ``rebase``: old, new texts),
         telling the guard, until one cannot start (the supervisor starts it and says why) or
-        ``stop()``. Unless mlaunch was ``settled`` in its cgroup, they are moved in after it;
-        with ``reaper``, mlaunch becomes their subreaper after them."""
+        ``stop()``. Unless mlaunch was ``settled`` in its cgroup, they are moved in after it."""
         import time
 
         from mlaunch.engine.spawning import start
@@ -285,11 +274,10 @@ class Prestart:
                 guard.watch(child.pid, grace)
         if guard is not None:
             guard.flush()
-        if self.children and reaper:
+        if self.children:
             # After them, not before (ctypes costs milliseconds): a daemon among them that
             # forks away while the supervisor is being made is re-parented to mlaunch, whose
-            # supervisor finds it (it becomes the subreaper again itself, as in every run); one
-            # that forks away sooner is found by its marker, as a child the supervisor starts.
+            # supervisor finds it (it becomes the subreaper again itself, as in every run).
             from mlaunch.engine.strays import set_subreaper
 
             set_subreaper(True)
