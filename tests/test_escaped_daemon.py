@@ -12,10 +12,15 @@ import pytest
 from procutil import wait_until
 from test_faults import Mlaunch, alive, write_launch
 
-# Double-forks into a session of its own, clears its environment, moves itself to the cgroup
+# Once the file argv[3] exists (the run is up: mlaunch is the subreaper from its first turn on;
+# a daemon that forks away sooner is found by its marker only, which this one drops),
+# double-forks into a session of its own, clears its environment, moves itself to the cgroup
 # argv[2] names (out of the run's), says its pid and sleeps.
 DAEMON = (
     "import os, sys, time\n"
+    "deadline = time.monotonic() + 60\n"
+    "while not os.path.exists(sys.argv[3]) and time.monotonic() < deadline:\n"
+    "    time.sleep(0.01)\n"
     "if os.fork():\n"
     "    time.sleep(60)\n"
     "    sys.exit(0)\n"
@@ -46,17 +51,20 @@ def test_a_daemon_that_left_the_runs_cgroup_ends_after_kill_9(tmp_path: Path) ->
         pytest.skip("no cgroup v2 here: a run has no cgroup to leave")
     # Where the test itself is (outside the run's): the daemon moves there.
     away = os.path.join(root, mine.lstrip("/"), "cgroup.procs")
-    daemon_pid = tmp_path / "daemon.pid"
+    daemon_pid, go = tmp_path / "daemon.pid", tmp_path / "go"
     launch = write_launch(
         tmp_path,
         [
             "ExecuteProcess(cmd=[PY, '-c', "
-            f"{DAEMON!r}, {str(daemon_pid)!r}, {away!r}], name='daemonizer', sigkill_timeout=0.5)"
+            f"{DAEMON!r}, {str(daemon_pid)!r}, {away!r}, {str(go)!r}], name='daemonizer',"
+            " sigkill_timeout=0.5)"
         ],
     )
     m = Mlaunch(tmp_path, launch)
     daemon = 0
     try:
+        assert wait_until(lambda: "process started with pid" in m.text, 15), m.text
+        go.touch()
         assert wait_until(daemon_pid.exists, 15), m.text
         daemon = int(daemon_pid.read_text())
         if "mlaunch-" in cgroup_of(daemon):
